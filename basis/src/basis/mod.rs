@@ -1,0 +1,158 @@
+//! The [`Basis`] trait and its implementations.
+//!
+//! A basis is a finite set of functions `phi_i` on a mesh, each non-zero on a
+//! few elements (its support). The MPM driver and the projection study only
+//! ever talk to a basis through this trait, so swapping piecewise-linear for
+//! Powell–Sabin changes no line of the driver.
+//!
+//! | implementation | dim | functions | continuity |
+//! |---|---|---|---|
+//! | [`linear::Linear`] | 2 | one per vertex | C⁰ |
+//! | [`powell_sabin::PowellSabin`] | 2 | three per vertex | C¹ |
+//! | [`linear1d::Linear1d`] | 1 | one per node | C⁰ |
+//! | [`bspline1d::QuadraticBSpline`] | 1 | nodes + 1 | C¹ |
+//!
+//! Evaluation writes into a caller-owned [`BasisEval`] sized once from
+//! [`Basis::max_functions_per_element`]; nothing allocates per call.
+
+pub mod bspline1d;
+pub mod linear;
+pub mod linear1d;
+pub mod powell_sabin;
+
+use crate::scalar::Real;
+use nalgebra::SVector;
+
+/// A point (or gradient) in `D` dimensions in scalar type `T`.
+pub type Point<T, const D: usize> = SVector<T, D>;
+
+/// Values and gradients of the functions non-zero at one point, written by
+/// [`Basis::eval`]. Entries `0..len()` are valid; the buffers keep their capacity.
+#[derive(Debug, Clone)]
+pub struct BasisEval<T: Real, const D: usize> {
+    len: usize,
+    /// Global function indices.
+    pub index: Vec<usize>,
+    /// Values `phi_i(x)`.
+    pub phi: Vec<T>,
+    /// Gradients `grad phi_i(x)`.
+    pub grad_phi: Vec<Point<T, D>>,
+}
+
+impl<T: Real, const D: usize> BasisEval<T, D> {
+    /// A buffer for up to `capacity` functions per point.
+    pub fn with_capacity(capacity: usize) -> Self {
+        BasisEval {
+            len: 0,
+            index: vec![0; capacity],
+            phi: vec![T::zero(); capacity],
+            grad_phi: vec![Point::<T, D>::zeros(); capacity],
+        }
+    }
+    /// A buffer sized for `basis`.
+    pub fn for_basis<B: Basis<T, D> + ?Sized>(basis: &B) -> Self {
+        Self::with_capacity(basis.max_functions_per_element())
+    }
+    /// Number of valid entries.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// `true` when no entry is valid.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+    /// Sets the number of valid entries (implementations of [`Basis::eval`] call this).
+    ///
+    /// # Panics
+    /// If `len` exceeds the capacity: the basis under-reported its maximum support.
+    #[inline]
+    pub fn set_len(&mut self, len: usize) {
+        assert!(len <= self.index.len(), "BasisEval capacity exceeded");
+        self.len = len;
+    }
+    /// `(index, phi, grad_phi)` for each valid entry.
+    #[inline]
+    pub fn iter(&self) -> impl Iterator<Item = (usize, T, &Point<T, D>)> + '_ {
+        (0..self.len).map(move |k| (self.index[k], self.phi[k], &self.grad_phi[k]))
+    }
+}
+
+/// One linear constraint on the coefficients `c_i ∈ R^D` of a vector field
+/// `v = Σ_i c_i phi_i`: `Σ_k weight_k · (direction · c_{function_k}) = 0`.
+///
+/// Homogeneous Dirichlet conditions are sets of such constraints
+/// ([`Basis::dirichlet`]). Most are single-term (`c_i · n = 0`), which the driver
+/// applies by zeroing a component.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Constraint<T: Real, const D: usize> {
+    /// Unit vector `n`: the component `n · v` is constrained.
+    pub direction: Point<T, D>,
+    /// `(function, weight)` pairs.
+    pub terms: Vec<(usize, T)>,
+}
+
+impl<T: Real, const D: usize> Constraint<T, D> {
+    /// `true` for a constraint `c_i · n = 0` on a single function.
+    pub fn is_single(&self) -> bool {
+        self.terms.len() == 1
+    }
+}
+
+/// Errors of basis construction and queries.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BasisError {
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    #[error("the centroid split point is not valid on this mesh: the line between the centroids of triangles {t1} and {t2} does not cross their common edge; use incentres")]
+    InvalidSplitPoint { t1: usize, t2: usize },
+    #[error("no control triangle found for vertex {vertex}")]
+    NoControlTriangle { vertex: usize },
+    #[error("invalid basis parameter: {0}")]
+    InvalidParameter(String),
+}
+
+/// A finite-dimensional function space on a mesh in `D` dimensions, evaluated in
+/// scalar type `T`.
+///
+/// Elements are the mesh cells (triangles, or intervals in 1D). Functions are
+/// numbered `0..num_functions()`. Properties every implementation satisfies
+/// (and the test suites check): partition of unity `Σ_i phi_i = 1`,
+/// non-negativity, linear precision `Σ_i X_i phi_i = x` with the
+/// [`function_point`](Basis::function_point)s `X_i`.
+pub trait Basis<T: Real, const D: usize> {
+    /// Short name for output (`"pl"`, `"ps"`, `"bspline"`, `"pl1d"`).
+    fn name(&self) -> &'static str;
+    /// Number of basis functions.
+    fn num_functions(&self) -> usize;
+    /// Number of elements.
+    fn num_elements(&self) -> usize;
+    /// Largest number of functions non-zero on one element (the [`BasisEval`] capacity).
+    fn max_functions_per_element(&self) -> usize;
+    /// The element containing `x`, starting the search at `hint` (e.g. a particle's
+    /// previous element). `None` when `x` lies outside the mesh.
+    fn locate(&self, x: &Point<T, D>, hint: Option<usize>) -> Option<usize>;
+    /// Writes index, value and gradient of every function non-zero on `element`
+    /// at `x` (which must lie in the element, up to round-off) into `out`.
+    fn eval(&self, element: usize, x: &Point<T, D>, out: &mut BasisEval<T, D>);
+    /// The functions non-zero on `element` (the same set [`eval`](Basis::eval) writes).
+    fn element_functions(&self, element: usize) -> &[usize];
+    /// The elements forming the support of `function`.
+    fn function_support(&self, function: usize) -> &[usize];
+    /// The point identifying `function` for output and for linear precision
+    /// (the vertex for Lagrange bases, the control point for PS, the Greville
+    /// abscissa for B-splines).
+    fn function_point(&self, function: usize) -> Point<f64, D>;
+    /// Names of the boundary tags the basis knows.
+    fn boundary_tags(&self) -> Vec<String>;
+    /// Linear constraints making the component `direction · v` of any vector
+    /// field `v = Σ c_i phi_i` vanish identically on the boundary tagged `tag`.
+    fn dirichlet(&self, tag: &str, direction: &Point<T, D>) -> Result<Vec<Constraint<T, D>>, BasisError>;
+    /// Appends to `out` the simplices (`D + 1` points each) of `element` on each of
+    /// which every function is a polynomial: the quadrature cells (the six PS
+    /// sub-triangles, or the element itself).
+    fn polynomial_pieces(&self, element: usize, out: &mut Vec<Point<f64, D>>);
+    /// Polynomial degree of the functions on each piece.
+    fn degree(&self) -> usize;
+}

@@ -1,0 +1,462 @@
+//! Triangle meshes (and 1D node vectors) on which the bases are built.
+//!
+//! A [`TriMesh`] holds vertices, counter-clockwise triangles, the edge graph
+//! (neighbours across each edge, global edge ids) and tags on boundary edges.
+//! It is built once, validated on construction ([`MeshError`] names what is wrong),
+//! and never changes afterwards: bases precompute their per-element data from it.
+//!
+//! Conventions used throughout the crate:
+//! - local edge `k` of triangle `t` joins `triangles[t][k]` and `triangles[t][(k + 1) % 3]`;
+//! - `neighbours[t][k]` is the triangle across local edge `k`, `None` on the boundary;
+//! - `triangle_edges[t][k]` is the global id of local edge `k`;
+//! - boundary edges carry an optional tag id into [`TriMesh::tags`].
+//!
+//! Submodules: [`generators`] (block grids, lattice Delaunay, quality meshes of
+//! polygons), [`gmsh`] (`.msh` import), [`locate`] (point location),
+//! [`mesh1d`] (node vectors on an interval).
+
+pub mod generators;
+pub mod gmsh;
+pub mod locate;
+pub mod mesh1d;
+
+pub use locate::Locator;
+pub use mesh1d::Mesh1d;
+
+use nalgebra::Vector2;
+use std::collections::HashMap;
+
+/// A point or vector in the plane.
+pub type Vec2 = Vector2<f64>;
+
+/// What is wrong with a mesh. Every variant names the offending entity.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("mesh has no triangles")]
+    Empty,
+    #[error("triangle {triangle} refers to vertex {vertex}, but the mesh has {num_vertices} vertices")]
+    VertexOutOfRange {
+        triangle: usize,
+        vertex: usize,
+        num_vertices: usize,
+    },
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex { vertex: usize },
+    #[error("triangle {triangle} repeats a vertex ({vertices:?})")]
+    RepeatedVertex { triangle: usize, vertices: [usize; 3] },
+    #[error("triangle {triangle} is degenerate (signed area {area:e} relative to the mesh size)")]
+    DegenerateTriangle { triangle: usize, area: f64 },
+    #[error("triangle {triangle} is clockwise (inverted); triangles must be counter-clockwise")]
+    InvertedTriangle { triangle: usize },
+    #[error("edge ({a}, {b}) is shared by more than two triangles or by two triangles with the same orientation (non-manifold)")]
+    NonManifoldEdge { a: usize, b: usize },
+    #[error("vertex {vertex} is where two separate fans of triangles touch (non-manifold vertex)")]
+    NonManifoldVertex { vertex: usize },
+    #[error("vertices {a} and {b} coincide at ({x}, {y})")]
+    DuplicateVertex { a: usize, b: usize, x: f64, y: f64 },
+    #[error("vertex {vertex} belongs to no triangle")]
+    IsolatedVertex { vertex: usize },
+    #[error("boundary edge ({a}, {b}) from ({ax}, {ay}) to ({bx}, {by}) has no tag, but every boundary edge must be tagged")]
+    UntaggedBoundary {
+        a: usize,
+        b: usize,
+        ax: f64,
+        ay: f64,
+        bx: f64,
+        by: f64,
+    },
+    #[error("unknown boundary tag `{tag}`; the mesh has tags {known:?}")]
+    UnknownTag { tag: String, known: Vec<String> },
+    #[error("invalid mesh parameter: {0}")]
+    InvalidParameter(String),
+    #[error("mesher failed: {0}")]
+    Mesher(String),
+}
+
+/// One edge of the mesh: its two vertices (in the orientation of its first
+/// triangle), the triangles on either side, and its tag if it is a tagged
+/// boundary edge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Edge {
+    /// End vertices, ordered as in `triangles[0]` (counter-clockwise there).
+    pub vertices: [usize; 2],
+    /// The triangle having this edge counter-clockwise, and the one across (`None` on the boundary).
+    pub triangles: (usize, Option<usize>),
+    /// Tag id into [`TriMesh::tags`], boundary edges only.
+    pub tag: Option<usize>,
+}
+
+impl Edge {
+    /// `true` when the edge has a triangle on one side only.
+    pub fn is_boundary(&self) -> bool {
+        self.triangles.1.is_none()
+    }
+}
+
+/// A validated, counter-clockwise triangle mesh with tagged boundary edges.
+#[derive(Debug, Clone)]
+pub struct TriMesh {
+    vertices: Vec<Vec2>,
+    triangles: Vec<[usize; 3]>,
+    neighbours: Vec<[Option<usize>; 3]>,
+    triangle_edges: Vec<[usize; 3]>,
+    edges: Vec<Edge>,
+    tags: Vec<String>,
+    /// For every vertex, the triangles around it (a fan, counter-clockwise order not guaranteed).
+    vertex_triangles: Vec<Vec<usize>>,
+    locator: Locator,
+}
+
+/// Relative tolerance for degenerate triangles (area relative to the squared
+/// length scale of the mesh) and duplicate vertices (distance relative to it).
+pub const GEOMETRY_TOLERANCE: f64 = 1e-12;
+
+impl TriMesh {
+    /// Builds and validates a mesh from vertices and counter-clockwise triangles.
+    /// Boundary edges start untagged; see [`TriMesh::tag_boundary`].
+    ///
+    /// Errors: out-of-range or repeated vertex indices, non-finite coordinates,
+    /// degenerate or clockwise triangles, non-manifold edges or vertices,
+    /// duplicate or isolated vertices.
+    pub fn new(vertices: Vec<Vec2>, triangles: Vec<[usize; 3]>) -> Result<Self, MeshError> {
+        if triangles.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        let nv = vertices.len();
+        for (i, v) in vertices.iter().enumerate() {
+            if !v.x.is_finite() || !v.y.is_finite() {
+                return Err(MeshError::NonFiniteVertex { vertex: i });
+            }
+        }
+        let (lo, hi) = bounding_box(&vertices);
+        let scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
+        for (t, tri) in triangles.iter().enumerate() {
+            for &v in tri {
+                if v >= nv {
+                    return Err(MeshError::VertexOutOfRange {
+                        triangle: t,
+                        vertex: v,
+                        num_vertices: nv,
+                    });
+                }
+            }
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+                return Err(MeshError::RepeatedVertex {
+                    triangle: t,
+                    vertices: *tri,
+                });
+            }
+            let area = signed_area(vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]);
+            let rel = area / (scale * scale);
+            if rel.abs() <= GEOMETRY_TOLERANCE {
+                return Err(MeshError::DegenerateTriangle { triangle: t, area: rel });
+            }
+            if area < 0.0 {
+                return Err(MeshError::InvertedTriangle { triangle: t });
+            }
+        }
+
+        // Duplicate vertices: sort by x and compare neighbours in a window.
+        let tol = GEOMETRY_TOLERANCE * scale * 1e3;
+        let mut order: Vec<usize> = (0..nv).collect();
+        order.sort_by(|&a, &b| vertices[a].x.total_cmp(&vertices[b].x).then(a.cmp(&b)));
+        for i in 0..nv {
+            let a = order[i];
+            for &b in &order[i + 1..] {
+                if vertices[b].x - vertices[a].x > tol {
+                    break;
+                }
+                if (vertices[b] - vertices[a]).norm() <= tol {
+                    let (a, b) = (a.min(b), a.max(b));
+                    return Err(MeshError::DuplicateVertex {
+                        a,
+                        b,
+                        x: vertices[a].x,
+                        y: vertices[a].y,
+                    });
+                }
+            }
+        }
+
+        // Edges: a directed edge (a, b) may occur once; its twin (b, a) at most once.
+        let mut directed: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if directed.insert((a, b), (t, k)).is_some() {
+                    return Err(MeshError::NonManifoldEdge {
+                        a: a.min(b),
+                        b: a.max(b),
+                    });
+                }
+            }
+        }
+        let mut neighbours = vec![[None; 3]; triangles.len()];
+        let mut triangle_edges = vec![[usize::MAX; 3]; triangles.len()];
+        let mut edges = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                if triangle_edges[t][k] != usize::MAX {
+                    continue;
+                }
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let twin = directed.get(&(b, a)).copied();
+                let id = edges.len();
+                triangle_edges[t][k] = id;
+                if let Some((t2, k2)) = twin {
+                    triangle_edges[t2][k2] = id;
+                    neighbours[t][k] = Some(t2);
+                    neighbours[t2][k2] = Some(t);
+                }
+                edges.push(Edge {
+                    vertices: [a, b],
+                    triangles: (t, twin.map(|(t2, _)| t2)),
+                    tag: None,
+                });
+            }
+        }
+
+        let mut vertex_triangles = vec![Vec::new(); nv];
+        for (t, tri) in triangles.iter().enumerate() {
+            for &v in tri {
+                vertex_triangles[v].push(t);
+            }
+        }
+        for (v, fan) in vertex_triangles.iter().enumerate() {
+            if fan.is_empty() {
+                return Err(MeshError::IsolatedVertex { vertex: v });
+            }
+            // A manifold vertex has its triangles connected through edges at v.
+            let mut seen = vec![fan[0]];
+            let mut stack = vec![fan[0]];
+            while let Some(t) = stack.pop() {
+                for k in 0..3 {
+                    let tri = triangles[t];
+                    if tri[k] != v && tri[(k + 1) % 3] != v {
+                        continue;
+                    }
+                    if let Some(n) = neighbours[t][k] {
+                        if !seen.contains(&n) {
+                            seen.push(n);
+                            stack.push(n);
+                        }
+                    }
+                }
+            }
+            if seen.len() != fan.len() {
+                return Err(MeshError::NonManifoldVertex { vertex: v });
+            }
+        }
+
+        let mut mesh = TriMesh {
+            vertices,
+            triangles,
+            neighbours,
+            triangle_edges,
+            edges,
+            tags: Vec::new(),
+            vertex_triangles,
+            locator: Locator::default(),
+        };
+        mesh.locator = Locator::new(&mesh);
+        Ok(mesh)
+    }
+
+    /// Tags boundary edges: `tagger(a, b)` receives the end points of each boundary
+    /// edge and returns its tag name, or `None` to leave it as it is. Returns the
+    /// number of edges tagged.
+    pub fn tag_boundary(&mut self, mut tagger: impl FnMut(Vec2, Vec2) -> Option<String>) -> usize {
+        let mut count = 0;
+        for e in 0..self.edges.len() {
+            if !self.edges[e].is_boundary() {
+                continue;
+            }
+            let [a, b] = self.edges[e].vertices;
+            if let Some(name) = tagger(self.vertices[a], self.vertices[b]) {
+                let id = self.tag_id_or_insert(&name);
+                self.edges[e].tag = Some(id);
+                count += 1;
+            }
+        }
+        count
+    }
+
+    /// Tags the boundary edges lying on the sides of the axis-aligned box
+    /// `[x0, x1] × [y0, y1]` as `left`, `right`, `bottom` and `top` (relative
+    /// tolerance 1e-9 of the box size). Other boundary edges are left untouched.
+    pub fn tag_box_sides(&mut self, x0: f64, x1: f64, y0: f64, y1: f64) -> usize {
+        let tol = 1e-9 * ((x1 - x0).abs() + (y1 - y0).abs());
+        self.tag_boundary(|a, b| {
+            let on = |p: f64, q: f64, c: f64| (p - c).abs() <= tol && (q - c).abs() <= tol;
+            if on(a.x, b.x, x0) {
+                Some("left".into())
+            } else if on(a.x, b.x, x1) {
+                Some("right".into())
+            } else if on(a.y, b.y, y0) {
+                Some("bottom".into())
+            } else if on(a.y, b.y, y1) {
+                Some("top".into())
+            } else {
+                None
+            }
+        })
+    }
+
+    /// Sets the tag of the boundary edge joining vertices `a` and `b` (either
+    /// order). Returns `false` when no such boundary edge exists.
+    pub fn set_edge_tag(&mut self, a: usize, b: usize, tag: &str) -> bool {
+        let Some(e) = self.find_edge(a, b) else {
+            return false;
+        };
+        if !self.edges[e].is_boundary() {
+            return false;
+        }
+        let id = self.tag_id_or_insert(tag);
+        self.edges[e].tag = Some(id);
+        true
+    }
+
+    fn tag_id_or_insert(&mut self, name: &str) -> usize {
+        match self.tags.iter().position(|t| t == name) {
+            Some(i) => i,
+            None => {
+                self.tags.push(name.to_string());
+                self.tags.len() - 1
+            }
+        }
+    }
+
+    /// Checks that every boundary edge carries a tag.
+    pub fn require_tagged_boundary(&self) -> Result<(), MeshError> {
+        for e in &self.edges {
+            if e.is_boundary() && e.tag.is_none() {
+                let [a, b] = e.vertices;
+                let (pa, pb) = (self.vertices[a], self.vertices[b]);
+                return Err(MeshError::UntaggedBoundary {
+                    a,
+                    b,
+                    ax: pa.x,
+                    ay: pa.y,
+                    bx: pb.x,
+                    by: pb.y,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The id of a tag name, or [`MeshError::UnknownTag`] listing the known ones.
+    pub fn tag_id(&self, name: &str) -> Result<usize, MeshError> {
+        self.tags
+            .iter()
+            .position(|t| t == name)
+            .ok_or_else(|| MeshError::UnknownTag {
+                tag: name.to_string(),
+                known: self.tags.clone(),
+            })
+    }
+
+    /// Global id of the edge joining `a` and `b`, if any.
+    pub fn find_edge(&self, a: usize, b: usize) -> Option<usize> {
+        for &t in &self.vertex_triangles[a] {
+            for k in 0..3 {
+                let tri = self.triangles[t];
+                let (p, q) = (tri[k], tri[(k + 1) % 3]);
+                if (p == a && q == b) || (p == b && q == a) {
+                    return Some(self.triangle_edges[t][k]);
+                }
+            }
+        }
+        None
+    }
+
+    /// Vertex coordinates.
+    pub fn vertices(&self) -> &[Vec2] {
+        &self.vertices
+    }
+    /// Counter-clockwise triangles as vertex indices.
+    pub fn triangles(&self) -> &[[usize; 3]] {
+        &self.triangles
+    }
+    /// `neighbours()[t][k]`: the triangle across local edge `k` of `t`.
+    pub fn neighbours(&self) -> &[[Option<usize>; 3]] {
+        &self.neighbours
+    }
+    /// `triangle_edges()[t][k]`: global id of local edge `k` of `t`.
+    pub fn triangle_edges(&self) -> &[[usize; 3]] {
+        &self.triangle_edges
+    }
+    /// All edges.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+    /// Tag names; boundary edges refer to them by index.
+    pub fn tags(&self) -> &[String] {
+        &self.tags
+    }
+    /// Triangles incident to vertex `v`.
+    pub fn vertex_triangles(&self, v: usize) -> &[usize] {
+        &self.vertex_triangles[v]
+    }
+    /// Number of vertices.
+    pub fn num_vertices(&self) -> usize {
+        self.vertices.len()
+    }
+    /// Number of triangles.
+    pub fn num_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+    /// The three corner points of triangle `t`.
+    pub fn triangle_points(&self, t: usize) -> [Vec2; 3] {
+        let [a, b, c] = self.triangles[t];
+        [self.vertices[a], self.vertices[b], self.vertices[c]]
+    }
+    /// Area of triangle `t` (positive).
+    pub fn area(&self, t: usize) -> f64 {
+        let [a, b, c] = self.triangle_points(t);
+        signed_area(a, b, c)
+    }
+    /// Axis-aligned bounding box `(min, max)` of the vertices.
+    pub fn bounding_box(&self) -> (Vec2, Vec2) {
+        bounding_box(&self.vertices)
+    }
+    /// The point locator built with the mesh.
+    pub fn locator(&self) -> &Locator {
+        &self.locator
+    }
+    /// The triangle containing `p`, searching first from `hint` (e.g. a particle's
+    /// previous triangle). `None` when `p` lies outside the mesh. Points on a shared
+    /// edge or vertex are assigned to one of the triangles containing them.
+    pub fn locate(&self, p: Vec2, hint: Option<usize>) -> Option<usize> {
+        self.locator.locate(self, p, hint)
+    }
+    /// Barycentric coordinates of `p` in triangle `t` (they sum to one).
+    pub fn barycentric(&self, t: usize, p: Vec2) -> [f64; 3] {
+        let [a, b, c] = self.triangle_points(t);
+        barycentric(a, b, c, p)
+    }
+}
+
+/// The signed area of triangle (a, b, c), positive when counter-clockwise.
+pub fn signed_area(a: Vec2, b: Vec2, c: Vec2) -> f64 {
+    0.5 * ((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y))
+}
+
+/// Barycentric coordinates of `p` with respect to triangle (a, b, c).
+pub fn barycentric(a: Vec2, b: Vec2, c: Vec2, p: Vec2) -> [f64; 3] {
+    let d = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    let l1 = ((b.x - p.x) * (c.y - p.y) - (c.x - p.x) * (b.y - p.y)) / d;
+    let l2 = ((c.x - p.x) * (a.y - p.y) - (a.x - p.x) * (c.y - p.y)) / d;
+    [l1, l2, 1.0 - l1 - l2]
+}
+
+/// Axis-aligned bounding box of a point set.
+pub fn bounding_box(points: &[Vec2]) -> (Vec2, Vec2) {
+    let mut lo = Vec2::repeat(f64::INFINITY);
+    let mut hi = Vec2::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (lo, hi)
+}

@@ -1,0 +1,2 @@
+//! psmpm: the Material Point Method with Powell–Sabin spline bases.
+pub use psmpm_basis as basis;
