@@ -136,7 +136,8 @@ pub trait Basis<T: Real, const D: usize> {
     /// Writes index, value and gradient of every function non-zero on `element`
     /// at `x` (which must lie in the element, up to round-off) into `out`.
     fn eval(&self, element: usize, x: &Point<T, D>, out: &mut BasisEval<T, D>);
-    /// The functions non-zero on `element` (the same set [`eval`](Basis::eval) writes).
+    /// The functions non-zero on `element`, in the order in which [`eval`](Basis::eval)
+    /// writes them (assembly relies on it).
     fn element_functions(&self, element: usize) -> &[usize];
     /// The elements forming the support of `function`.
     fn function_support(&self, function: usize) -> &[usize];

@@ -1,0 +1,68 @@
+//! The typed choice of basis made at the edge (command line, scene file), and
+//! how each choice is built from a mesh.
+//!
+//! Strings become a [`BasisKind`] once, when input is parsed; from there on
+//! the code is monomorphised over the concrete basis type.
+
+use psmpm_basis::basis::linear::Linear;
+use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+use psmpm_basis::{BasisError, Real, TriMesh};
+use serde::Serialize;
+
+/// The bases of psmpm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BasisKind {
+    /// Quadratic Powell–Sabin splines on triangles (C¹).
+    Ps,
+    /// Piecewise-linear Lagrange on triangles (C⁰).
+    Pl,
+    /// Quadratic B-splines in 1D (C¹).
+    Bspline,
+    /// Piecewise-linear Lagrange in 1D.
+    Pl1d,
+}
+
+impl BasisKind {
+    /// All kinds, in the order they are listed to users.
+    pub const ALL: [BasisKind; 4] = [BasisKind::Ps, BasisKind::Pl, BasisKind::Bspline, BasisKind::Pl1d];
+
+    /// The name used on the command line and in output.
+    pub fn name(self) -> &'static str {
+        match self {
+            BasisKind::Ps => "ps",
+            BasisKind::Pl => "pl",
+            BasisKind::Bspline => "bspline",
+            BasisKind::Pl1d => "pl1d",
+        }
+    }
+
+    /// Parses a name; the error lists the known names.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| {
+                let known: Vec<_> = Self::ALL.iter().map(|k| k.name()).collect();
+                format!("unknown basis `{name}` (known: {})", known.join(", "))
+            })
+    }
+
+    /// Spatial dimension of the basis.
+    pub fn dim(self) -> usize {
+        match self {
+            BasisKind::Ps | BasisKind::Pl => 2,
+            BasisKind::Bspline | BasisKind::Pl1d => 1,
+        }
+    }
+}
+
+/// Builds the piecewise-linear basis on `mesh`.
+pub fn linear<T: Real>(mesh: TriMesh) -> Result<Linear<T>, BasisError> {
+    Ok(Linear::new(mesh))
+}
+
+/// Builds the Powell–Sabin basis on `mesh` with incentre split points.
+pub fn powell_sabin<T: Real>(mesh: TriMesh) -> Result<PowellSabin<T>, BasisError> {
+    PowellSabin::new(mesh, SplitPoint::Incentre)
+}

@@ -1,0 +1,261 @@
+//! Sparse symmetric matrices on a basis, and their Cholesky factorisation.
+//!
+//! The mass matrix `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)` (paper eq. (17)) and the
+//! L² Gram matrix share one sparsity pattern: `i` and `j` couple when some element
+//! carries both functions. [`SymmetricPattern`] builds that pattern once per basis,
+//! stores its upper triangle in compressed sparse column form (an `sprs` matrix), and
+//! precomputes for every element where each local pair `(a, b)` lands in the value
+//! array, so that assembly is a gather–scatter without searching.
+//!
+//! [`SparseCholesky`] splits the work as faer does: the symbolic factorisation
+//! (fill-reducing ordering, elimination tree, factor pattern) once per pattern,
+//! the numeric factorisation and the solves on every call, with all scratch memory
+//! owned by the struct, so that a time step allocates nothing.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+use psmpm_basis::{Basis, Real};
+use sprs::CsMat;
+
+/// The scalar types the solvers accept: a [`Real`] that faer can factorise (`f32`, `f64`).
+pub trait Scalar: Real + faer::traits::RealField {}
+impl<T: Real + faer::traits::RealField> Scalar for T {}
+
+/// Upper-triangular CSC pattern of a symmetric matrix indexed by basis functions,
+/// with per-element scatter maps.
+#[derive(Debug, Clone)]
+pub struct SymmetricPattern {
+    /// Upper triangle (`row ≤ col`) with unit values, in CSC storage; its index arrays
+    /// are the pattern, values are kept by the caller.
+    upper: CsMat<f64>,
+    /// Column pointers of `upper`.
+    col_ptr: Vec<usize>,
+    /// For element `e`, `scatter[scatter_offsets[e]..]` holds, for each local pair
+    /// `(a, b)` (row-major over the element's functions), the position of entry
+    /// `(min(i,j), max(i,j))` in the value array.
+    scatter: Vec<usize>,
+    scatter_offsets: Vec<usize>,
+    /// Position of each diagonal entry in the value array.
+    diagonal: Vec<usize>,
+}
+
+impl SymmetricPattern {
+    /// The pattern of all products `phi_i phi_j` of `basis`.
+    pub fn new<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(basis: &B) -> Self {
+        let n = basis.num_functions();
+        let mut tri = sprs::TriMat::new((n, n));
+        for e in 0..basis.num_elements() {
+            let f = basis.element_functions(e);
+            for &i in f {
+                for &j in f {
+                    if i <= j {
+                        tri.add_triplet(i, j, 1.0);
+                    }
+                }
+            }
+        }
+        for i in 0..n {
+            tri.add_triplet(i, i, 1.0);
+        }
+        // Duplicates are summed by the conversion; only the pattern matters.
+        let upper: CsMat<f64> = tri.to_csc();
+        let position = |i: usize, j: usize| -> usize {
+            let (r, c) = if i <= j { (i, j) } else { (j, i) };
+            let start = upper.indptr().outer_inds_sz(c);
+            let rows = &upper.indices()[start.clone()];
+            start.start + rows.binary_search(&r).expect("entry in pattern")
+        };
+        let mut scatter = Vec::new();
+        let mut scatter_offsets = Vec::with_capacity(basis.num_elements() + 1);
+        scatter_offsets.push(0);
+        for e in 0..basis.num_elements() {
+            let f = basis.element_functions(e);
+            for &i in f {
+                for &j in f {
+                    scatter.push(position(i, j));
+                }
+            }
+            scatter_offsets.push(scatter.len());
+        }
+        let diagonal = (0..n).map(|i| position(i, i)).collect();
+        let col_ptr = upper.proper_indptr().into_owned();
+        SymmetricPattern {
+            upper,
+            col_ptr,
+            scatter,
+            scatter_offsets,
+            diagonal,
+        }
+    }
+
+    /// Matrix dimension.
+    pub fn dim(&self) -> usize {
+        self.upper.rows()
+    }
+    /// Number of stored (upper-triangular) entries.
+    pub fn nnz(&self) -> usize {
+        self.upper.nnz()
+    }
+    /// Column pointers of the upper triangle.
+    pub fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+    /// Row indices of the upper triangle (sorted within each column).
+    pub fn row_idx(&self) -> &[usize] {
+        self.upper.indices()
+    }
+    /// Value positions of the local pairs of element `e`, row-major over its functions.
+    #[inline]
+    pub fn element_scatter(&self, e: usize) -> &[usize] {
+        &self.scatter[self.scatter_offsets[e]..self.scatter_offsets[e + 1]]
+    }
+    /// Value position of diagonal entry `i`.
+    #[inline]
+    pub fn diagonal_position(&self, i: usize) -> usize {
+        self.diagonal[i]
+    }
+
+    /// `y = A x` for the symmetric matrix whose upper triangle has `values`.
+    pub fn mul_vec<T: Real>(&self, values: &[T], x: &[T], y: &mut [T]) {
+        y.iter_mut().for_each(|v| *v = T::zero());
+        let (ptr, rows) = (self.col_ptr(), self.row_idx());
+        for c in 0..self.dim() {
+            for k in ptr[c]..ptr[c + 1] {
+                let r = rows[k];
+                let a = values[k];
+                y[r] += a * x[c];
+                if r != c {
+                    y[c] += a * x[r];
+                }
+            }
+        }
+    }
+
+    /// Row sums `Σ_j A_ij` of the symmetric matrix (the lumped mass).
+    pub fn row_sums<T: Real>(&self, values: &[T], out: &mut [T]) {
+        out.iter_mut().for_each(|v| *v = T::zero());
+        let (ptr, rows) = (self.col_ptr(), self.row_idx());
+        for c in 0..self.dim() {
+            for k in ptr[c]..ptr[c + 1] {
+                let r = rows[k];
+                out[r] += values[k];
+                if r != c {
+                    out[c] += values[k];
+                }
+            }
+        }
+    }
+}
+
+/// The factorisation failed: the matrix is not numerically positive definite.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("matrix is not positive definite (non-positive pivot at row {row} of the reordered matrix)")]
+pub struct NotPositiveDefinite {
+    /// Pivot row in the fill-reducing order.
+    pub row: usize,
+}
+
+/// Sparse Cholesky `A = L Lᵀ` of a symmetric positive definite matrix with a fixed
+/// [`SymmetricPattern`]: symbolic analysis once, numeric factorisation per call.
+pub struct SparseCholesky<T: Scalar> {
+    symbolic: SymbolicCholesky<usize>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    l_values: Vec<T>,
+    factorised: bool,
+    scratch: MemBuffer,
+    rhs_columns: usize,
+}
+
+impl<T: Scalar> std::fmt::Debug for SparseCholesky<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SparseCholesky")
+            .field("dim", &(self.col_ptr.len() - 1))
+            .field("factor_nnz", &self.l_values.len())
+            .field("factorised", &self.factorised)
+            .finish()
+    }
+}
+
+impl<T: Scalar> SparseCholesky<T> {
+    /// Symbolic factorisation (AMD ordering) of `pattern`, with scratch memory for
+    /// solves with up to `rhs_columns` right-hand sides at once.
+    pub fn new(pattern: &SymmetricPattern, rhs_columns: usize) -> Self {
+        let n = pattern.dim();
+        let col_ptr = pattern.col_ptr().to_vec();
+        let row_idx = pattern.row_idx().to_vec();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .expect("symbolic Cholesky of a valid pattern");
+        let par = Par::Seq;
+        let req = StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<T>(par, Default::default()),
+            symbolic.solve_in_place_scratch::<T>(rhs_columns.max(1), par),
+        ]);
+        let l_values = vec![T::zero(); symbolic.len_val()];
+        SparseCholesky {
+            symbolic,
+            col_ptr,
+            row_idx,
+            l_values,
+            factorised: false,
+            scratch: MemBuffer::new(req),
+            rhs_columns: rhs_columns.max(1),
+        }
+    }
+
+    /// Numeric factorisation of the matrix whose upper triangle has `values`
+    /// (in the order of the pattern). Allocation-free.
+    pub fn factorize(&mut self, values: &[T]) -> Result<(), NotPositiveDefinite> {
+        let n = self.col_ptr.len() - 1;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
+        let a = SparseColMatRef::new(sym, values);
+        self.factorised = false;
+        let result = self.symbolic.factorize_numeric_llt::<T>(
+            &mut self.l_values,
+            a,
+            Side::Upper,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.scratch),
+            Default::default(),
+        );
+        match result {
+            Ok(_) => {
+                self.factorised = true;
+                Ok(())
+            }
+            Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) => {
+                Err(NotPositiveDefinite { row: index })
+            }
+        }
+    }
+
+    /// Solves `A X = B` in place for the `columns` right-hand sides stored
+    /// column-major in `rhs` (length `n · columns`).
+    ///
+    /// # Panics
+    /// If called before a successful [`factorize`](Self::factorize), or with more
+    /// columns than the scratch was sized for.
+    pub fn solve_in_place(&mut self, rhs: &mut [T], columns: usize) {
+        assert!(self.factorised, "solve before a successful factorisation");
+        assert!(columns <= self.rhs_columns, "more right-hand sides than scratch allows");
+        let n = self.col_ptr.len() - 1;
+        let b = MatMut::from_column_major_slice_mut(rhs, n, columns);
+        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+            Conj::No,
+            b,
+            Par::Seq,
+            MemStack::new(&mut self.scratch),
+        );
+    }
+}
