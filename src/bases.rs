@@ -25,7 +25,12 @@ pub enum BasisKind {
 
 impl BasisKind {
     /// All kinds, in the order they are listed to users.
-    pub const ALL: [BasisKind; 4] = [BasisKind::Ps, BasisKind::Pl, BasisKind::Bspline, BasisKind::Pl1d];
+    pub const ALL: [BasisKind; 4] = [
+        BasisKind::Ps,
+        BasisKind::Pl,
+        BasisKind::Bspline,
+        BasisKind::Pl1d,
+    ];
 
     /// The name used on the command line and in output.
     pub fn name(self) -> &'static str {

@@ -12,11 +12,11 @@
 //! piece of the basis (the six PS sub-triangles, the PL triangle), so quadrature
 //! error is far below the projection error at every level of the study.
 
+use crate::bases::{self, BasisKind};
 use crate::sparse::{NotPositiveDefinite, Scalar, SparseCholesky, SymmetricPattern};
 use nalgebra::Vector2;
-use psmpm_basis::quadrature::TriangleRule;
-use crate::bases::{self, BasisKind};
 use psmpm_basis::mesh::generators;
+use psmpm_basis::quadrature::TriangleRule;
 use psmpm_basis::{Basis, BasisEval, TriMesh, Vec2};
 use serde::Serialize;
 
@@ -235,7 +235,9 @@ pub fn default_levels(kind: BasisKind, count: usize) -> Result<Vec<usize>, Study
             )))
         }
     };
-    Ok((0..count).map(|k| (1usize << (first_exponent + k)) + 1).collect())
+    Ok((0..count)
+        .map(|k| (1usize << (first_exponent + k)) + 1)
+        .collect())
 }
 
 /// Measured outcome of one projection.

@@ -153,7 +153,9 @@ impl SymmetricPattern {
 
 /// The factorisation failed: the matrix is not numerically positive definite.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("matrix is not positive definite (non-positive pivot at row {row} of the reordered matrix)")]
+#[error(
+    "matrix is not positive definite (non-positive pivot at row {row} of the reordered matrix)"
+)]
 pub struct NotPositiveDefinite {
     /// Pivot row in the fill-reducing order.
     pub row: usize,
@@ -248,7 +250,10 @@ impl<T: Scalar> SparseCholesky<T> {
     /// columns than the scratch was sized for.
     pub fn solve_in_place(&mut self, rhs: &mut [T], columns: usize) {
         assert!(self.factorised, "solve before a successful factorisation");
-        assert!(columns <= self.rhs_columns, "more right-hand sides than scratch allows");
+        assert!(
+            columns <= self.rhs_columns,
+            "more right-hand sides than scratch allows"
+        );
         let n = self.col_ptr.len() - 1;
         let b = MatMut::from_column_major_slice_mut(rhs, n, columns);
         LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(

@@ -8,7 +8,6 @@ mod project;
 mod table;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use error::CliError;
 use std::process::ExitCode;
 
 /// Material Point Method with Powell–Sabin spline bases on triangular grids.

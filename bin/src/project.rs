@@ -27,7 +27,10 @@ pub struct ProjectArgs {
     format: Format,
 }
 
-fn parse_list<T>(list: &str, parse: impl Fn(&str) -> Result<T, String>) -> Result<Vec<T>, CliError> {
+fn parse_list<T>(
+    list: &str,
+    parse: impl Fn(&str) -> Result<T, String>,
+) -> Result<Vec<T>, CliError> {
     list.split(',')
         .map(|s| parse(s.trim()).map_err(CliError::Input))
         .collect()
@@ -37,7 +40,9 @@ fn parse_mass(name: &str) -> Result<MassOption, String> {
     match name {
         "consistent" => Ok(MassOption::Consistent),
         "lumped" => Ok(MassOption::Lumped),
-        _ => Err(format!("unknown mass option `{name}` (known: consistent, lumped)")),
+        _ => Err(format!(
+            "unknown mass option `{name}` (known: consistent, lumped)"
+        )),
     }
 }
 
@@ -53,7 +58,9 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
     let kinds = parse_list(&args.basis, |s| {
         let k = BasisKind::parse(s)?;
         if k.dim() != 2 {
-            return Err(format!("basis `{s}` is one-dimensional; the projection study needs ps or pl"));
+            return Err(format!(
+                "basis `{s}` is one-dimensional; the projection study needs ps or pl"
+            ));
         }
         Ok(k)
     })?;
@@ -78,7 +85,8 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
                     projection::mesh_study::<f64>(kind, mass, mesh.clone()).map_err(study_error)?,
                 ),
                 None => {
-                    let levels = projection::default_levels(kind, args.levels).map_err(study_error)?;
+                    let levels =
+                        projection::default_levels(kind, args.levels).map_err(study_error)?;
                     rows.extend(
                         projection::unit_square_study::<f64>(kind, mass, &levels)
                             .map_err(study_error)?,
@@ -94,7 +102,15 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
         }
         Format::Table => {
             let mut table = Table::new(&[
-                "basis", "mass", "n", "functions", "error", "order", "error_dx", "order_dx", "seconds",
+                "basis",
+                "mass",
+                "n",
+                "functions",
+                "error",
+                "order",
+                "error_dx",
+                "order_dx",
+                "seconds",
             ]);
             for r in &rows {
                 table.push(vec![

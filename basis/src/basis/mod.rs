@@ -149,7 +149,11 @@ pub trait Basis<T: Real, const D: usize> {
     fn boundary_tags(&self) -> Vec<String>;
     /// Linear constraints making the component `direction · v` of any vector
     /// field `v = Σ c_i phi_i` vanish identically on the boundary tagged `tag`.
-    fn dirichlet(&self, tag: &str, direction: &Point<T, D>) -> Result<Vec<Constraint<T, D>>, BasisError>;
+    fn dirichlet(
+        &self,
+        tag: &str,
+        direction: &Point<T, D>,
+    ) -> Result<Vec<Constraint<T, D>>, BasisError>;
     /// Appends to `out` the simplices (`D + 1` points each) of `element` on each of
     /// which every function is a polynomial: the quadrature cells (the six PS
     /// sub-triangles, or the element itself).

@@ -34,7 +34,9 @@ pub type Vec2 = Vector2<f64>;
 pub enum MeshError {
     #[error("mesh has no triangles")]
     Empty,
-    #[error("triangle {triangle} refers to vertex {vertex}, but the mesh has {num_vertices} vertices")]
+    #[error(
+        "triangle {triangle} refers to vertex {vertex}, but the mesh has {num_vertices} vertices"
+    )]
     VertexOutOfRange {
         triangle: usize,
         vertex: usize,
@@ -43,7 +45,10 @@ pub enum MeshError {
     #[error("vertex {vertex} has a non-finite coordinate")]
     NonFiniteVertex { vertex: usize },
     #[error("triangle {triangle} repeats a vertex ({vertices:?})")]
-    RepeatedVertex { triangle: usize, vertices: [usize; 3] },
+    RepeatedVertex {
+        triangle: usize,
+        vertices: [usize; 3],
+    },
     #[error("triangle {triangle} is degenerate (signed area {area:e} relative to the mesh size)")]
     DegenerateTriangle { triangle: usize, area: f64 },
     #[error("triangle {triangle} is clockwise (inverted); triangles must be counter-clockwise")]
@@ -149,7 +154,10 @@ impl TriMesh {
             let area = signed_area(vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]);
             let rel = area / (scale * scale);
             if rel.abs() <= GEOMETRY_TOLERANCE {
-                return Err(MeshError::DegenerateTriangle { triangle: t, area: rel });
+                return Err(MeshError::DegenerateTriangle {
+                    triangle: t,
+                    area: rel,
+                });
             }
             if area < 0.0 {
                 return Err(MeshError::InvertedTriangle { triangle: t });
