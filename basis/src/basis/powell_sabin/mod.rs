@@ -57,31 +57,56 @@ impl Triplets {
     }
 }
 
-/// Affine function `a + g · x`.
-type Affine<T> = (T, Vector2<T>);
+/// Barycentric coordinates of a triangle `(P_0, P_1, P_2)` as functions of `x`:
+/// `τ_1 = g_1 · (x − P_0)`, `τ_2 = g_2 · (x − P_0)`, `τ_0 = 1 − τ_1 − τ_2`.
+/// Measuring from `P_0` keeps round-off relative to the triangle's size, not to `|x|`,
+/// and makes the coordinates sum to one exactly.
+#[derive(Debug, Clone, Copy)]
+struct LocalCoordinates<T: Real> {
+    origin: Vector2<T>,
+    g1: Vector2<T>,
+    g2: Vector2<T>,
+}
+
+impl<T: Real> LocalCoordinates<T> {
+    fn new(p: [Vec2; 3]) -> Self {
+        let d = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
+        // τ_1 = ((x − P_0) × (P_2 − P_0)) / d, τ_2 = ((P_1 − P_0) × (x − P_0)) / d.
+        let g1 = Vec2::new(p[2].y - p[0].y, p[0].x - p[2].x) / d;
+        let g2 = Vec2::new(p[0].y - p[1].y, p[1].x - p[0].x) / d;
+        let t = |v: Vec2| Vector2::new(T::of(v.x), T::of(v.y));
+        LocalCoordinates {
+            origin: t(p[0]),
+            g1: t(g1),
+            g2: t(g2),
+        }
+    }
+
+    #[inline(always)]
+    fn at(&self, x: &Vector2<T>) -> [T; 3] {
+        let d = x - self.origin;
+        let (t1, t2) = (self.g1.dot(&d), self.g2.dot(&d));
+        [T::one() - t1 - t2, t1, t2]
+    }
+
+    /// Gradients of `τ_0, τ_1, τ_2`.
+    #[inline(always)]
+    fn gradients(&self) -> [Vector2<T>; 3] {
+        [-(self.g1 + self.g2), self.g1, self.g2]
+    }
+}
 
 /// Precomputed evaluation data of one main triangle.
 #[derive(Debug, Clone)]
 struct ElementData<T: Real> {
-    /// Main-triangle barycentric coordinates as affine functions.
-    lambda: [Affine<T>; 3],
+    /// Main-triangle barycentric coordinates.
+    lambda: LocalCoordinates<T>,
     z_bary: [T; 3],
     r_lambda: [T; 3],
-    /// Sub-triangle barycentric coordinates as affine functions.
-    tau: [[Affine<T>; 3]; 6],
+    /// Sub-triangle barycentric coordinates.
+    tau: [LocalCoordinates<T>; 6],
     /// `ordinates[s][f]`: the six Bézier ordinates of local function `f` on sub-triangle `s`.
     ordinates: [[[T; 6]; 9]; 6],
-}
-
-/// Barycentric coordinates of triangle `p` as affine functions of `x`.
-fn barycentric_affine<T: Real>(p: [Vec2; 3]) -> [Affine<T>; 3] {
-    let d = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
-    std::array::from_fn(|k| {
-        let (b, c) = (p[(k + 1) % 3], p[(k + 2) % 3]);
-        let g = Vec2::new(b.y - c.y, c.x - b.x) / d;
-        let a = (b.x * c.y - c.x * b.y) / d;
-        (T::of(a), Vector2::new(T::of(g.x), T::of(g.y)))
-    })
 }
 
 /// The quadratic Powell–Sabin spline basis on a [`TriMesh`].
@@ -148,10 +173,10 @@ impl<T: Real> PowellSabin<T> {
             }
             let subs = refinement.sub_triangles(&mesh, t);
             elements.push(ElementData {
-                lambda: barycentric_affine(geometry.v),
+                lambda: LocalCoordinates::new(geometry.v),
                 z_bary: geometry.z_bary.map(T::of),
                 r_lambda: geometry.r_lambda.map(T::of),
-                tau: std::array::from_fn(|s| barycentric_affine(subs[s])),
+                tau: std::array::from_fn(|s| LocalCoordinates::new(subs[s])),
                 ordinates,
             });
         }
@@ -267,13 +292,13 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
     #[inline]
     fn eval(&self, element: usize, x: &Point<T, 2>, out: &mut BasisEval<T, 2>) {
         let e = &self.elements[element];
-        let lambda = e.lambda.map(|(a, g)| a + g.dot(x));
+        let lambda = e.lambda.at(x);
         let s = Refinement::sub_triangle_of(lambda, e.z_bary, e.r_lambda);
-        let tau_affine = &e.tau[s];
-        let tau = tau_affine.map(|(a, g)| a + g.dot(x));
+        let tau = e.tau[s].at(x);
+        let grad_tau = e.tau[s].gradients();
         let (b, db) = bernstein(tau);
         let grad_b: [Vector2<T>; 6] = std::array::from_fn(|k| {
-            tau_affine[0].1 * db[k][0] + tau_affine[1].1 * db[k][1] + tau_affine[2].1 * db[k][2]
+            grad_tau[0] * db[k][0] + grad_tau[1] * db[k][1] + grad_tau[2] * db[k][2]
         });
         let ordinates = &e.ordinates[s];
         let functions = &self.element_functions[element];
@@ -378,5 +403,181 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
     }
     fn degree(&self) -> usize {
         2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check;
+    use crate::mesh::generators::{self, PolygonDomain};
+    use proptest::prelude::*;
+
+    /// The properties of `ps-splines.md` §6 on one mesh.
+    fn assert_ps_properties(mesh: TriMesh) -> PowellSabin<f64> {
+        let (lo, hi) = mesh.bounding_box();
+        let scale = (hi - lo).norm();
+        let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+        let pu = check::partition_of_unity(&ps);
+        assert!(pu < 1e-13, "partition of unity off by {pu:e}");
+        let min = check::min_value(&ps);
+        assert!(min > -1e-13, "negative basis value {min:e}");
+        let (lp, lp_grad) = check::linear_precision(&ps);
+        assert!(lp < 1e-13 * scale, "linear precision off by {lp:e}");
+        assert!(
+            lp_grad < 1e-11,
+            "gradient of linear precision off by {lp_grad:e}"
+        );
+        let fd = check::gradient_error(&ps);
+        assert!(fd < 1e-6, "gradient vs finite differences: {fd:e}");
+        let jumps = check::continuity_jumps(&ps);
+        assert!(jumps.points > 0);
+        assert!(jumps.value < 1e-9, "value jump {:e}", jumps.value);
+        assert!(
+            jumps.gradient < 1e-4,
+            "gradient jump {:e} (C¹ violated)",
+            jumps.gradient
+        );
+        ps
+    }
+
+    fn unit_square_walls() -> [(&'static str, Vec2, Vec2); 4] {
+        [
+            ("left", Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)),
+            ("right", Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0)),
+            ("bottom", Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)),
+            ("top", Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)),
+        ]
+    }
+
+    /// Dirichlet exactness on each wall of the unit square, both components, and on a
+    /// corner with two walls constrained together.
+    fn assert_dirichlet_exact(ps: &PowellSabin<f64>) {
+        for (tag, a, b) in unit_square_walls() {
+            let points = check::points_on_segment(a, b, 100);
+            for direction in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
+                let r = check::dirichlet_residual(ps, tag, direction, &points, 11);
+                assert!(r < 1e-13, "{tag} {direction:?}: residual {r:e}");
+            }
+        }
+        // Corner: left and bottom constrained for v_x at once.
+        let n = Vec2::new(1.0, 0.0);
+        let mut constraints = ps.dirichlet("left", &n).unwrap();
+        constraints.extend(ps.dirichlet("bottom", &n).unwrap());
+        let mut rng = generators::SplitMix64(5);
+        let mut c: Vec<Vec2> = (0..ps.num_functions())
+            .map(|_| Vec2::new(rng.next_f64(), rng.next_f64()))
+            .collect();
+        check::apply_constraints(&mut c, &constraints);
+        let mut eval = BasisEval::for_basis(ps);
+        for p in check::points_on_segment(Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0), 100)
+            .into_iter()
+            .chain(check::points_on_segment(
+                Vec2::new(0.0, 0.0),
+                Vec2::new(1.0, 0.0),
+                100,
+            ))
+        {
+            let e = ps.locate(&p, None).unwrap();
+            ps.eval(e, &p, &mut eval);
+            let v: Vec2 = eval.iter().map(|(i, phi, _)| c[i] * phi).sum();
+            assert!(v.x.abs() < 1e-13, "corner residual {:e} at {p:?}", v.x);
+        }
+    }
+
+    #[test]
+    fn block_grid_properties_and_dirichlet() {
+        let ps = assert_ps_properties(generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap());
+        assert_dirichlet_exact(&ps);
+        // Boundary-aligned control triangles: every wall constraint is single-term.
+        for tag in ["left", "bottom"] {
+            let k = ps.dirichlet(tag, &Vec2::new(1.0, 0.0)).unwrap();
+            assert!(k.iter().all(|c| c.is_single()));
+        }
+        assert_eq!(ps.num_functions(), 3 * (12 + 6));
+    }
+
+    #[test]
+    fn lattice_properties_and_dirichlet() {
+        let ps = assert_ps_properties(generators::lattice_delaunay(6, 0.0, 1.0, 0.0, 1.0).unwrap());
+        assert_dirichlet_exact(&ps);
+    }
+
+    #[test]
+    fn polygon_with_hole_properties_and_general_constraints() {
+        let mut domain = PolygonDomain::rectangle(0.0, 1.0, 0.0, 1.0);
+        let hole: Vec<Vec2> = (0..10)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 10.0;
+                Vec2::new(0.5 + 0.2 * a.cos(), 0.5 + 0.2 * a.sin())
+            })
+            .collect();
+        domain.holes.push((hole.clone(), "hole".into()));
+        let ps = assert_ps_properties(generators::polygon_mesh(&domain, 0.15).unwrap());
+        assert_dirichlet_exact(&ps);
+        // The hole's corners are reflex: their constraints are general ones, and the
+        // field still vanishes along every hole segment.
+        let k = ps.dirichlet("hole", &Vec2::new(0.0, 1.0)).unwrap();
+        assert!(k.iter().any(|c| !c.is_single()));
+        let points: Vec<Vec2> = (0..10)
+            .flat_map(|i| check::points_on_segment(hole[i], hole[(i + 1) % 10], 10))
+            .collect();
+        for direction in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
+            let r = check::dirichlet_residual(&ps, "hole", direction, &points, 3);
+            // General constraints are imposed by a least-squares projection: round-off
+            // of that solve, not of the basis, sets this tolerance.
+            assert!(r < 1e-11, "hole residual {r:e}");
+        }
+    }
+
+    #[test]
+    fn centroid_split_points_on_the_block_grid() {
+        let mesh = generators::block_grid(0.0, 25.0, 0.0, 2.0, 4, 1).unwrap();
+        let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Centroid).unwrap();
+        assert!(check::partition_of_unity(&ps) < 1e-13);
+        assert!(check::continuity_jumps(&ps).gradient < 1e-4);
+        // The thesis' 42-function PS grid of the vibrating bar.
+        assert_eq!(ps.num_functions(), 42);
+    }
+
+    #[test]
+    fn f32_basis_is_a_partition_of_unity_to_single_precision() {
+        let mesh = generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap();
+        let ps = PowellSabin::<f32>::new(mesh, SplitPoint::Incentre).unwrap();
+        assert!(check::partition_of_unity(&ps) < 1e-5);
+    }
+
+    #[test]
+    fn pl_fails_the_c1_check_that_ps_passes() {
+        // The continuity check can fail: PL gradients jump across edges.
+        let mesh = generators::lattice_delaunay(4, 0.0, 1.0, 0.0, 1.0).unwrap();
+        let pl = crate::basis::linear::Linear::<f64>::new(mesh);
+        let j = check::continuity_jumps(&pl);
+        assert!(j.value < 1e-9);
+        assert!(j.gradient > 0.1);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 12, .. ProptestConfig::default() })]
+
+        #[test]
+        fn jittered_delaunay_meshes(seed in 0u64..1_000_000, n in 3usize..7, jitter in 0.0f64..0.4) {
+            let mesh = generators::jittered_lattice_delaunay(n, n + 1, (0.0, 1.0, 0.0, 1.0), jitter, seed).unwrap();
+            let ps = assert_ps_properties(mesh);
+            assert_dirichlet_exact(&ps);
+        }
+
+        #[test]
+        fn random_point_delaunay_meshes(seed in 0u64..1_000_000, count in 8usize..40) {
+            let mut rng = generators::SplitMix64(seed);
+            let mut points = vec![
+                Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0),
+            ];
+            points.extend((0..count).map(|_| Vec2::new(0.05 + 0.9 * rng.next_f64(), 0.05 + 0.9 * rng.next_f64())));
+            let mut mesh = generators::delaunay(&points).unwrap();
+            mesh.tag_box_sides(0.0, 1.0, 0.0, 1.0);
+            let ps = assert_ps_properties(mesh);
+            assert_dirichlet_exact(&ps);
+        }
     }
 }
