@@ -468,3 +468,102 @@ pub fn bounding_box(points: &[Vec2]) -> (Vec2, Vec2) {
     }
     (lo, hi)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> (Vec<Vec2>, Vec<[usize; 3]>) {
+        (
+            vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(0.0, 1.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn valid_square_has_edges_neighbours_and_tags() {
+        let (v, t) = square();
+        let mut m = TriMesh::new(v, t).unwrap();
+        assert_eq!(m.edges().len(), 5);
+        assert_eq!(m.edges().iter().filter(|e| e.is_boundary()).count(), 4);
+        assert_eq!(m.neighbours()[0][2], Some(1));
+        assert!(m.require_tagged_boundary().is_err());
+        assert_eq!(m.tag_box_sides(0.0, 1.0, 0.0, 1.0), 4);
+        m.require_tagged_boundary().unwrap();
+        assert!(matches!(
+            m.tag_id("inlet"),
+            Err(MeshError::UnknownTag { .. })
+        ));
+    }
+
+    #[test]
+    fn each_kind_of_bad_mesh_is_named() {
+        let (v, _) = square();
+        let err = |v: Vec<Vec2>, t: Vec<[usize; 3]>| TriMesh::new(v, t).unwrap_err();
+        assert_eq!(err(v.clone(), vec![]), MeshError::Empty);
+        assert!(matches!(
+            err(v.clone(), vec![[0, 1, 7]]),
+            MeshError::VertexOutOfRange { vertex: 7, .. }
+        ));
+        assert!(matches!(
+            err(v.clone(), vec![[0, 1, 1]]),
+            MeshError::RepeatedVertex { .. }
+        ));
+        assert!(matches!(
+            err(v.clone(), vec![[0, 2, 1], [0, 2, 3]]),
+            MeshError::InvertedTriangle { triangle: 0 }
+        ));
+        let mut flat = v.clone();
+        flat.push(Vec2::new(2.0, 0.0));
+        assert!(matches!(
+            err(flat, vec![[0, 1, 4], [0, 2, 3]]),
+            MeshError::DegenerateTriangle { triangle: 0, .. }
+        ));
+        let mut dup = v.clone();
+        dup.push(Vec2::new(1.0, 1.0));
+        assert!(matches!(
+            err(dup, vec![[0, 1, 2], [0, 4, 3]]),
+            MeshError::DuplicateVertex { a: 2, b: 4, .. }
+        ));
+        let mut iso = v.clone();
+        iso.push(Vec2::new(3.0, 3.0));
+        assert!(matches!(
+            err(iso, vec![[0, 1, 2], [0, 2, 3]]),
+            MeshError::IsolatedVertex { vertex: 4 }
+        ));
+        // Three triangles on the edge 0–2.
+        let mut fan = v.clone();
+        fan.push(Vec2::new(2.0, 0.5));
+        assert!(matches!(
+            err(fan, vec![[0, 1, 2], [0, 2, 3], [0, 4, 2]]),
+            MeshError::NonManifoldEdge { .. }
+        ));
+        // Two triangles touching only at vertex 2 (a bow tie).
+        let bow = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(2.0, 1.0),
+            Vec2::new(2.0, 2.0),
+        ];
+        assert!(matches!(
+            err(bow, vec![[0, 1, 2], [2, 3, 4]]),
+            MeshError::NonManifoldVertex { vertex: 2 }
+        ));
+        let mut nan = v.clone();
+        nan[1].x = f64::NAN;
+        assert!(matches!(
+            err(nan, vec![[0, 1, 2]]),
+            MeshError::NonFiniteVertex { vertex: 1 }
+        ));
+        // Messages name the entity.
+        assert!(MeshError::IsolatedVertex { vertex: 4 }
+            .to_string()
+            .contains("vertex 4"));
+    }
+}
