@@ -133,3 +133,48 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
         1
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check;
+    use crate::mesh::generators;
+    use proptest::prelude::*;
+
+    fn assert_pl(mesh: TriMesh) {
+        let pl = Linear::<f64>::new(mesh);
+        assert!(check::partition_of_unity(&pl) < 1e-14);
+        assert!(check::min_value(&pl) > -1e-14);
+        assert!(check::linear_precision(&pl).0 < 1e-14);
+        assert!(check::gradient_error(&pl) < 1e-8);
+        assert!(check::continuity_jumps(&pl).value < 1e-9);
+        for (tag, a, b) in [
+            ("left", Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)),
+            ("right", Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0)),
+            ("bottom", Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)),
+            ("top", Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)),
+        ] {
+            let points = check::points_on_segment(a, b, 100);
+            for n in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
+                assert!(check::dirichlet_residual(&pl, tag, n, &points, 1) < 1e-13);
+            }
+        }
+        assert!(pl.dirichlet("inlet", &Vec2::new(1.0, 0.0)).is_err());
+    }
+
+    #[test]
+    fn block_and_lattice_grids() {
+        assert_pl(generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap());
+        assert_pl(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
+        let pl = Linear::<f32>::new(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
+        assert!(check::partition_of_unity(&pl) < 1e-6);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 12, .. ProptestConfig::default() })]
+        #[test]
+        fn jittered_meshes(seed in 0u64..1_000_000, jitter in 0.0f64..0.4) {
+            assert_pl(generators::jittered_lattice_delaunay(5, 6, (0.0, 1.0, 0.0, 1.0), jitter, seed).unwrap());
+        }
+    }
+}
