@@ -32,7 +32,9 @@ impl<T: Real> QuadraticBSpline<T> {
         let mut knots64 = vec![x[0], x[0]];
         knots64.extend_from_slice(x);
         knots64.extend([x[n], x[n]]);
-        let greville = (0..n + 2).map(|k| 0.5 * (knots64[k + 1] + knots64[k + 2])).collect();
+        let greville = (0..n + 2)
+            .map(|k| 0.5 * (knots64[k + 1] + knots64[k + 2]))
+            .collect();
         let support = (0..n + 2)
             .map(|k| (k.saturating_sub(2)..k.min(n - 1) + 1).collect())
             .collect();
@@ -88,7 +90,11 @@ impl<T: Real> Basis<T, 1> for QuadraticBSpline<T> {
             (u - t[i - 1]) / d0 * n1[0] + (t[i + 2] - u) / d1 * n1[1],
             (u - t[i]) / d1 * n1[1],
         ];
-        let dphi = [-two / d0 * n1[0], two / d0 * n1[0] - two / d1 * n1[1], two / d1 * n1[1]];
+        let dphi = [
+            -two / d0 * n1[0],
+            two / d0 * n1[0] - two / d1 * n1[1],
+            two / d1 * n1[1],
+        ];
         for k in 0..3 {
             out.index[k] = element + k;
             out.phi[k] = phi[k];
@@ -108,7 +114,11 @@ impl<T: Real> Basis<T, 1> for QuadraticBSpline<T> {
     fn boundary_tags(&self) -> Vec<String> {
         self.mesh.tags().map(String::from).to_vec()
     }
-    fn dirichlet(&self, tag: &str, direction: &Point<T, 1>) -> Result<Vec<Constraint<T, 1>>, BasisError> {
+    fn dirichlet(
+        &self,
+        tag: &str,
+        direction: &Point<T, 1>,
+    ) -> Result<Vec<Constraint<T, 1>>, BasisError> {
         let f = match tag {
             "left" => 0,
             "right" => self.num_functions() - 1,
@@ -163,9 +173,17 @@ mod tests {
                 let (v, d) = dense(b, e, x);
                 assert!((v.iter().sum::<f64>() - 1.0).abs() < 1e-14);
                 assert!(v.iter().all(|&p| p >= -1e-15));
-                let lin: f64 = v.iter().enumerate().map(|(i, p)| p * b.function_point(i).x).sum();
+                let lin: f64 = v
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| p * b.function_point(i).x)
+                    .sum();
                 assert!((lin - x).abs() < 1e-13 * (1.0 + x.abs()));
-                let dlin: f64 = d.iter().enumerate().map(|(i, p)| p * b.function_point(i).x).sum();
+                let dlin: f64 = d
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| p * b.function_point(i).x)
+                    .sum();
                 assert!((dlin - 1.0).abs() < 1e-11);
                 if (0.05..0.95).contains(&s) {
                     let h = 1e-6 * (c - a);
@@ -173,7 +191,11 @@ mod tests {
                     let (vm, _) = dense(b, e, x - h);
                     for i in 0..v.len() {
                         let fd = (vp[i] - vm[i]) / (2.0 * h);
-                        assert!((fd - d[i]).abs() < 1e-6 * (1.0 + d[i].abs()), "fd {fd} vs {}", d[i]);
+                        assert!(
+                            (fd - d[i]).abs() < 1e-6 * (1.0 + d[i].abs()),
+                            "fd {fd} vs {}",
+                            d[i]
+                        );
                     }
                 }
             }

@@ -76,7 +76,11 @@ impl<T: Real> Basis<T, 1> for Linear1d<T> {
     fn boundary_tags(&self) -> Vec<String> {
         self.mesh.tags().map(String::from).to_vec()
     }
-    fn dirichlet(&self, tag: &str, direction: &Point<T, 1>) -> Result<Vec<Constraint<T, 1>>, BasisError> {
+    fn dirichlet(
+        &self,
+        tag: &str,
+        direction: &Point<T, 1>,
+    ) -> Result<Vec<Constraint<T, 1>>, BasisError> {
         let f = match tag {
             "left" => 0,
             "right" => self.nodes.len() - 1,

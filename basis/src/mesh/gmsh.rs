@@ -431,3 +431,133 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
     }
     Ok(mesh)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn data(name: &str) -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/data")
+            .join(name)
+    }
+
+    fn area(m: &TriMesh) -> f64 {
+        (0..m.num_triangles()).map(|t| m.area(t)).sum()
+    }
+
+    #[test]
+    fn reads_the_square_in_both_formats() {
+        let a = read_msh(&data("square.msh")).unwrap();
+        let b = read_msh(&data("square_v22.msh")).unwrap();
+        assert_eq!(a.vertices(), b.vertices());
+        assert_eq!(a.triangles(), b.triangles());
+        assert!((area(&a) - 1.0).abs() < 1e-12);
+        a.require_tagged_boundary().unwrap();
+        b.require_tagged_boundary().unwrap();
+        let mut tags = a.tags().to_vec();
+        tags.sort();
+        assert_eq!(tags, ["bottom", "left", "right", "top"]);
+    }
+
+    #[test]
+    fn reads_the_square_with_a_hole_and_the_l_shape() {
+        let m = read_msh(&data("square_hole.msh")).unwrap();
+        m.require_tagged_boundary().unwrap();
+        let hole = m.tag_id("hole").unwrap();
+        let hole_edges: Vec<_> = m.edges().iter().filter(|e| e.tag == Some(hole)).collect();
+        assert!(hole_edges.len() >= 12);
+        for e in hole_edges {
+            for v in e.vertices {
+                assert!(((m.vertices()[v] - Vec2::new(0.5, 0.5)).norm() - 0.2).abs() < 1e-9);
+            }
+        }
+        // Area of the square minus the inscribed polygon of the circle.
+        let expected = 1.0 - std::f64::consts::PI * 0.04;
+        assert!((area(&m) - expected).abs() < 0.01);
+        assert_eq!(m.locate(Vec2::new(0.5, 0.5), None), None);
+        let l = read_msh(&data("lshape.msh")).unwrap();
+        l.require_tagged_boundary().unwrap();
+        assert!((area(&l) - 0.75).abs() < 1e-12);
+        assert_eq!(l.locate(Vec2::new(0.75, 0.75), None), None);
+    }
+
+    const GOOD_22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 7 \"wall\"\n$EndPhysicalNames\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n$EndNodes\n$Elements\n6\n1 1 2 7 1 1 2\n2 1 2 7 1 2 3\n3 1 2 7 1 3 4\n4 1 2 7 1 4 1\n5 2 2 1 1 1 2 3\n6 2 2 1 1 1 3 4\n$EndElements\n";
+
+    fn syntax_line(text: &str) -> (usize, String) {
+        match parse_msh(text, "bad.msh").unwrap_err() {
+            GmshError::Syntax {
+                line,
+                message,
+                file,
+            } => {
+                assert_eq!(file, "bad.msh");
+                (line, message)
+            }
+            other => panic!("expected a syntax error, got {other}"),
+        }
+    }
+
+    #[test]
+    fn a_small_handwritten_file_parses() {
+        let m = parse_msh(GOOD_22, "good.msh").unwrap();
+        assert_eq!(m.num_triangles(), 2);
+        m.require_tagged_boundary().unwrap();
+        // Clockwise input is flipped.
+        let cw = GOOD_22
+            .replace("5 2 2 1 1 1 2 3", "5 2 2 1 1 1 3 2")
+            .replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 4 3");
+        assert_eq!(parse_msh(&cw, "cw.msh").unwrap().num_triangles(), 2);
+    }
+
+    #[test]
+    fn malformed_files_give_located_errors() {
+        assert!(syntax_line("hello\n").1.contains("$MeshFormat"));
+        assert!(syntax_line("$MeshFormat\n4.1 1 8\n$EndMeshFormat\n")
+            .1
+            .contains("binary"));
+        assert!(syntax_line("$MeshFormat\n3.0 0 8\n$EndMeshFormat\n")
+            .1
+            .contains("version"));
+        let (line, msg) = syntax_line(&GOOD_22.replace("2 1 0 0\n", "2 1 x 0\n"));
+        assert_eq!(line, 11);
+        assert!(msg.contains("`x`"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_22.replace("$EndNodes", "$EndNods"));
+        assert_eq!(line, 14);
+        assert!(msg.contains("$EndNodes"));
+        // Truncated in the middle of element 5.
+        let (line, msg) = syntax_line(&GOOD_22[..GOOD_22.len() - 40]);
+        assert_eq!(line, 21);
+        assert!(msg.contains("fewer tags"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_22[..GOOD_22.len() - 13]);
+        assert!(msg.contains("end of file"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 3 2 1 1 1 3 4 2"));
+        assert!(msg.contains("quadrilateral"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 3 9"));
+        assert_eq!(line, 22);
+        assert!(msg.contains("undefined node 9"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 3"));
+        assert!(msg.contains("needs 3 nodes"), "{msg}");
+        let no_tri = GOOD_22
+            .replace("5 2 2 1 1 1 2 3\n6 2 2 1 1 1 3 4\n", "")
+            .replace("\n6\n1 1", "\n4\n1 1");
+        assert!(matches!(
+            parse_msh(&no_tri, "x.msh"),
+            Err(GmshError::Content { .. })
+        ));
+        let z = GOOD_22.replace("3 1 1 0\n", "3 1 1 0.5\n");
+        assert!(matches!(
+            parse_msh(&z, "x.msh"),
+            Err(GmshError::Content { .. })
+        ));
+        let degenerate = GOOD_22.replace("3 1 1 0\n", "3 2 0 0\n");
+        assert!(matches!(
+            parse_msh(&degenerate, "x.msh"),
+            Err(GmshError::Mesh { .. })
+        ));
+        let missing = read_msh(Path::new("/nonexistent/mesh.msh")).unwrap_err();
+        assert!(missing
+            .to_string()
+            .starts_with("/nonexistent/mesh.msh: cannot read"));
+    }
+}

@@ -531,6 +531,33 @@ mod tests {
     }
 
     #[test]
+    fn gmsh_meshes() {
+        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data");
+        let square = crate::mesh::gmsh::read_msh(&data.join("square.msh")).unwrap();
+        let ps = assert_ps_properties(square);
+        assert_dirichlet_exact(&ps);
+        let hole = crate::mesh::gmsh::read_msh(&data.join("square_hole.msh")).unwrap();
+        let ps = assert_ps_properties(hole);
+        assert_dirichlet_exact(&ps);
+        let l = crate::mesh::gmsh::read_msh(&data.join("lshape.msh")).unwrap();
+        let ps = assert_ps_properties(l);
+        // The L-shape's reflex corner (0.5, 0.5) has general constraints; the field
+        // still vanishes along both edges meeting there.
+        let points: Vec<Vec2> =
+            check::points_on_segment(Vec2::new(1.0, 0.5), Vec2::new(0.5, 0.5), 50)
+                .into_iter()
+                .chain(check::points_on_segment(
+                    Vec2::new(0.5, 0.5),
+                    Vec2::new(0.5, 1.0),
+                    50,
+                ))
+                .collect();
+        for direction in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
+            assert!(check::dirichlet_residual(&ps, "wall", direction, &points, 2) < 1e-11);
+        }
+    }
+
+    #[test]
     fn centroid_split_points_on_the_block_grid() {
         let mesh = generators::block_grid(0.0, 25.0, 0.0, 2.0, 4, 1).unwrap();
         let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Centroid).unwrap();
