@@ -73,7 +73,7 @@ impl Refinement {
                     let d = split[t2] - split[t1];
                     let cross = |u: Vec2, v: Vec2| u.x * v.y - u.y * v.x;
                     let s = cross(split[t1] - va, d) / cross(vb - va, d);
-                    if !(s > EDGE_POINT_MARGIN && s < 1.0 - EDGE_POINT_MARGIN) || !s.is_finite() {
+                    if !(s > EDGE_POINT_MARGIN && s < 1.0 - EDGE_POINT_MARGIN && s.is_finite()) {
                         return Err(BasisError::InvalidSplitPoint {
                             t1: t1.min(t2),
                             t2: t1.max(t2),

@@ -2,7 +2,7 @@
 //!
 //! Meshes keep their geometry in `f64`; a basis evaluates in any [`Real`] (f64 by
 //! default, f32 where memory or bandwidth matter). `Real` is nalgebra's
-//! [`RealField`](nalgebra::RealField) plus the conversions numerical code needs.
+//! [`RealField`] plus the conversions numerical code needs.
 
 use nalgebra::RealField;
 

@@ -81,9 +81,9 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
     #[inline]
     fn eval(&self, element: usize, x: &Point<T, 2>, out: &mut BasisEval<T, 2>) {
         let tri = &self.mesh.triangles()[element];
-        for k in 0..3 {
+        for (k, &vertex) in tri.iter().enumerate() {
             let (a, g) = &self.affine[element][k];
-            out.index[k] = tri[k];
+            out.index[k] = vertex;
             out.phi[k] = *a + g.dot(x);
             out.grad_phi[k] = *g;
         }

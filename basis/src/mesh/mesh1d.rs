@@ -39,7 +39,7 @@ impl Mesh1d {
 
     /// `n_elements` equal elements on `[x0, x1]`.
     pub fn uniform(x0: f64, x1: f64, n_elements: usize) -> Result<Self, MeshError> {
-        if n_elements == 0 || !(x0 < x1) {
+        if n_elements == 0 || x0.partial_cmp(&x1) != Some(std::cmp::Ordering::Less) {
             return Err(MeshError::InvalidParameter(format!(
                 "uniform 1D mesh needs x0 < x1 and at least one element, got [{x0}, {x1}] with {n_elements}"
             )));

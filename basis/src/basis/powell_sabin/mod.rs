@@ -4,7 +4,7 @@
 //!
 //! Construction, each step in one place:
 //! 1. the PS refinement, [`crate::refinement`];
-//! 2. a control triangle per vertex, [`control_triangle`];
+//! 2. a control triangle per vertex, [`mod@control_triangle`];
 //! 3. the triplets `(α_q, β_q, γ_q)` of each vertex from its control triangle
 //!    (`ps-splines.md` §3), here in [`Triplets`];
 //! 4. each function as the PS Hermite interpolant of its triplet, stored as
@@ -341,7 +341,9 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
     ) -> Result<Vec<Constraint<T, 2>>, BasisError> {
         let id = self.mesh.tag_id(tag)?;
         let mut single: Vec<usize> = Vec::new();
-        let mut general: Vec<(usize, Option<(i64, i64)>, Vec<(usize, T)>)> = Vec::new();
+        // (vertex, tangent key: None for the value constraint, terms)
+        type General<T> = (usize, Option<(i64, i64)>, Vec<(usize, T)>);
+        let mut general: Vec<General<T>> = Vec::new();
         let p = self.mesh.vertices();
         for edge in self.mesh.edges().iter().filter(|e| e.tag == Some(id)) {
             let [a, b] = edge.vertices;
@@ -381,7 +383,7 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
         }
         single.sort_unstable();
         single.dedup();
-        general.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+        general.sort_by_key(|x| (x.0, x.1));
         general.dedup_by(|x, y| x.0 == y.0 && x.1 == y.1);
         let mut out: Vec<Constraint<T, 2>> = single
             .into_iter()
