@@ -597,6 +597,31 @@ mod tests {
         }
 
         #[test]
+        fn random_star_polygons(seed in 0u64..1_000_000, corners in 5usize..10) {
+            // A random star-shaped polygon (convex and reflex corners), meshed with
+            // the quality mesher; every wall tagged separately.
+            let mut rng = generators::SplitMix64(seed);
+            let outer: Vec<Vec2> = (0..corners)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * (k as f64 + 0.3 * rng.next_f64()) / corners as f64;
+                    let r = 0.5 + 0.5 * rng.next_f64();
+                    Vec2::new(r * a.cos(), r * a.sin())
+                })
+                .collect();
+            let domain = PolygonDomain {
+                outer_tags: (0..corners).map(|k| format!("wall{k}")).collect(),
+                outer: outer.clone(),
+                holes: Vec::new(),
+            };
+            let ps = assert_ps_properties(generators::polygon_mesh(&domain, 0.25).unwrap());
+            for k in 0..corners {
+                let points = check::points_on_segment(outer[k], outer[(k + 1) % corners], 20);
+                let r = check::dirichlet_residual(&ps, &format!("wall{k}"), Vec2::new(0.6, 0.8), &points, k as u64);
+                prop_assert!(r < 1e-11, "wall{} residual {:e}", k, r);
+            }
+        }
+
+        #[test]
         fn random_point_delaunay_meshes(seed in 0u64..1_000_000, count in 8usize..40) {
             let mut rng = generators::SplitMix64(seed);
             let mut points = vec![
