@@ -7,7 +7,10 @@
 //! - [`bases`]: the typed choice of basis made at the edge (command line, scene);
 //! - [`sparse`]: symmetric sparsity patterns on a basis and the sparse Cholesky solver
 //!   (symbolic once, numeric per call);
-//! - [`projection`]: L² projection onto a basis (benchmark B1 of the seeds).
+//! - [`projection`]: L² projection onto a basis (benchmark B1 of the seeds);
+//! - [`driver`]: the MPM time step, generic over basis, [`mass`] strategy and
+//!   [`material`]; [`particles`], [`effect`]s (gravity);
+//! - [`scene`]: built-in benchmark scenes with their exact solutions.
 //!
 //! # Example
 //!
@@ -28,5 +31,11 @@
 pub use psmpm_basis as basis;
 
 pub mod bases;
+pub mod driver;
+pub mod effect;
+pub mod mass;
+pub mod material;
+pub mod particles;
 pub mod projection;
+pub mod scene;
 pub mod sparse;

@@ -1,0 +1,410 @@
+//! The MPM time step (paper eqs. (13)–(31), thesis Fig. 2.5), generic over the
+//! basis, the mass strategy and the material. Nothing here knows which basis it has.
+//!
+//! One step, in order:
+//! 1. locate every particle (walking from its previous element) and evaluate the basis;
+//! 2. assemble `M` (eq. (13)), `F^int` (eq. (15)) and the effects' forces (eqs. (14), (16));
+//! 3. solve `M a = F` (eq. (17)) with the Dirichlet conditions;
+//! 4. update particle velocities `v_p += Δt Σ a_i phi_i(x_p)` (eq. (18));
+//! 5. project velocities `M v̂ = P` (eqs. (20)–(21));
+//! 6. update `F_p ← (I + Δt ∇v_p) F_p` with the full velocity gradient, `σ_p`,
+//!    `V_p = J_p V_p⁰` (eqs. (22)–(29));
+//! 7. move particles `x_p += Δt Σ v̂_i phi_i(x_p)` and `u_p` likewise (eqs. (30)–(31)).
+//!
+//! The paper (eq. (24)) updates `F` with the symmetric part of the velocity gradient,
+//! which ignores rotation: a rigidly rotating body would accumulate spurious strain.
+//! We use the full gradient `∇v`, which is exact for rigid rotation to first order
+//! (see the test `rigid_rotation_creates_no_stress`).
+//!
+//! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
+
+use crate::effect::{Effect, ParticleBasis};
+use crate::mass::{MassReport, MassStrategy};
+use crate::material::{det, Material};
+use crate::particles::Particles;
+use crate::sparse::{NotPositiveDefinite, Scalar, SymmetricPattern};
+use nalgebra::{SMatrix, SVector};
+use psmpm_basis::{Basis, BasisError, BasisEval};
+
+/// Why a step failed. Each names the step and says what to try.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    #[error("step {step}: particle {particle} at {position:?} left the mesh; try a smaller time step or a larger mesh")]
+    ParticleLeftMesh {
+        step: usize,
+        particle: usize,
+        position: Vec<f64>,
+    },
+    #[error("step {step}: the mass matrix is not positive definite ({source}); try a lumped or partially lumped mass strategy")]
+    MassNotPositiveDefinite {
+        step: usize,
+        source: NotPositiveDefinite,
+    },
+    #[error("step {step}: {quantity} of particle {particle} is not finite; the run is unstable: try a smaller time step or another mass strategy")]
+    NotFinite {
+        step: usize,
+        quantity: &'static str,
+        particle: usize,
+    },
+}
+
+/// Errors setting up a driver.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetupError {
+    #[error(transparent)]
+    Basis(#[from] BasisError),
+    #[error("boundary condition on `{tag}`: {message}")]
+    Boundary { tag: String, message: String },
+    #[error("particle {particle} at {position:?} lies outside the mesh")]
+    ParticleOutside { particle: usize, position: Vec<f64> },
+}
+
+/// A homogeneous Dirichlet condition: velocity component `component` vanishes on `tag`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Fix {
+    /// Boundary tag.
+    pub tag: String,
+    /// Velocity component (0 = x, 1 = y).
+    pub component: usize,
+}
+
+/// Energies, momentum and what the mass strategy did, after a step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepReport {
+    /// Step number (1-based after the first step).
+    pub step: usize,
+    /// Time after the step.
+    pub time: f64,
+    /// Kinetic energy `Σ ½ m_p |v_p|²`.
+    pub kinetic: f64,
+    /// Strain energy `Σ V_p⁰ W(F_p)`.
+    pub strain: f64,
+    /// Potential energy of the effects (gravity).
+    pub potential: f64,
+    /// Total mass.
+    pub mass: f64,
+    /// Total momentum (x, and y in 2D).
+    pub momentum: [f64; 2],
+    /// Largest particle speed.
+    pub max_speed: f64,
+    /// What the mass strategy did.
+    pub mass_report: MassReport,
+}
+
+impl StepReport {
+    /// Kinetic + strain + potential energy.
+    pub fn total_energy(&self) -> f64 {
+        self.kinetic + self.strain + self.potential
+    }
+}
+
+/// The MPM driver.
+pub struct Driver<T, const D: usize, B, M, Mat>
+where
+    T: Scalar,
+    B: Basis<T, D>,
+    M: MassStrategy<T>,
+    Mat: Material<T, D>,
+{
+    /// The basis.
+    pub basis: B,
+    /// The particles.
+    pub particles: Particles<T, D>,
+    material: Mat,
+    mass: M,
+    effects: Vec<Box<dyn Effect<T, D>>>,
+    pattern: SymmetricPattern,
+    dt: T,
+    step: usize,
+    time: f64,
+    // Buffers, sized once.
+    stride: usize,
+    len: Vec<usize>,
+    index: Vec<usize>,
+    phi: Vec<T>,
+    grad: Vec<SVector<T, D>>,
+    eval: BasisEval<T, D>,
+    values: Vec<T>,
+    rhs: Vec<Vec<T>>,
+    velocity: Vec<Vec<T>>,
+    last_report: MassReport,
+}
+
+impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
+where
+    T: Scalar,
+    B: Basis<T, D>,
+    M: MassStrategy<T>,
+    Mat: Material<T, D>,
+{
+    /// Sets up a run: symbolic work of the mass strategy, Dirichlet sets, particle
+    /// location, initial stress from the initial deformation gradients.
+    pub fn new(
+        basis: B,
+        mut particles: Particles<T, D>,
+        material: Mat,
+        fixes: &[Fix],
+        effects: Vec<Box<dyn Effect<T, D>>>,
+        dt: f64,
+    ) -> Result<Self, SetupError> {
+        let n = basis.num_functions();
+        let mut fixed = vec![vec![false; n]; D];
+        for fix in fixes {
+            if fix.component >= D {
+                return Err(SetupError::Boundary {
+                    tag: fix.tag.clone(),
+                    message: format!("component {} does not exist in {D}D", fix.component),
+                });
+            }
+            let mut direction = SVector::<T, D>::zeros();
+            direction[fix.component] = T::one();
+            let constraints = basis.dirichlet(&fix.tag, &direction)?;
+            for c in constraints {
+                if !c.is_single() {
+                    return Err(SetupError::Boundary {
+                        tag: fix.tag.clone(),
+                        message: "the basis needs general (multi-term) constraints here, which the driver does not support yet; use a straight boundary".into(),
+                    });
+                }
+                fixed[fix.component][c.terms[0].0] = true;
+            }
+        }
+        for p in 0..particles.len() {
+            match basis.locate(&particles.x[p], None) {
+                Some(e) => particles.element[p] = e,
+                None => {
+                    return Err(SetupError::ParticleOutside {
+                        particle: p,
+                        position: particles.x[p].iter().map(|v| v.to_f64()).collect(),
+                    })
+                }
+            }
+            particles.sigma[p] = material.stress(&particles.f[p]);
+        }
+        let pattern = SymmetricPattern::new(&basis);
+        let mass = M::prepare(&pattern, &fixed);
+        let stride = basis.max_functions_per_element();
+        let np = particles.len();
+        Ok(Driver {
+            eval: BasisEval::for_basis(&basis),
+            values: vec![T::zero(); pattern.nnz()],
+            rhs: vec![vec![T::zero(); n]; D],
+            velocity: vec![vec![T::zero(); n]; D],
+            len: vec![0; np],
+            index: vec![0; np * stride],
+            phi: vec![T::zero(); np * stride],
+            grad: vec![SVector::zeros(); np * stride],
+            stride,
+            basis,
+            particles,
+            material,
+            mass,
+            effects,
+            pattern,
+            dt: T::of(dt),
+            step: 0,
+            time: 0.0,
+            last_report: MassReport::default(),
+        })
+    }
+
+    /// Current time.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> usize {
+        self.step
+    }
+    /// The material.
+    pub fn material(&self) -> &Mat {
+        &self.material
+    }
+    /// The mass strategy.
+    pub fn mass_strategy(&self) -> &M {
+        &self.mass
+    }
+    /// Projected velocity coefficients `v̂` of the last step, per component.
+    pub fn velocity_coefficients(&self) -> &[Vec<T>] {
+        &self.velocity
+    }
+
+    /// Phase 1: locate and evaluate every particle.
+    fn evaluate(&mut self) -> Result<(), StepError> {
+        let p_all = &mut self.particles;
+        for p in 0..p_all.len() {
+            let x = p_all.x[p];
+            let e = self
+                .basis
+                .locate(&x, Some(p_all.element[p]))
+                .ok_or_else(|| StepError::ParticleLeftMesh {
+                    step: self.step + 1,
+                    particle: p,
+                    position: x.iter().map(|v| v.to_f64()).collect(),
+                })?;
+            p_all.element[p] = e;
+            self.basis.eval(e, &x, &mut self.eval);
+            let base = p * self.stride;
+            let m = self.eval.len();
+            self.len[p] = m;
+            self.index[base..base + m].copy_from_slice(&self.eval.index[..m]);
+            self.phi[base..base + m].copy_from_slice(&self.eval.phi[..m]);
+            self.grad[base..base + m].copy_from_slice(&self.eval.grad_phi[..m]);
+        }
+        Ok(())
+    }
+
+    /// Phase 2: `M` (eq. (13)) and `F = −F^int + effects` (eqs. (14)–(16)) into `rhs`.
+    fn assemble(&mut self) {
+        self.values.iter_mut().for_each(|v| *v = T::zero());
+        for r in &mut self.rhs {
+            r.iter_mut().for_each(|v| *v = T::zero());
+        }
+        let parts = &self.particles;
+        for p in 0..parts.len() {
+            let base = p * self.stride;
+            let m = self.len[p];
+            let scatter = self.pattern.element_scatter(parts.element[p]);
+            let (mass, vol, sigma) = (parts.mass[p], parts.volume[p], &parts.sigma[p]);
+            for a in 0..m {
+                let w = mass * self.phi[base + a];
+                for b in a..m {
+                    self.values[scatter[a * m + b]] += w * self.phi[base + b];
+                }
+                // F^int_{k,i} = Σ_p V_p σ_{kl} ∂phi_i/∂x_l (eq. (15)).
+                let f_int = sigma * self.grad[base + a] * vol;
+                let i = self.index[base + a];
+                for k in 0..D {
+                    self.rhs[k][i] -= f_int[k];
+                }
+            }
+        }
+        let view = ParticleBasis {
+            stride: self.stride,
+            len: &self.len,
+            index: &self.index,
+            phi: &self.phi,
+        };
+        for effect in &self.effects {
+            effect.add_forces(&self.particles, &view, &mut self.rhs);
+        }
+    }
+
+    /// Advances one time step.
+    pub fn step(&mut self) -> Result<StepReport, StepError> {
+        let dt = self.dt;
+        self.evaluate()?;
+        self.assemble();
+        // eq. (17): M a = F.
+        let report = self
+            .mass
+            .factorize(&self.pattern, &self.values)
+            .map_err(|source| StepError::MassNotPositiveDefinite {
+                step: self.step + 1,
+                source,
+            })?;
+        self.last_report = report;
+        for k in 0..D {
+            self.mass.solve(k, &mut self.rhs[k]);
+        }
+        // eq. (18): particle velocities; eq. (21): momentum P into `velocity`.
+        for v in &mut self.velocity {
+            v.iter_mut().for_each(|x| *x = T::zero());
+        }
+        let parts = &mut self.particles;
+        for p in 0..parts.len() {
+            let base = p * self.stride;
+            let mut a = SVector::<T, D>::zeros();
+            for s in base..base + self.len[p] {
+                let i = self.index[s];
+                for k in 0..D {
+                    a[k] += self.rhs[k][i] * self.phi[s];
+                }
+            }
+            parts.v[p] += a * dt;
+            for s in base..base + self.len[p] {
+                let w = parts.mass[p] * self.phi[s];
+                for k in 0..D {
+                    self.velocity[k][self.index[s]] += w * parts.v[p][k];
+                }
+            }
+        }
+        // eq. (20): M v̂ = P.
+        for k in 0..D {
+            self.mass.solve(k, &mut self.velocity[k]);
+        }
+        // eqs. (22)–(31).
+        let id = SMatrix::<T, D, D>::identity();
+        for p in 0..parts.len() {
+            let base = p * self.stride;
+            let mut grad_v = SMatrix::<T, D, D>::zeros();
+            let mut v_hat = SVector::<T, D>::zeros();
+            for s in base..base + self.len[p] {
+                let i = self.index[s];
+                for k in 0..D {
+                    let c = self.velocity[k][i];
+                    v_hat[k] += c * self.phi[s];
+                    for l in 0..D {
+                        grad_v[(k, l)] += c * self.grad[s][l];
+                    }
+                }
+            }
+            let f = (id + grad_v * dt) * parts.f[p];
+            let j = det(&f);
+            if !(j.to_f64() > 0.0 && j.to_f64().is_finite()) {
+                return Err(StepError::NotFinite {
+                    step: self.step + 1,
+                    quantity: "the Jacobian det F (non-positive or NaN)",
+                    particle: p,
+                });
+            }
+            parts.f[p] = f;
+            parts.sigma[p] = self.material.stress(&f);
+            parts.volume[p] = parts.volume0[p] * j;
+            parts.x[p] += v_hat * dt;
+            parts.u[p] += v_hat * dt;
+            if !parts.x[p].iter().all(|c| c.to_f64().is_finite())
+                || !parts.v[p].iter().all(|c| c.to_f64().is_finite())
+            {
+                return Err(StepError::NotFinite {
+                    step: self.step + 1,
+                    quantity: "position or velocity",
+                    particle: p,
+                });
+            }
+        }
+        self.step += 1;
+        self.time += dt.to_f64();
+        Ok(self.report())
+    }
+
+    /// Energies and momentum of the current state.
+    pub fn report(&self) -> StepReport {
+        let parts = &self.particles;
+        let (mut kinetic, mut strain, mut mass, mut max_speed) = (0.0, 0.0, 0.0, 0.0f64);
+        let mut momentum = [0.0; 2];
+        for p in 0..parts.len() {
+            let m = parts.mass[p].to_f64();
+            let speed2 = parts.v[p].norm_squared().to_f64();
+            kinetic += 0.5 * m * speed2;
+            max_speed = max_speed.max(speed2.sqrt());
+            strain +=
+                parts.volume0[p].to_f64() * self.material.energy_density(&parts.f[p]).to_f64();
+            mass += m;
+            for k in 0..D {
+                momentum[k] += m * parts.v[p][k].to_f64();
+            }
+        }
+        StepReport {
+            step: self.step,
+            time: self.time,
+            kinetic,
+            strain,
+            potential: self.effects.iter().map(|e| e.potential_energy(parts)).sum(),
+            mass,
+            momentum,
+            max_speed,
+            mass_report: self.last_report,
+        }
+    }
+}

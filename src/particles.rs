@@ -1,0 +1,59 @@
+//! Material points, stored as a struct of arrays so that each phase of a step
+//! streams through the quantities it needs.
+
+use crate::sparse::Scalar;
+use nalgebra::{SMatrix, SVector};
+
+/// The particles of a simulation.
+#[derive(Debug, Clone, Default)]
+pub struct Particles<T: Scalar, const D: usize> {
+    /// Current positions `x_p`.
+    pub x: Vec<SVector<T, D>>,
+    /// Initial positions `x_p⁰` (where exact solutions are evaluated).
+    pub x0: Vec<SVector<T, D>>,
+    /// Velocities `v_p`.
+    pub v: Vec<SVector<T, D>>,
+    /// Displacements `u_p`, updated with eq. (31).
+    pub u: Vec<SVector<T, D>>,
+    /// Deformation gradients `F_p`.
+    pub f: Vec<SMatrix<T, D, D>>,
+    /// Cauchy stresses `σ_p`.
+    pub sigma: Vec<SMatrix<T, D, D>>,
+    /// Initial volumes `V_p⁰`.
+    pub volume0: Vec<T>,
+    /// Current volumes `V_p = J_p V_p⁰` (eq. (28)).
+    pub volume: Vec<T>,
+    /// Masses `m_p = ρ_0 V_p⁰`, constant (eq. (13)).
+    pub mass: Vec<T>,
+    /// Element containing each particle (the hint for the next location).
+    pub element: Vec<usize>,
+}
+
+impl<T: Scalar, const D: usize> Particles<T, D> {
+    /// Particles at rest and unstressed at `positions` with volumes `volumes` and density `rho`.
+    pub fn new(positions: Vec<SVector<T, D>>, volumes: Vec<T>, rho: T) -> Self {
+        let n = positions.len();
+        Particles {
+            x0: positions.clone(),
+            x: positions,
+            v: vec![SVector::zeros(); n],
+            u: vec![SVector::zeros(); n],
+            f: vec![SMatrix::identity(); n],
+            sigma: vec![SMatrix::zeros(); n],
+            mass: volumes.iter().map(|&v| v * rho).collect(),
+            volume0: volumes.clone(),
+            volume: volumes,
+            element: vec![0; n],
+        }
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// `true` without particles.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
