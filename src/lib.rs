@@ -28,6 +28,9 @@
 //! assert!(error < 2e-4);
 //! ```
 
+// Index loops over components and stored entries read like the paper's sums.
+#![allow(clippy::needless_range_loop)]
+
 pub use psmpm_basis as basis;
 
 pub mod bases;

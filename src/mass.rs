@@ -78,13 +78,7 @@ impl<T: Scalar> MassStrategy<T> for Consistent<T> {
             })
             .collect();
         // Row index of every stored entry, for masking rows and columns.
-        let mut rows = vec![0; pattern.nnz()];
-        let ptr = pattern.col_ptr();
-        for c in 0..pattern.dim() {
-            for k in ptr[c]..ptr[c + 1] {
-                rows[k] = pattern.row_idx()[k];
-            }
-        }
+        let rows = pattern.row_idx().to_vec();
         Consistent {
             solvers: distinct
                 .iter()
