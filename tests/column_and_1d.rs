@@ -1,0 +1,126 @@
+//! Benchmark B5a (column under self-weight, thesis §4.3) in 2D and 1D, and B2 in 1D.
+
+use psmpm::bases::BasisKind;
+use psmpm::scene::{run, run_2d, MassKind, Scene};
+
+/// Relative error of the mid-height particle's displacement against the exact one.
+fn column_2d(basis: BasisKind, blocks: (usize, usize), t_end: f64) -> (f64, psmpm::scene::Summary) {
+    let mut s = Scene::builtin("column-small").unwrap();
+    s.basis = basis;
+    s.blocks = blocks;
+    s.t_end = t_end;
+    let out = run_2d(&s, &mut |_| {}).unwrap();
+    let p = &out.particles;
+    // Particle nearest to (W/2, H/2).
+    let mid = (0..p.len())
+        .min_by(|&a, &b| {
+            let d = |i: usize| (p.x0[i][0] - 1.0).powi(2) + (p.x0[i][1] - 12.5).powi(2);
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let exact = s.exact_displacement([p.x0[mid][0], p.x0[mid][1]], t_end)[1];
+    ((p.u[mid][1] - exact).abs() / exact.abs(), out.summary)
+}
+
+#[test]
+fn column_tracks_the_exact_displacement() {
+    // t = 0.1: a bit more than a quarter of the fundamental period (4H / c ≈ 0.45).
+    let (ps_err, ps) = column_2d(BasisKind::Ps, (1, 8), 0.1);
+    assert_eq!(ps.functions, 78);
+    assert!(ps_err < 5e-3, "PS mid-height displacement error {ps_err:e}");
+    let (pl_err, pl) = column_2d(BasisKind::Pl, (2, 16), 0.1);
+    assert_eq!(pl.functions, 83);
+    assert!(pl_err < 2e-2, "PL mid-height displacement error {pl_err:e}");
+    assert!(ps.stable && pl.stable);
+    insta::assert_snapshot!(format!(
+        "ps 1x8: E_u={:.4e} mid rel err={:.3e}\npl 2x16: E_u={:.4e} mid rel err={:.3e}\n",
+        ps.error.unwrap(),
+        ps_err,
+        pl.error.unwrap(),
+        pl_err
+    ));
+}
+
+fn scene_1d(name: &str, basis: BasisKind, elements: usize) -> f64 {
+    let mut s = Scene::builtin(name).unwrap();
+    s.basis = basis;
+    s.blocks = (elements, 1);
+    s.particles_per_block = (16, 1);
+    if name.starts_with("vibrating") {
+        s.dt = 1e-5;
+        s.t_end = 0.02;
+    } else {
+        s.dt = 1e-4;
+        s.t_end = 0.05;
+    }
+    run(&s, &mut |_| {}).unwrap().error.unwrap()
+}
+
+fn orders(errors: &[f64]) -> Vec<f64> {
+    errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}
+
+#[test]
+fn one_dimensional_bar_converges_with_orders_2_and_3() {
+    let pl: Vec<f64> = [4, 8, 16]
+        .iter()
+        .map(|&n| scene_1d("vibrating-bar-1d", BasisKind::Pl1d, n))
+        .collect();
+    let bs: Vec<f64> = [2, 4, 8]
+        .iter()
+        .map(|&n| scene_1d("vibrating-bar-1d", BasisKind::Bspline, n))
+        .collect();
+    let (o_pl, o_bs) = (orders(&pl), orders(&bs));
+    assert!(
+        o_pl.iter().all(|&o| (1.8..2.3).contains(&o)),
+        "PL 1D orders {o_pl:?}"
+    );
+    assert!(o_bs.iter().all(|&o| o > 2.7), "B-spline orders {o_bs:?}");
+}
+
+/// The suddenly applied self-weight sends kinks (jumps in u_yy) through the column,
+/// so the exact solution is only C¹ and the observed orders fall below 2 and 3 once
+/// the kinks are resolved; this test checks that both bases converge and that the
+/// B-spline is the more accurate per function. The orders are recorded in
+/// `docs/results.md`.
+#[test]
+fn one_dimensional_column_converges() {
+    let pl: Vec<f64> = [8, 16, 32]
+        .iter()
+        .map(|&n| scene_1d("column-small-1d", BasisKind::Pl1d, n))
+        .collect();
+    let bs: Vec<f64> = [4, 8, 16]
+        .iter()
+        .map(|&n| scene_1d("column-small-1d", BasisKind::Bspline, n))
+        .collect();
+    assert!(
+        pl.windows(2).all(|w| w[1] < w[0]),
+        "PL 1D column errors {pl:?}"
+    );
+    assert!(
+        bs.windows(2).all(|w| w[1] < w[0]),
+        "B-spline column errors {bs:?}"
+    );
+    // B-spline with 18 functions beats PL with 17.
+    assert!(bs[2] < pl[1], "B-spline {bs:?} vs PL {pl:?}");
+    insta::assert_snapshot!(format!(
+        "pl1d (8, 16, 32 elements): {:.3e} {:.3e} {:.3e}\nbspline (4, 8, 16 elements): {:.3e} {:.3e} {:.3e}\n",
+        pl[0], pl[1], pl[2], bs[0], bs[1], bs[2]
+    ));
+}
+
+#[test]
+fn every_strategy_conserves_mass() {
+    // Particle masses are constant (eq. (13)): total mass is conserved to round-off
+    // for every strategy. (Momentum exchange with walls is physical here; a
+    // wall-free conservation test belongs with the partially lumped strategy.)
+    for mass in [MassKind::Lumped, MassKind::Consistent] {
+        let mut s = Scene::builtin("vibrating-bar").unwrap();
+        s.mass = mass;
+        s.t_end = 0.2;
+        let mut masses = Vec::new();
+        run(&s, &mut |r| masses.push(r.mass)).unwrap();
+        let m0 = masses[0];
+        assert!(masses.iter().all(|m| (m - m0).abs() <= 1e-12 * m0));
+    }
+}
