@@ -374,7 +374,8 @@ where
             }
         }
         self.step += 1;
-        self.time += dt.to_f64();
+        // Time from the step count, so that it does not accumulate round-off.
+        self.time = self.step as f64 * dt.to_f64();
         Ok(self.report())
     }
 
@@ -400,7 +401,11 @@ where
             time: self.time,
             kinetic,
             strain,
-            potential: self.effects.iter().map(|e| e.potential_energy(parts)).sum(),
+            potential: self
+                .effects
+                .iter()
+                .map(|e| e.potential_energy(parts))
+                .fold(0.0, |a, b| a + b),
             mass,
             momentum,
             max_speed,

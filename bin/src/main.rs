@@ -5,6 +5,7 @@
 
 mod error;
 mod project;
+mod run;
 mod table;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -36,12 +37,18 @@ enum Command {
     /// prints the L² errors of f and ∂f/∂x with their observed orders. With
     /// --mesh, projects on that Gmsh mesh instead (one level).
     Project(project::ProjectArgs),
+    /// Run a built-in scene and print per-step diagnostics and a summary.
+    ///
+    /// Scenes: vibrating-bar (B2), column-small (B5a), and their 1D versions
+    /// vibrating-bar-1d and column-small-1d. Energies are in J per unit thickness.
+    Run(run::RunArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Project(args) => project::run(args),
+        Command::Run(args) => run::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
