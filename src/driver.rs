@@ -19,7 +19,7 @@
 //! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
 
 use crate::effect::{Effect, ParticleBasis};
-use crate::mass::{MassReport, MassStrategy};
+use crate::mass::{MassKind, MassReport, MassStrategy, StepContext};
 use crate::material::{det, Material};
 use crate::particles::Particles;
 use crate::sparse::{NotPositiveDefinite, Scalar, SymmetricPattern};
@@ -104,6 +104,8 @@ pub struct StepReport {
     pub max_speed: f64,
     /// What the mass strategy did.
     pub mass_report: MassReport,
+    /// Condition-number estimate of the solved mass system, when requested.
+    pub condition: Option<f64>,
 }
 
 impl StepReport {
@@ -142,7 +144,12 @@ where
     values: Vec<T>,
     rhs: Vec<Vec<T>>,
     velocity: Vec<Vec<T>>,
+    occupied: Vec<bool>,
+    touches_empty: Vec<bool>,
     last_report: MassReport,
+    last_condition: Option<f64>,
+    /// Estimate the condition number every step.
+    pub estimate_condition: bool,
 }
 
 impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
@@ -158,6 +165,7 @@ where
         basis: B,
         mut particles: Particles<T, D>,
         material: Mat,
+        mass_kind: MassKind,
         fixes: &[Fix],
         effects: Vec<Box<dyn Effect<T, D>>>,
         dt: f64,
@@ -197,7 +205,7 @@ where
             particles.sigma[p] = material.stress(&particles.f[p]);
         }
         let pattern = SymmetricPattern::new(&basis);
-        let mass = M::prepare(&pattern, &fixed);
+        let mass = M::prepare(&pattern, &fixed, mass_kind);
         let stride = basis.max_functions_per_element();
         let np = particles.len();
         Ok(Driver {
@@ -206,6 +214,10 @@ where
             rhs: vec![vec![T::zero(); n]; D],
             velocity: vec![vec![T::zero(); n]; D],
             len: vec![0; np],
+            occupied: vec![false; basis.num_elements()],
+            touches_empty: vec![false; n],
+            last_condition: None,
+            estimate_condition: false,
             index: vec![0; np * stride],
             phi: vec![T::zero(); np * stride],
             grad: vec![SVector::zeros(); np * stride],
@@ -305,20 +317,43 @@ where
         }
     }
 
+    /// Marks the functions whose support contains an element without particles.
+    fn mark_empty_elements(&mut self) {
+        self.occupied.iter_mut().for_each(|o| *o = false);
+        for &e in &self.particles.element {
+            self.occupied[e] = true;
+        }
+        self.touches_empty.iter_mut().for_each(|t| *t = false);
+        for (e, &occupied) in self.occupied.iter().enumerate() {
+            if !occupied {
+                for &i in self.basis.element_functions(e) {
+                    self.touches_empty[i] = true;
+                }
+            }
+        }
+    }
+
     /// Advances one time step.
     pub fn step(&mut self) -> Result<StepReport, StepError> {
         let dt = self.dt;
         self.evaluate()?;
         self.assemble();
         // eq. (17): M a = F.
+        self.mark_empty_elements();
+        let context = StepContext {
+            touches_empty: &self.touches_empty,
+        };
         let report = self
             .mass
-            .factorize(&self.pattern, &self.values)
+            .factorize(&self.pattern, &self.values, context)
             .map_err(|source| StepError::MassNotPositiveDefinite {
                 step: self.step + 1,
                 source,
             })?;
         self.last_report = report;
+        self.last_condition = self
+            .estimate_condition
+            .then(|| self.mass.condition_estimate(&self.pattern));
         for k in 0..D {
             self.mass.solve(k, &mut self.rhs[k]);
         }
@@ -424,6 +459,7 @@ where
             momentum,
             max_speed,
             mass_report: self.last_report,
+            condition: self.last_condition,
         }
     }
 }

@@ -14,7 +14,8 @@
 use crate::bases::BasisKind;
 use crate::driver::{Driver, Fix, SetupError, StepError, StepReport};
 use crate::effect::{Effect, Gravity};
-use crate::mass::{Consistent, Lumped, MassStrategy};
+pub use crate::mass::MassKind;
+use crate::mass::{Lumped, MassStrategy, SparseMass};
 use crate::material::{Elastic, LinearElastic};
 use crate::particles::Particles;
 use crate::sparse::Scalar;
@@ -27,36 +28,6 @@ use psmpm_basis::mesh::generators;
 use psmpm_basis::{Basis, Mesh1d, TriMesh};
 use serde::Serialize;
 use std::f64::consts::PI;
-
-/// How the mass systems are solved.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MassKind {
-    /// Consistent mass matrix, sparse Cholesky.
-    Consistent,
-    /// Row-sum lumped mass.
-    Lumped,
-}
-
-impl MassKind {
-    /// Parses a name; the error lists the known ones.
-    pub fn parse(name: &str) -> Result<Self, String> {
-        match name {
-            "consistent" => Ok(MassKind::Consistent),
-            "lumped" => Ok(MassKind::Lumped),
-            _ => Err(format!(
-                "unknown mass strategy `{name}` (known: consistent, lumped)"
-            )),
-        }
-    }
-    /// Name for output.
-    pub fn name(self) -> &'static str {
-        match self {
-            MassKind::Consistent => "consistent",
-            MassKind::Lumped => "lumped",
-        }
-    }
-}
 
 /// Which benchmark.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -103,6 +74,8 @@ pub struct Scene {
     pub split: SplitPoint,
     /// Triangulation of the rectangle.
     pub grid: Grid,
+    /// Estimate the mass-matrix condition number every step (costs ~60 solves).
+    pub condition: bool,
 }
 
 /// Names of the built-in scenes, with one line each.
@@ -142,6 +115,7 @@ impl Scene {
                 v0: 0.1,
                 split: SplitPoint::Incentre,
                 grid: Grid::Blocks,
+                condition: false,
             },
             "column-small" => Scene {
                 name: "column-small",
@@ -156,6 +130,7 @@ impl Scene {
                 v0: 0.0,
                 split: SplitPoint::Incentre,
                 grid: Grid::Blocks,
+                condition: false,
             },
             "vibrating-bar-1d" => Scene {
                 name: "vibrating-bar-1d",
@@ -401,6 +376,8 @@ pub struct Summary {
     pub error: Option<f64>,
     /// Largest number of lumped rows in a step.
     pub max_lumped_rows: usize,
+    /// Largest condition-number estimate (when requested).
+    pub max_condition: Option<f64>,
     /// Total energy at the start.
     pub energy_initial: f64,
     /// Total energy at the end.
@@ -480,8 +457,8 @@ fn dispatch_mass<const D: usize, B: Basis<f64, D>>(
     on_step: &mut dyn FnMut(&StepReport),
 ) -> Result<Outcome<f64, D>, RunError> {
     match scene.mass {
-        MassKind::Consistent => run_with::<D, B, Consistent<f64>>(scene, basis, on_step),
         MassKind::Lumped => run_with::<D, B, Lumped<f64>>(scene, basis, on_step),
+        _ => run_with::<D, B, SparseMass<f64>>(scene, basis, on_step),
     }
 }
 
@@ -511,12 +488,15 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
         basis,
         particles,
         LinearElastic::new(elastic, D),
+        scene.mass,
         &scene.fixes(),
         effects,
         scene.dt,
     )?;
+    driver.estimate_condition = scene.condition;
     let start = driver.report();
     let e0 = start.total_energy();
+    let mut max_condition: Option<f64> = None;
     let (mut scale, mut drift, mut lumped) = (
         e0.abs()
             .max(start.kinetic)
@@ -532,6 +512,9 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
         drift = drift.max((r.total_energy() - e0).abs());
         lumped = lumped.max(r.mass_report.lumped_rows);
+        if let Some(c) = r.condition {
+            max_condition = Some(max_condition.map_or(c, |m: f64| m.max(c)));
+        }
     }
     let seconds = clock.elapsed().as_secs_f64();
     let end = driver.report();
@@ -561,6 +544,7 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
             t_end: driver.time(),
             error: Some(err2.sqrt()),
             max_lumped_rows: lumped,
+            max_condition,
             energy_initial: e0,
             energy_final: end.total_energy(),
             energy_drift,

@@ -9,7 +9,7 @@ use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::Basis;
 use psmpm::driver::{Driver, Fix};
 use psmpm::effect::{Effect, Gravity};
-use psmpm::mass::{Consistent, Lumped, MassStrategy};
+use psmpm::mass::{Lumped, MassKind, MassStrategy, SparseMass};
 use psmpm::material::{Elastic, LinearElastic};
 use psmpm::particles::Particles;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -51,7 +51,7 @@ fn column_particles() -> Particles<f64, 2> {
     Particles::new(x, vec![2.0 * 25.0 / n as f64; n], 1.0)
 }
 
-fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B) -> usize {
+fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B, kind: MassKind) -> usize {
     let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
     let fixes = [
         Fix {
@@ -74,8 +74,17 @@ fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B) -> usize {
     let effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity {
         g: Vector2::new(0.0, -9.81),
     })];
-    let mut driver: Driver<f64, 2, B, M, LinearElastic> =
-        Driver::new(basis, column_particles(), material, &fixes, effects, 1e-4).unwrap();
+    let mut driver: Driver<f64, 2, B, M, LinearElastic> = Driver::new(
+        basis,
+        column_particles(),
+        material,
+        kind,
+        &fixes,
+        effects,
+        1e-4,
+    )
+    .unwrap();
+    driver.estimate_condition = true;
     driver.step().unwrap(); // warm-up outside the count
     ALLOCATIONS.store(0, Ordering::SeqCst);
     COUNTING.store(true, Ordering::SeqCst);
@@ -90,9 +99,21 @@ fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B) -> usize {
 fn a_step_allocates_nothing() {
     let mesh = || block_grid(0.0, 2.0, 0.0, 25.0, 1, 8).unwrap();
     let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
-    assert_eq!(steps_allocate::<_, Consistent<f64>>(ps), 0, "PS consistent");
     assert_eq!(
-        steps_allocate::<_, Lumped<f64>>(Linear::<f64>::new(mesh())),
+        steps_allocate::<_, SparseMass<f64>>(ps, MassKind::Consistent),
+        0,
+        "PS consistent"
+    );
+    let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
+    let partial = MassKind::Partial(psmpm::mass::LumpRule::EmptyElement);
+    assert_eq!(
+        steps_allocate::<_, SparseMass<f64>>(ps, partial),
+        0,
+        "PS partially lumped"
+    );
+    let pl = Linear::<f64>::new(mesh());
+    assert_eq!(
+        steps_allocate::<_, Lumped<f64>>(pl, MassKind::Lumped),
         0,
         "PL lumped"
     );

@@ -93,7 +93,8 @@ fn table_and_summary_for_a_1d_scene() {
         "total",
         "max_speed",
         "active",
-        "lumped"
+        "lumped",
+        "condition"
     ]));
     assert!(text.contains("column-small-1d · pl1d · consistent mass · 17 functions"));
     assert!(text.contains("stable"));
