@@ -4,8 +4,9 @@ use crate::error::CliError;
 use crate::table::{sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
+use psmpm::basis::basis::powell_sabin::SplitPoint;
 use psmpm::driver::StepReport;
-use psmpm::scene::{self, MassKind, RunError, Scene};
+use psmpm::scene::{self, Grid, MassKind, RunError, Scene};
 use serde_json::json;
 
 /// Arguments of `mpm-cli run`.
@@ -26,6 +27,13 @@ pub struct RunArgs {
     /// Particles per block PXxPY (1D: per element, e.g. 4x1).
     #[arg(long, value_name = "PXxPY")]
     particles: Option<String>,
+    /// PS split points: incentre (default) or centroid (the thesis' tables).
+    #[arg(long)]
+    split: Option<String>,
+    /// Triangulation of the rectangle: blocks (4 triangles per block, default) or
+    /// block-delaunay (Delaunay of block corners and centres, the thesis' tables).
+    #[arg(long)]
+    grid: Option<String>,
     /// Time step.
     #[arg(long)]
     dt: Option<f64>,
@@ -65,6 +73,28 @@ fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     }
     if let Some(p) = &args.particles {
         s.particles_per_block = pair(p, "--particles")?;
+    }
+    if let Some(split) = &args.split {
+        s.split = match split.as_str() {
+            "incentre" => SplitPoint::Incentre,
+            "centroid" => SplitPoint::Centroid,
+            other => {
+                return Err(CliError::Input(format!(
+                    "unknown split point `{other}` (known: incentre, centroid)"
+                )))
+            }
+        };
+    }
+    if let Some(grid) = &args.grid {
+        s.grid = match grid.as_str() {
+            "blocks" => Grid::Blocks,
+            "block-delaunay" => Grid::BlockDelaunay,
+            other => {
+                return Err(CliError::Input(format!(
+                    "unknown grid `{other}` (known: blocks, block-delaunay)"
+                )))
+            }
+        };
     }
     if let Some(dt) = args.dt {
         s.dt = dt;
