@@ -106,6 +106,21 @@ pub struct StepReport {
     pub mass_report: MassReport,
     /// Condition-number estimate of the solved mass system, when requested.
     pub condition: Option<f64>,
+    /// Wall time of the phases of the step.
+    pub phases: PhaseTimes,
+}
+
+/// Wall time (seconds) of the phases of one step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PhaseTimes {
+    /// Locate particles and evaluate the basis.
+    pub evaluate: f64,
+    /// Assemble the mass matrix and forces.
+    pub assemble: f64,
+    /// Factorise and solve both mass systems (and the condition estimate, if on).
+    pub solve: f64,
+    /// Update particle velocities, momentum, deformation, stress and positions.
+    pub update: f64,
 }
 
 impl StepReport {
@@ -148,6 +163,7 @@ where
     touches_empty: Vec<bool>,
     last_report: MassReport,
     last_condition: Option<f64>,
+    phases: PhaseTimes,
     /// Estimate the condition number every step.
     pub estimate_condition: bool,
 }
@@ -217,6 +233,7 @@ where
             occupied: vec![false; basis.num_elements()],
             touches_empty: vec![false; n],
             last_condition: None,
+            phases: PhaseTimes::default(),
             estimate_condition: false,
             index: vec![0; np * stride],
             phi: vec![T::zero(); np * stride],
@@ -336,8 +353,11 @@ where
     /// Advances one time step.
     pub fn step(&mut self) -> Result<StepReport, StepError> {
         let dt = self.dt;
+        let clock = std::time::Instant::now();
         self.evaluate()?;
+        let t_evaluate = clock.elapsed().as_secs_f64();
         self.assemble();
+        let t_assemble = clock.elapsed().as_secs_f64();
         // eq. (17): M a = F.
         self.mark_empty_elements();
         let context = StepContext {
@@ -357,6 +377,7 @@ where
         for k in 0..D {
             self.mass.solve(k, &mut self.rhs[k]);
         }
+        let mut t_solve = clock.elapsed().as_secs_f64() - t_assemble;
         // eq. (18): particle velocities; eq. (21): momentum P into `velocity`.
         for v in &mut self.velocity {
             v.iter_mut().for_each(|x| *x = T::zero());
@@ -380,9 +401,12 @@ where
             }
         }
         // eq. (20): M v̂ = P.
+        let before_projection = clock.elapsed().as_secs_f64();
         for k in 0..D {
             self.mass.solve(k, &mut self.velocity[k]);
         }
+        let after_projection = clock.elapsed().as_secs_f64();
+        t_solve += after_projection - before_projection;
         // eqs. (22)–(31).
         for p in 0..parts.len() {
             let base = p * self.stride;
@@ -422,6 +446,12 @@ where
                 });
             }
         }
+        self.phases = PhaseTimes {
+            evaluate: t_evaluate,
+            assemble: t_assemble - t_evaluate,
+            solve: t_solve,
+            update: clock.elapsed().as_secs_f64() - t_assemble - t_solve,
+        };
         self.step += 1;
         // Time from the step count, so that it does not accumulate round-off.
         self.time = self.step as f64 * dt.to_f64();
@@ -460,6 +490,7 @@ where
             max_speed,
             mass_report: self.last_report,
             condition: self.last_condition,
+            phases: self.phases,
         }
     }
 }

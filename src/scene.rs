@@ -12,7 +12,7 @@
 //! has no gravity, so gravity is never evaluated for it).
 
 use crate::bases::BasisKind;
-use crate::driver::{Driver, Fix, SetupError, StepError, StepReport};
+use crate::driver::{Driver, Fix, PhaseTimes, SetupError, StepError, StepReport};
 use crate::effect::{Effect, Gravity};
 pub use crate::mass::MassKind;
 use crate::mass::{Lumped, MassStrategy, SparseMass};
@@ -388,6 +388,9 @@ pub struct Summary {
     pub stable: bool,
     /// Wall time of the time loop.
     pub seconds: f64,
+    /// Wall time per phase, summed over the steps.
+    #[serde(skip)]
+    pub phases: PhaseTimes,
 }
 
 /// Energy drift above which a completed run is called unstable.
@@ -497,6 +500,7 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
     let start = driver.report();
     let e0 = start.total_energy();
     let mut max_condition: Option<f64> = None;
+    let mut phases = PhaseTimes::default();
     let (mut scale, mut drift, mut lumped) = (
         e0.abs()
             .max(start.kinetic)
@@ -512,6 +516,10 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
         drift = drift.max((r.total_energy() - e0).abs());
         lumped = lumped.max(r.mass_report.lumped_rows);
+        phases.evaluate += r.phases.evaluate;
+        phases.assemble += r.phases.assemble;
+        phases.solve += r.phases.solve;
+        phases.update += r.phases.update;
         if let Some(c) = r.condition {
             max_condition = Some(max_condition.map_or(c, |m: f64| m.max(c)));
         }
@@ -550,6 +558,7 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
             energy_drift,
             stable: energy_drift < STABLE_ENERGY_DRIFT,
             seconds,
+            phases,
         },
         particles: driver.particles,
     })

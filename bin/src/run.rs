@@ -201,6 +201,15 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             summary.seconds,
             1e6 * summary.seconds / summary.steps.max(1) as f64
         );
+        let p = &summary.phases;
+        let total = (p.evaluate + p.assemble + p.solve + p.update).max(f64::MIN_POSITIVE);
+        println!(
+            "phases: evaluate {:.0} % · assemble {:.0} % · solve {:.0} % · update {:.0} %",
+            100.0 * p.evaluate / total,
+            100.0 * p.assemble / total,
+            100.0 * p.solve / total,
+            100.0 * p.update / total
+        );
     }
     Ok(())
 }
