@@ -76,6 +76,8 @@ pub struct Scene {
     pub grid: Grid,
     /// Estimate the mass-matrix condition number every step (costs ~60 solves).
     pub condition: bool,
+    /// Points whose nearest particles are tracked (velocity and displacement every step).
+    pub tracked: Vec<[f64; 2]>,
 }
 
 /// Names of the built-in scenes, with one line each.
@@ -116,6 +118,7 @@ impl Scene {
                 split: SplitPoint::Incentre,
                 grid: Grid::Blocks,
                 condition: false,
+                tracked: Vec::new(),
             },
             "column-small" => Scene {
                 name: "column-small",
@@ -131,6 +134,7 @@ impl Scene {
                 split: SplitPoint::Incentre,
                 grid: Grid::Blocks,
                 condition: false,
+                tracked: Vec::new(),
             },
             "vibrating-bar-1d" => Scene {
                 name: "vibrating-bar-1d",
@@ -402,6 +406,24 @@ pub struct Outcome<T: Scalar, const D: usize> {
     pub summary: Summary,
     /// Particles at the end.
     pub particles: Particles<T, D>,
+    /// For each tracked point: the particle index and its `(time, velocity,
+    /// displacement)` after every step.
+    pub tracked: Vec<Tracked>,
+}
+
+/// The history of one tracked particle.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Tracked {
+    /// Particle index.
+    pub particle: usize,
+    /// Initial position.
+    pub x0: [f64; 2],
+    /// Times after each step.
+    pub time: Vec<f64>,
+    /// Velocity after each step.
+    pub velocity: Vec<[f64; 2]>,
+    /// Displacement after each step.
+    pub displacement: Vec<[f64; 2]>,
 }
 
 fn to_vec<const D: usize>(p: [f64; 2]) -> SVector<f64, D> {
@@ -509,9 +531,47 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
         0.0f64,
         0usize,
     );
+    let mut tracked: Vec<Tracked> = scene
+        .tracked
+        .iter()
+        .map(|t| {
+            let d = |p: usize| {
+                (0..D)
+                    .map(|k| (positions[p][k] - t[k]).powi(2))
+                    .sum::<f64>()
+            };
+            let particle = (0..positions.len())
+                .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+                .unwrap_or(0);
+            Tracked {
+                particle,
+                x0: positions[particle],
+                ..Tracked::default()
+            }
+        })
+        .collect();
+    for t in &mut tracked {
+        t.time.reserve(scene.steps());
+        t.velocity.reserve(scene.steps());
+        t.displacement.reserve(scene.steps());
+    }
     let clock = std::time::Instant::now();
     for _ in 0..scene.steps() {
         let r = driver.step()?;
+        for t in &mut tracked {
+            let (v, u) = (
+                &driver.particles.v[t.particle],
+                &driver.particles.u[t.particle],
+            );
+            let mut pair = ([0.0; 2], [0.0; 2]);
+            for k in 0..D {
+                pair.0[k] = v[k];
+                pair.1[k] = u[k];
+            }
+            t.time.push(r.time);
+            t.velocity.push(pair.0);
+            t.displacement.push(pair.1);
+        }
         on_step(&r);
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
         drift = drift.max((r.total_energy() - e0).abs());
@@ -561,5 +621,6 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
             phases,
         },
         particles: driver.particles,
+        tracked,
     })
 }
