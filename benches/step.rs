@@ -39,14 +39,31 @@ fn particles() -> Particles<f64, 2> {
     Particles::new(x, vec![50.0 / n as f64; n], 1.0)
 }
 
-fn driver<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B, kind: MassKind) -> Driver<f64, 2, B, M, LinearElastic> {
+fn driver<B: Basis<f64, 2>, M: MassStrategy<f64>>(
+    basis: B,
+    kind: MassKind,
+) -> Driver<f64, 2, B, M, LinearElastic> {
     let fixes = [
-        Fix { tag: "bottom".into(), component: 0 },
-        Fix { tag: "bottom".into(), component: 1 },
-        Fix { tag: "left".into(), component: 0 },
-        Fix { tag: "right".into(), component: 0 },
+        Fix {
+            tag: "bottom".into(),
+            component: 0,
+        },
+        Fix {
+            tag: "bottom".into(),
+            component: 1,
+        },
+        Fix {
+            tag: "left".into(),
+            component: 0,
+        },
+        Fix {
+            tag: "right".into(),
+            component: 0,
+        },
     ];
-    let effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity { g: Vector2::new(0.0, -9.81) })];
+    let effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity {
+        g: Vector2::new(0.0, -9.81),
+    })];
     let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
     Driver::new(basis, particles(), material, kind, &fixes, effects, 1e-5).unwrap()
 }

@@ -624,3 +624,179 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
         tracked,
     })
 }
+
+/// A scene file: a built-in scene and the parameters it changes, in TOML.
+///
+/// ```toml
+/// scene = "column-small"      # the built-in scene to start from
+/// basis = "ps"                # ps, pl (2D); bspline, pl1d (1D)
+/// mass = "partial"            # consistent, lumped, partial[:TAU], deactivate[:M]
+/// blocks = [2, 16]
+/// particles = [6, 8]          # per block
+/// dt = 1e-4
+/// t_end = 0.5
+/// split = "incentre"          # or "centroid"
+/// grid = "blocks"             # or "block-delaunay"
+/// condition = true
+/// tracked = [[1.0, 12.5]]
+/// ```
+///
+/// Unknown keys are rejected; every error names the file, line and column.
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Built-in scene to start from.
+    pub scene: String,
+    /// Basis name.
+    pub basis: Option<String>,
+    /// Mass strategy.
+    pub mass: Option<String>,
+    /// Blocks `[n_x, n_y]`.
+    pub blocks: Option<[usize; 2]>,
+    /// Particles per block `[p_x, p_y]`.
+    pub particles: Option<[usize; 2]>,
+    /// Time step.
+    pub dt: Option<f64>,
+    /// End time.
+    pub t_end: Option<f64>,
+    /// Initial velocity amplitude (vibrating bar).
+    pub v0: Option<f64>,
+    /// `incentre` or `centroid`.
+    pub split: Option<String>,
+    /// `blocks` or `block-delaunay`.
+    pub grid: Option<String>,
+    /// Condition estimate every step.
+    pub condition: Option<bool>,
+    /// Tracked points.
+    pub tracked: Option<Vec<[f64; 2]>>,
+}
+
+/// An error in a scene file, located.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}:{line}:{column}: {message}")]
+pub struct SceneFileError {
+    /// File name.
+    pub file: String,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// 1-based line and column of byte offset `at` in `text`.
+fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before
+        .rfind('\n')
+        .map_or(before.len(), |i| before.len() - i - 1)
+        + 1;
+    (line, column)
+}
+
+impl Scene {
+    /// Parses a scene file (`file` names it in errors).
+    pub fn from_toml(text: &str, file: &str) -> Result<Self, SceneFileError> {
+        let error = |at: usize, message: String| {
+            let (line, column) = line_column(text, at);
+            SceneFileError {
+                file: file.to_string(),
+                line,
+                column,
+                message,
+            }
+        };
+        let parsed: SceneFile = toml::from_str(text).map_err(|e| {
+            let at = e.span().map_or(0, |s| s.start);
+            error(at, e.message().trim().to_string())
+        })?;
+        // Locate a key's value for value errors.
+        let key_at = |key: &str| -> usize {
+            text.lines()
+                .scan(0usize, |offset, l| {
+                    let start = *offset;
+                    *offset += l.len() + 1;
+                    Some((start, l))
+                })
+                .find(|(_, l)| {
+                    l.trim_start().starts_with(key)
+                        && l.trim_start()[key.len()..].trim_start().starts_with('=')
+                })
+                .map_or(0, |(start, l)| {
+                    start
+                        + l.find('=').map_or(0, |i| {
+                            i + 1 + (l[i + 1..].len() - l[i + 1..].trim_start().len())
+                        })
+                })
+        };
+        let mut s = Scene::builtin(&parsed.scene)
+            .map_err(|m| error(key_at("scene"), format!("scene: {m}")))?;
+        if let Some(b) = &parsed.basis {
+            s.basis =
+                BasisKind::parse(b).map_err(|m| error(key_at("basis"), format!("basis: {m}")))?;
+        } else if s.dim == 1 {
+            s.basis = BasisKind::Bspline;
+        }
+        if let Some(m) = &parsed.mass {
+            s.mass = MassKind::parse(m).map_err(|m| error(key_at("mass"), format!("mass: {m}")))?;
+        }
+        if let Some([a, b]) = parsed.blocks {
+            s.blocks = (a, b);
+        }
+        if let Some([a, b]) = parsed.particles {
+            s.particles_per_block = (a, b);
+        }
+        if let Some(v) = parsed.dt {
+            s.dt = v;
+        }
+        if let Some(v) = parsed.t_end {
+            s.t_end = v;
+        }
+        if let Some(v) = parsed.v0 {
+            if !v.is_finite() {
+                return Err(error(key_at("v0"), format!("v0: must be finite, got {v}")));
+            }
+            s.v0 = v;
+        }
+        if let Some(v) = &parsed.split {
+            s.split = match v.as_str() {
+                "incentre" => SplitPoint::Incentre,
+                "centroid" => SplitPoint::Centroid,
+                other => {
+                    return Err(error(
+                        key_at("split"),
+                        format!("split: unknown split point `{other}` (known: incentre, centroid)"),
+                    ))
+                }
+            };
+        }
+        if let Some(v) = &parsed.grid {
+            s.grid = match v.as_str() {
+                "blocks" => Grid::Blocks,
+                "block-delaunay" => Grid::BlockDelaunay,
+                other => {
+                    return Err(error(
+                        key_at("grid"),
+                        format!("grid: unknown grid `{other}` (known: blocks, block-delaunay)"),
+                    ))
+                }
+            };
+        }
+        if let Some(c) = parsed.condition {
+            s.condition = c;
+        }
+        if let Some(t) = parsed.tracked {
+            s.tracked = t;
+        }
+        s.validate().map_err(|m| {
+            let key = ["dt", "t_end", "particles", "blocks", "basis"]
+                .into_iter()
+                .find(|k| m.contains(k.trim_end_matches('s')))
+                .unwrap_or("scene");
+            error(key_at(key), m)
+        })?;
+        Ok(s)
+    }
+}

@@ -12,7 +12,8 @@ use serde_json::json;
 /// Arguments of `mpm-cli run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// Built-in scene: vibrating-bar, column-small, vibrating-bar-1d, column-small-1d.
+    /// Built-in scene (vibrating-bar, column-small, vibrating-bar-1d, column-small-1d)
+    /// or a scene file FILE.toml; command-line options override the scene's values.
     scene: String,
     /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
     #[arg(long)]
@@ -59,7 +60,13 @@ fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
 
 /// The scene with the command line's overrides applied.
 fn scene(args: &RunArgs) -> Result<Scene, CliError> {
-    let mut s = Scene::builtin(&args.scene).map_err(CliError::Input)?;
+    let mut s = if args.scene.ends_with(".toml") {
+        let text = std::fs::read_to_string(&args.scene)
+            .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", args.scene)))?;
+        Scene::from_toml(&text, &args.scene).map_err(|e| CliError::Input(e.to_string()))?
+    } else {
+        Scene::builtin(&args.scene).map_err(CliError::Input)?
+    };
     if let Some(b) = &args.basis {
         s.basis = BasisKind::parse(b).map_err(CliError::Input)?;
     } else if s.dim == 1 {

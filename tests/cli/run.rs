@@ -137,3 +137,67 @@ fn a_particle_leaving_the_mesh_is_a_numerical_failure_with_status_1() {
         "{stderr}"
     );
 }
+
+#[test]
+fn scene_files_run_and_bad_ones_name_file_line_and_column() {
+    let file = format!(
+        "{}/../scenes/column-partial.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = cli()
+        .args(["run", &file, "--t-end", "0.01", "--diag-every", "0"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("column-small · ps · partial mass · 249 functions"),
+        "{text}"
+    );
+    let dir = std::env::temp_dir().join(format!("psmpm-scenes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [(&str, &str); 8] = [
+        (
+            "scene = \"vibrating-bar\"\nbasis = \"ps\"\ncolour = \"red\"\n",
+            ":3:1: unknown field `colour`",
+        ),
+        (
+            "scene = \"pendulum\"\n",
+            ":1:9: scene: unknown scene `pendulum`",
+        ),
+        (
+            "scene = \"vibrating-bar\"\n\ndt = \"small\"\n",
+            ":3:6: invalid type",
+        ),
+        (
+            "scene = \"vibrating-bar\"\ndt = -1.0\n",
+            ":2:6: dt must be positive",
+        ),
+        (
+            "scene = \"vibrating-bar\"\nbasis = \"bspline\"\n",
+            ":2:9: basis `bspline` is 1D",
+        ),
+        (
+            "scene = \"vibrating-bar\"\nblocks = [0, 1]\n",
+            ":2:10: blocks must be between",
+        ),
+        (
+            "scene = \"vibrating-bar\"\nmass = \"heavy\"\n",
+            ":2:8: mass: unknown mass strategy",
+        ),
+        ("scene = \"vibrating-bar\"\nblocks = [4, 1\n", ":2:"),
+    ];
+    for (k, (text, expected)) in cases.iter().enumerate() {
+        let path = dir.join(format!("bad{k}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let msg = input_error(&["run", path.to_str().unwrap()]);
+        assert!(
+            msg.contains(&format!("bad{k}.toml{expected}")),
+            "case {k}: {msg}"
+        );
+    }
+}
