@@ -163,6 +163,18 @@ impl Scene {
         Ok(scene)
     }
 
+    /// The effects the scene declares: gravity for the column, none for the bar.
+    /// Only these are assembled.
+    pub fn effects<const D: usize>(&self) -> Vec<Box<dyn Effect<f64, D>>> {
+        let mut effects: Vec<Box<dyn Effect<f64, D>>> = Vec::new();
+        if self.benchmark == Benchmark::ColumnSmall {
+            let mut g = SVector::<f64, D>::zeros();
+            g[D - 1] = COLUMN.4;
+            effects.push(Box::new(Gravity { g }));
+        }
+        effects
+    }
+
     /// Checks that the parameters make a valid run.
     pub fn validate(&self) -> Result<(), String> {
         if self.basis.dim() != self.dim {
@@ -502,12 +514,7 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
     for (p, x0) in positions.iter().enumerate() {
         particles.v[p] = to_vec::<D>(scene.initial_velocity(*x0));
     }
-    let mut effects: Vec<Box<dyn Effect<f64, D>>> = Vec::new();
-    if scene.benchmark == Benchmark::ColumnSmall {
-        let mut g = SVector::<f64, D>::zeros();
-        g[D - 1] = COLUMN.4;
-        effects.push(Box::new(Gravity { g }));
-    }
+    let effects = scene.effects::<D>();
     let functions = basis.num_functions();
     let mut driver: Driver<f64, D, B, M, LinearElastic> = Driver::new(
         basis,

@@ -60,3 +60,61 @@ fn builtin_scene_summaries() {
     }
     insta::assert_snapshot!(out);
 }
+
+/// Only the effects a scene declares are assembled: the bar declares none, the column
+/// gravity; an effect in the driver's list is called exactly once per step.
+#[test]
+fn only_declared_effects_are_evaluated() {
+    use psmpm::effect::{Effect, ParticleBasis};
+    use psmpm::particles::Particles;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    let bar = Scene::builtin("vibrating-bar").unwrap();
+    assert!(bar.effects::<2>().is_empty());
+    let column = Scene::builtin("column-small").unwrap();
+    let names: Vec<&str> = column.effects::<2>().iter().map(|e| e.name()).collect();
+    assert_eq!(names, ["gravity"]);
+
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    struct Counting;
+    impl Effect<f64, 1> for Counting {
+        fn name(&self) -> &'static str {
+            "counting"
+        }
+        fn add_forces(&self, _: &Particles<f64, 1>, _: &ParticleBasis<f64, 1>, _: &mut [Vec<f64>]) {
+            CALLS.fetch_add(1, Ordering::SeqCst);
+        }
+        fn potential_energy(&self, _: &Particles<f64, 1>) -> f64 {
+            0.0
+        }
+    }
+    use nalgebra::Vector1;
+    use psmpm::basis::basis::linear1d::Linear1d;
+    use psmpm::basis::Mesh1d;
+    use psmpm::driver::Driver;
+    use psmpm::mass::{Lumped, MassKind};
+    use psmpm::material::{Elastic, LinearElastic};
+    let particles = Particles::new(
+        (0..8)
+            .map(|i| Vector1::new(0.0625 + 0.125 * i as f64))
+            .collect(),
+        vec![0.125; 8],
+        1.0,
+    );
+    let material = LinearElastic::new(Elastic::new(1.0, 0.0, 1.0).unwrap(), 1);
+    let basis = Linear1d::<f64>::new(Mesh1d::uniform(0.0, 1.0, 4).unwrap());
+    let mut d: Driver<f64, 1, _, Lumped<f64>, _> = Driver::new(
+        basis,
+        particles,
+        material,
+        MassKind::Lumped,
+        &[],
+        vec![Box::new(Counting)],
+        1e-3,
+    )
+    .unwrap();
+    for _ in 0..5 {
+        d.step().unwrap();
+    }
+    assert_eq!(CALLS.load(Ordering::SeqCst), 5);
+}
