@@ -8,6 +8,7 @@
 //! homogeneous Dirichlet condition fixes one coefficient. Linear precision holds with
 //! the Greville abscissae `(t_{k+1} + t_{k+2}) / 2`.
 
+use super::linear1d::end_constraint;
 use super::{Basis, BasisError, BasisEval, Constraint, Point};
 use crate::mesh::Mesh1d;
 use crate::scalar::Real;
@@ -119,21 +120,7 @@ impl<T: Real> Basis<T, 1> for QuadraticBSpline<T> {
         tag: &str,
         direction: &Point<T, 1>,
     ) -> Result<Vec<Constraint<T, 1>>, BasisError> {
-        let f = match tag {
-            "left" => 0,
-            "right" => self.num_functions() - 1,
-            _ => {
-                return Err(crate::mesh::MeshError::UnknownTag {
-                    tag: tag.into(),
-                    known: self.boundary_tags(),
-                }
-                .into())
-            }
-        };
-        Ok(vec![Constraint {
-            direction: *direction,
-            terms: vec![(f, T::one())],
-        }])
+        end_constraint(tag, direction, self.num_functions() - 1)
     }
     fn polynomial_pieces(&self, element: usize, out: &mut Vec<Point<f64, 1>>) {
         let (a, b) = self.mesh.element(element);

@@ -81,21 +81,7 @@ impl<T: Real> Basis<T, 1> for Linear1d<T> {
         tag: &str,
         direction: &Point<T, 1>,
     ) -> Result<Vec<Constraint<T, 1>>, BasisError> {
-        let f = match tag {
-            "left" => 0,
-            "right" => self.nodes.len() - 1,
-            _ => {
-                return Err(crate::mesh::MeshError::UnknownTag {
-                    tag: tag.into(),
-                    known: self.boundary_tags(),
-                }
-                .into())
-            }
-        };
-        Ok(vec![Constraint {
-            direction: *direction,
-            terms: vec![(f, T::one())],
-        }])
+        end_constraint(tag, direction, self.nodes.len() - 1)
     }
     fn polynomial_pieces(&self, element: usize, out: &mut Vec<Point<f64, 1>>) {
         let (a, b) = self.mesh.element(element);
@@ -105,4 +91,28 @@ impl<T: Real> Basis<T, 1> for Linear1d<T> {
     fn degree(&self) -> usize {
         1
     }
+}
+
+/// The homogeneous Dirichlet constraint at an end of a 1D basis whose only function
+/// non-zero at `left` is the first and at `right` is `last` (both equal to one there).
+pub(crate) fn end_constraint<T: Real>(
+    tag: &str,
+    direction: &Point<T, 1>,
+    last: usize,
+) -> Result<Vec<Constraint<T, 1>>, BasisError> {
+    let f = match tag {
+        "left" => 0,
+        "right" => last,
+        _ => {
+            return Err(crate::mesh::MeshError::UnknownTag {
+                tag: tag.into(),
+                known: vec!["left".into(), "right".into()],
+            }
+            .into())
+        }
+    };
+    Ok(vec![Constraint {
+        direction: *direction,
+        terms: vec![(f, T::one())],
+    }])
 }
