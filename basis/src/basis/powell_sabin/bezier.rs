@@ -96,3 +96,207 @@ pub fn bernstein<T: crate::Real>(tau: [T; 3]) -> ([T; 6], [[T; 3]; 6]) {
         ],
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::barycentric;
+    use crate::mesh::generators::SplitMix64;
+
+    /// Value and gradient at `x` of the quadratic with ordinates `b` on the triangle
+    /// `p` (extended outside it).
+    fn eval(p: &[Vec2; 3], b: &[f64; 6], x: Vec2) -> (f64, Vec2) {
+        let tau = barycentric(p[0], p[1], p[2], x);
+        let d = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
+        // ∇τ_k = perp(P_{k+2} − P_{k+1}) / d.
+        let grad_tau: [Vec2; 3] = std::array::from_fn(|k| {
+            let e = p[(k + 2) % 3] - p[(k + 1) % 3];
+            Vec2::new(-e.y, e.x) / d
+        });
+        let (bb, db) = bernstein(tau);
+        let mut value = 0.0;
+        let mut grad = Vec2::zeros();
+        for k in 0..6 {
+            value += b[k] * bb[k];
+            for m in 0..3 {
+                grad += grad_tau[m] * (b[k] * db[k][m]);
+            }
+        }
+        (value, grad)
+    }
+
+    /// A random counter-clockwise triangle with a random interior split point and
+    /// random edge points (not the PS-consistent ones: the identities tested here hold
+    /// for any split point inside and edge points on the edges).
+    fn random_geometry(rng: &mut SplitMix64) -> MainTriangle {
+        loop {
+            let v: [Vec2; 3] =
+                std::array::from_fn(|_| Vec2::new(rng.next_f64(), rng.next_f64()) * 2.0);
+            let area = crate::mesh::signed_area(v[0], v[1], v[2]);
+            if area < 0.05 {
+                continue;
+            }
+            let w: [f64; 3] = std::array::from_fn(|_| 0.2 + rng.next_f64());
+            let s = w.iter().sum::<f64>();
+            let z_bary = w.map(|x| x / s);
+            let r_lambda: [f64; 3] = std::array::from_fn(|_| 0.15 + 0.7 * rng.next_f64());
+            return MainTriangle {
+                v,
+                z: v[0] * z_bary[0] + v[1] * z_bary[1] + v[2] * z_bary[2],
+                z_bary,
+                r: std::array::from_fn(|m| {
+                    v[m] * r_lambda[m] + v[(m + 1) % 3] * (1.0 - r_lambda[m])
+                }),
+                r_lambda,
+            };
+        }
+    }
+
+    fn sub_triangles(tri: &MainTriangle) -> [[Vec2; 3]; 6] {
+        let mut out = [[Vec2::zeros(); 3]; 6];
+        for m in 0..3 {
+            out[2 * m] = [tri.v[m], tri.r[m], tri.z];
+            out[2 * m + 1] = [tri.r[m], tri.v[(m + 1) % 3], tri.z];
+        }
+        out
+    }
+
+    #[test]
+    fn bernstein_polynomials_sum_to_one_and_their_derivatives_to_two() {
+        let (b, db) = bernstein([0.2f64, 0.3, 0.5]);
+        assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        for m in 0..3 {
+            // Σ_k ∂B_k/∂τ_m = 2 (τ_0 + τ_1 + τ_2) = 2.
+            assert!((db.iter().map(|d| d[m]).sum::<f64>() - 2.0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn hermite_interpolant_reproduces_quadratics() {
+        let mut rng = SplitMix64(7);
+        for _ in 0..50 {
+            let tri = random_geometry(&mut rng);
+            let c: [f64; 6] = std::array::from_fn(|_| 2.0 * rng.next_f64() - 1.0);
+            let p = |x: Vec2| {
+                c[0] + c[1] * x.x
+                    + c[2] * x.y
+                    + c[3] * x.x * x.x
+                    + c[4] * x.x * x.y
+                    + c[5] * x.y * x.y
+            };
+            let dp = |x: Vec2| {
+                Vec2::new(
+                    c[1] + 2.0 * c[3] * x.x + c[4] * x.y,
+                    c[2] + c[4] * x.x + 2.0 * c[5] * x.y,
+                )
+            };
+            let b = hermite_ordinates(&tri, tri.v.map(p), tri.v.map(dp));
+            for (s, corners) in sub_triangles(&tri).iter().enumerate() {
+                for w in [
+                    [0.2, 0.3, 0.5],
+                    [0.7, 0.2, 0.1],
+                    [1.0, 0.0, 0.0],
+                    [0.0, 0.5, 0.5],
+                ] {
+                    let x = corners[0] * w[0] + corners[1] * w[1] + corners[2] * w[2];
+                    let (value, grad) = eval(corners, &b[s], x);
+                    assert!((value - p(x)).abs() < 1e-13, "sub {s}: {value} vs {}", p(x));
+                    assert!((grad - dp(x)).norm() < 1e-12);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn hermite_interpolant_matches_the_vertex_data_and_is_c1_inside() {
+        let mut rng = SplitMix64(11);
+        for _ in 0..50 {
+            let tri = random_geometry(&mut rng);
+            let f: [f64; 3] = std::array::from_fn(|_| rng.next_f64());
+            let g: [Vec2; 3] = std::array::from_fn(|_| Vec2::new(rng.next_f64(), rng.next_f64()));
+            let b = hermite_ordinates(&tri, f, g);
+            let subs = sub_triangles(&tri);
+            for m in 0..3 {
+                // Both sub-triangles at V_m interpolate f_m and g_m.
+                for s in [2 * m, 2 * ((m + 2) % 3) + 1] {
+                    let (value, grad) = eval(&subs[s], &b[s], tri.v[m]);
+                    assert!((value - f[m]).abs() < 1e-14);
+                    assert!((grad - g[m]).norm() < 1e-12);
+                }
+                // C¹ across the inner sub-edges R_m–Z and V_m–Z.
+                for (s1, s2, p, q) in [
+                    (2 * m, 2 * m + 1, tri.r[m], tri.z),
+                    (2 * m, 2 * ((m + 2) % 3) + 1, tri.v[m], tri.z),
+                ] {
+                    for w in [0.0, 0.3, 0.6, 1.0] {
+                        let x = p + (q - p) * w;
+                        let (v1, g1) = eval(&subs[s1], &b[s1], x);
+                        let (v2, g2) = eval(&subs[s2], &b[s2], x);
+                        assert!((v1 - v2).abs() < 1e-14);
+                        assert!((g1 - g2).norm() < 1e-12, "{g1:?} vs {g2:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn vertex_function_ordinates_are_the_papers_eqs_37_38() {
+        // φ with value α and gradient g at V_1 (local 0), zero data elsewhere:
+        // L = α + (1 − λ_1)/2 β̄ at M_12, L' = α + (1 − ν_1)/2 γ̄ at M_13,
+        // L̃ = α + b/2 β̄ + c/2 γ̄ at S_1, λ_1 L at R_12, ν_1 L' at R_13,
+        // λ_1 L̃ at T_12, ν_1 L̃ at T_13, a L̃ at Z, with β̄ = g·(V_2 − V_1),
+        // γ̄ = g·(V_3 − V_1), R_12 = λ_1 V_1 + (1 − λ_1) V_2, R_13 = ν_1 V_1 + (1 − ν_1) V_3.
+        let mut rng = SplitMix64(3);
+        let tri = random_geometry(&mut rng);
+        let (alpha, g) = (0.4, Vec2::new(0.7, -1.3));
+        let b = hermite_ordinates(&tri, [alpha, 0.0, 0.0], [g, Vec2::zeros(), Vec2::zeros()]);
+        let [za, zb, zc] = tri.z_bary;
+        let lambda1 = tri.r_lambda[0];
+        // Local edge 2 joins V_3 and V_1: the weight of V_1 in R_13 is 1 − λ_2.
+        let nu1 = 1.0 - tri.r_lambda[2];
+        let beta_bar = g.dot(&(tri.v[1] - tri.v[0]));
+        let gamma_bar = g.dot(&(tri.v[2] - tri.v[0]));
+        let l = alpha + (1.0 - lambda1) / 2.0 * beta_bar;
+        let l_prime = alpha + (1.0 - nu1) / 2.0 * gamma_bar;
+        let l_tilde = alpha + zb / 2.0 * beta_bar + zc / 2.0 * gamma_bar;
+        // Sub-triangle 0 = (V_1, R_12, Z): b200 b020 b002 b110 b011 b101.
+        let expected0 = [
+            alpha,
+            lambda1 * l,
+            za * l_tilde,
+            l,
+            lambda1 * l_tilde,
+            l_tilde,
+        ];
+        // Sub-triangle 5 = (R_31, V_1, Z).
+        let expected5 = [
+            nu1 * l_prime,
+            alpha,
+            za * l_tilde,
+            l_prime,
+            l_tilde,
+            nu1 * l_tilde,
+        ];
+        for k in 0..6 {
+            assert!(
+                (b[0][k] - expected0[k]).abs() < 1e-14,
+                "sub 0, {}",
+                BERNSTEIN_ORDER[k]
+            );
+            assert!(
+                (b[5][k] - expected5[k]).abs() < 1e-14,
+                "sub 5, {}",
+                BERNSTEIN_ORDER[k]
+            );
+        }
+        // Sub-triangles 2 and 3 (on the edge V_2–V_3, away from V_1): only the
+        // ordinate at Z is non-zero (T_23 mixes S_2 and S_3, both zero).
+        for s in [2, 3] {
+            for (k, ordinate) in b[s].iter().enumerate() {
+                let expect = if k == 2 { za * l_tilde } else { 0.0 };
+                assert!((ordinate - expect).abs() < 1e-14);
+            }
+        }
+    }
+}

@@ -95,11 +95,20 @@ fn area(t: &[Vec2; 3]) -> f64 {
     0.5 * cross(t[1] - t[0], t[2] - t[0])
 }
 
-/// The triangle cut from the wedge `{a, b}` (apex `a ∩ b`) by the line orthogonal to
-/// its bisector through the farthest point. `None` if the lines are parallel or the
+/// The triangle cut from the wedge `{a, b}` by the line orthogonal to its bisector
+/// through the farthest point. The apex is `a ∩ b`, or `apex` when given (a boundary
+/// corner, whose apex is known exactly). `None` if the lines are parallel or the
 /// wedge is not a proper angle.
-fn wedge_candidate(a: &HalfPlane, b: &HalfPlane, points: &[Vec2]) -> Option<[Vec2; 3]> {
-    let apex = intersect(a, b)?;
+fn wedge_candidate(
+    a: &HalfPlane,
+    b: &HalfPlane,
+    apex: Option<Vec2>,
+    points: &[Vec2],
+) -> Option<[Vec2; 3]> {
+    let apex = match apex {
+        Some(p) => p,
+        None => intersect(a, b)?,
+    };
     let sum = a.n + b.n;
     if sum.norm() < 1e-12 {
         return None;
@@ -144,49 +153,125 @@ fn contains_all(t: &[Vec2; 3], points: &[Vec2], tol: f64) -> bool {
     })
 }
 
+/// A convex boundary corner takes the apex construction `Q¹ = V_i` (edges on both
+/// boundary lines) only while its area is at most this multiple of the smallest
+/// candidate with an edge on one of the two lines. A nearly straight corner (interior
+/// angle close to π) would otherwise get a very flat control triangle whose far
+/// corners run off along the boundary: its two basis functions `φ²`, `φ³` become
+/// nearly equal (ill-conditioned mass matrix) and round-off in its triplets breaks
+/// non-negativity. The fallback keeps Dirichlet conditions exact (single-term on the
+/// chosen line, general constraints on the other; see `dirichlet` of
+/// [`super::PowellSabin`]). At a right angle the ratio is about 1.
+pub const CORNER_AREA_RATIO: f64 = 4.0;
+
 /// The control triangle of a vertex at `vertex` with PS points `points`, counter-
-/// clockwise; for a [`VertexKind::Corner`] the first point is the vertex itself.
-/// `None` if no candidate contains the points (cannot happen on a valid mesh).
+/// clockwise (thesis §3.5.2, `ps-splines.md` §2):
+/// - [`VertexKind::Interior`]: the smallest candidate from the hull lines;
+/// - [`VertexKind::Straight`]: the smallest candidate having the boundary line as one
+///   of its lines;
+/// - [`VertexKind::Corner`]: the wedge with apex `vertex` on the two boundary lines,
+///   closed orthogonally to its bisector; `vertex` is returned first (`Q¹ = V_i`).
+///   Falls back to the best `Straight` candidate on either line when the wedge is
+///   more than [`CORNER_AREA_RATIO`] times larger.
+///
+/// Ties between candidates of equal area go to the first one found (hull lines in
+/// counter-clockwise order from the lowest-leftmost point), so the choice is
+/// deterministic. `None` if no candidate contains the points (cannot happen on a
+/// valid mesh).
 pub fn control_triangle(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Option<[Vec2; 3]> {
-    let scale = points
-        .iter()
-        .fold(0.0f64, |m, p| m.max((p - vertex).norm()));
-    let tol = 1e-9 * scale;
-    let orient = |t: [Vec2; 3]| {
-        if area(&t) < 0.0 {
-            [t[0], t[2], t[1]]
-        } else {
-            t
+    let t = choose(vertex, points, kind)?;
+    // Enlarge about the vertex (see CONTROL_TRIANGLE_MARGIN).
+    Some(t.map(|q| vertex + (q - vertex) * (1.0 + CONTROL_TRIANGLE_MARGIN)))
+}
+
+/// The chosen triangle is enlarged by the factor `1 + CONTROL_TRIANGLE_MARGIN` about
+/// the vertex. A PS point on one of its edges would get Bézier ordinates that are
+/// zero up to round-off of either sign, and round-off is amplified by `|∇L_q|`, the
+/// inverse height of the triangle (large for thin ones): this margin moves such
+/// points inside by `ε · dist(V_i, edge)`, so that every ordinate, hence every basis
+/// function, is non-negative in floating point too. Lines through `V_i` do not move:
+/// the boundary lines of aligned control triangles stay exact (Dirichlet conditions),
+/// and at a corner `Q¹ = V_i` stays. Partition of unity and linear precision hold for
+/// any control triangle and are unaffected.
+pub const CONTROL_TRIANGLE_MARGIN: f64 = 1e-11;
+
+/// The unenlarged choice of [`control_triangle`].
+fn choose(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Option<[Vec2; 3]> {
+    match kind {
+        VertexKind::Interior => smallest_candidate(vertex, points, None),
+        VertexKind::Straight(h) => smallest_candidate(vertex, points, Some(h)),
+        VertexKind::Corner(a, b) => {
+            let corner = corner_candidate(vertex, points, &a, &b);
+            let along = [a, b]
+                .iter()
+                .filter_map(|h| smallest_candidate(vertex, points, Some(*h)))
+                .min_by(|s, t| area(s).total_cmp(&area(t)));
+            match (corner, along) {
+                (Some(c), Some(s)) if area(&c) > CORNER_AREA_RATIO * area(&s) => Some(s),
+                (Some(c), _) => Some(c),
+                (None, s) => s,
+            }
         }
-    };
-    if let VertexKind::Corner(a, b) = kind {
-        let t = orient(wedge_candidate(&a, &b, points)?);
-        // Put the apex (the vertex) first, keeping the orientation.
-        let k =
-            (0..3).min_by(|&i, &j| (t[i] - vertex).norm().total_cmp(&(t[j] - vertex).norm()))?;
-        let t = [t[k], t[(k + 1) % 3], t[(k + 2) % 3]];
-        return contains_all(&t, points, tol).then_some(t);
     }
+}
+
+/// Containment tolerance: round-off relative to the spread of the PS points.
+fn tolerance(vertex: Vec2, points: &[Vec2]) -> f64 {
+    1e-9 * points
+        .iter()
+        .fold(0.0f64, |m, p| m.max((p - vertex).norm()))
+}
+
+/// Counter-clockwise orientation of `t`.
+fn orient(t: [Vec2; 3]) -> [Vec2; 3] {
+    if area(&t) < 0.0 {
+        [t[0], t[2], t[1]]
+    } else {
+        t
+    }
+}
+
+/// The wedge on the two boundary lines of a convex corner with apex at the vertex,
+/// the vertex first.
+fn corner_candidate(
+    vertex: Vec2,
+    points: &[Vec2],
+    a: &HalfPlane,
+    b: &HalfPlane,
+) -> Option<[Vec2; 3]> {
+    let t = orient(wedge_candidate(a, b, Some(vertex), points)?);
+    let t = if t[1] == vertex {
+        [t[1], t[2], t[0]]
+    } else if t[2] == vertex {
+        [t[2], t[0], t[1]]
+    } else {
+        t
+    };
+    contains_all(&t, points, tolerance(vertex, points)).then_some(t)
+}
+
+/// The smallest candidate (wedge or triple of hull lines) containing `points`; with
+/// `required`, only candidates having that line as one of theirs.
+fn smallest_candidate(
+    vertex: Vec2,
+    points: &[Vec2],
+    required: Option<HalfPlane>,
+) -> Option<[Vec2; 3]> {
+    let tol = tolerance(vertex, points);
     let hull = convex_hull(points);
     // The hull is counter-clockwise, so the points lie left of every edge.
     let mut lines: Vec<HalfPlane> = (0..hull.len())
         .map(|k| HalfPlane::left_of(hull[k], hull[(k + 1) % hull.len()]))
         .collect();
-    let required: Option<usize> = match kind {
-        VertexKind::Straight(h) => {
-            let found = lines
-                .iter()
-                .position(|l| (l.n - h.n).norm() < 1e-9 && (l.c - h.c).abs() <= tol);
-            match found {
-                Some(i) => Some(i),
-                None => {
-                    lines.push(h);
-                    Some(lines.len() - 1)
-                }
-            }
-        }
-        _ => None,
-    };
+    let required: Option<usize> = required.map(|h| {
+        let found = lines
+            .iter()
+            .position(|l| (l.n - h.n).norm() < 1e-9 && (l.c - h.c).abs() <= tol);
+        found.unwrap_or_else(|| {
+            lines.push(h);
+            lines.len() - 1
+        })
+    });
     let allowed = |ids: &[usize]| required.is_none_or(|r| ids.contains(&r));
     let mut best: Option<([Vec2; 3], f64)> = None;
     let mut consider = |t: [Vec2; 3]| {
@@ -203,7 +288,7 @@ pub fn control_triangle(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Opti
     for i in 0..n {
         for j in i + 1..n {
             if allowed(&[i, j]) {
-                if let Some(t) = wedge_candidate(&lines[i], &lines[j], points) {
+                if let Some(t) = wedge_candidate(&lines[i], &lines[j], None, points) {
                     consider(t);
                 }
             }
@@ -240,6 +325,21 @@ mod tests {
         }
     }
 
+    /// Smallest barycentric coordinate of the points in `t`.
+    fn margin(t: &[Vec2; 3], points: &[Vec2]) -> f64 {
+        points
+            .iter()
+            .flat_map(|p| crate::mesh::barycentric(t[0], t[1], t[2], *p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Number of corners of `t` on the line of `h`.
+    fn on_line(t: &[Vec2; 3], h: &HalfPlane) -> usize {
+        t.iter()
+            .filter(|q| (h.n.dot(q) - h.c).abs() < 1e-15)
+            .count()
+    }
+
     #[test]
     fn control_triangle_of_a_regular_hexagon_contains_it() {
         let pts: Vec<Vec2> = (0..6)
@@ -250,9 +350,99 @@ mod tests {
             .chain([Vec2::zeros()])
             .collect();
         let t = control_triangle(Vec2::zeros(), &pts, VertexKind::Interior).unwrap();
-        assert!(contains_all(&t, &pts, 1e-12));
+        // Strictly inside, by the margin: the hexagon's corners touching the edges
+        // are at distance 1e-11 × (distance of the centre to the edge, 1).
+        let m = margin(&t, &pts);
+        assert!(m > 0.0 && m < 1e-10, "margin {m:e}");
         // The smallest triangle around a regular hexagon has 1.5× its area.
         let hex = 1.5 * 3f64.sqrt();
         assert!((area(&t) - 1.5 * hex).abs() < 1e-9, "area {}", area(&t));
+    }
+
+    #[test]
+    fn the_choice_does_not_depend_on_the_order_of_the_points() {
+        let mut pts: Vec<Vec2> = [
+            (0.0, 0.0),
+            (0.4, 0.1),
+            (0.1, 0.5),
+            (-0.3, 0.2),
+            (-0.2, -0.4),
+            (0.3, -0.3),
+            (0.45, -0.05),
+        ]
+        .map(|(x, y)| Vec2::new(x, y))
+        .to_vec();
+        let t = control_triangle(Vec2::zeros(), &pts, VertexKind::Interior).unwrap();
+        assert!(margin(&t, &pts) > 0.0);
+        pts.reverse();
+        pts.swap(1, 4);
+        assert_eq!(
+            control_triangle(Vec2::zeros(), &pts, VertexKind::Interior),
+            Some(t)
+        );
+    }
+
+    #[test]
+    fn straight_boundary_gives_an_edge_on_the_boundary_line() {
+        // Boundary along the x-axis, domain above: the PS points of a boundary vertex.
+        let pts: Vec<Vec2> = [
+            (0.0, 0.0),
+            (0.5, 0.0),
+            (-0.4, 0.0),
+            (0.35, 0.3),
+            (-0.1, 0.45),
+            (-0.35, 0.2),
+            (0.1, 0.4),
+        ]
+        .map(|(x, y)| Vec2::new(x, y))
+        .to_vec();
+        let h = HalfPlane::left_of(Vec2::zeros(), Vec2::new(1.0, 0.0));
+        let t = control_triangle(Vec2::zeros(), &pts, VertexKind::Straight(h)).unwrap();
+        assert_eq!(on_line(&t, &h), 2);
+        assert!(margin(&t, &pts) > -1e-15);
+        // Never smaller than the unconstrained choice.
+        let free = control_triangle(Vec2::zeros(), &pts, VertexKind::Interior).unwrap();
+        assert!(area(&t) >= area(&free) * (1.0 - 1e-12));
+    }
+
+    #[test]
+    fn convex_corner_gets_its_apex_at_the_vertex() {
+        // Right-angled corner at the origin, domain in the first quadrant.
+        let (a, b) = (Vec2::new(0.0, 1.0), Vec2::new(1.0, 0.0));
+        let la = HalfPlane::left_of(a, Vec2::zeros());
+        let lb = HalfPlane::left_of(Vec2::zeros(), b);
+        let pts: Vec<Vec2> = [(0.0, 0.0), (0.0, 0.4), (0.5, 0.0), (0.3, 0.25), (0.1, 0.3)]
+            .map(|(x, y)| Vec2::new(x, y))
+            .to_vec();
+        let t = control_triangle(Vec2::zeros(), &pts, VertexKind::Corner(la, lb)).unwrap();
+        assert_eq!(t[0], Vec2::zeros());
+        assert_eq!((on_line(&t, &la), on_line(&t, &lb)), (2, 2));
+        assert!(area(&t) > 0.0 && margin(&t, &pts) > -1e-15);
+        // The cut is orthogonal to the bisector: an isosceles right triangle.
+        assert!(((t[1] - t[0]).norm() - (t[2] - t[0]).norm()).abs() < 1e-14);
+    }
+
+    #[test]
+    fn nearly_flat_convex_corner_falls_back_to_one_boundary_line() {
+        // Interior angle 176°: the apex wedge would be ~30 times too large.
+        let turn = 4f64.to_radians();
+        let a = Vec2::new(-1.0, (turn / 2.0).tan());
+        let b = Vec2::new(1.0, (turn / 2.0).tan());
+        let la = HalfPlane::left_of(a, Vec2::zeros());
+        let lb = HalfPlane::left_of(Vec2::zeros(), b);
+        let pts: Vec<Vec2> = [
+            Vec2::zeros(),
+            a * 0.3,
+            b * 0.25,
+            Vec2::new(0.1, 0.3),
+            Vec2::new(-0.15, 0.25),
+        ]
+        .to_vec();
+        let t = control_triangle(Vec2::zeros(), &pts, VertexKind::Corner(la, lb)).unwrap();
+        let wedge = corner_candidate(Vec2::zeros(), &pts, &la, &lb).unwrap();
+        assert!(area(&wedge) > CORNER_AREA_RATIO * area(&t));
+        assert_ne!(t[0], Vec2::zeros());
+        assert!(on_line(&t, &la) == 2 || on_line(&t, &lb) == 2);
+        assert!(margin(&t, &pts) > -1e-15);
     }
 }
