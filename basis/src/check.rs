@@ -218,35 +218,37 @@ pub fn continuity_jumps<T: Real, B: Basis<T, 2> + ?Sized>(basis: &B) -> Jumps {
     jumps
 }
 
-/// Applies constraints to the `direction` component of the coefficients `c`
-/// (single-term: zeroed; general: orthogonal projection of the component vector onto
-/// the constraints' null space).
+/// Applies constraints (all with the same direction `n`) to the coefficients `c`: the
+/// component vector `u_i = n · c_i` is projected orthogonally onto the null space of
+/// all constraint rows together, `u ← u − A⁺ A u` with the SVD pseudo-inverse, so
+/// single-term and general constraints that share functions are satisfied at once.
 pub fn apply_constraints(c: &mut [Vec2], constraints: &[Constraint<f64, 2>]) {
-    let general: Vec<&Constraint<f64, 2>> = constraints.iter().filter(|k| !k.is_single()).collect();
-    for k in constraints.iter().filter(|k| k.is_single()) {
-        let (i, _) = k.terms[0];
-        let n = k.direction;
-        c[i] -= n * n.dot(&c[i]);
-    }
-    if general.is_empty() {
+    if constraints.is_empty() {
         return;
     }
-    let n = general[0].direction;
-    let m = general.len();
+    let n = constraints[0].direction;
     let ncoef = c.len();
-    let mut a = DMatrix::<f64>::zeros(m, ncoef);
-    for (r, k) in general.iter().enumerate() {
+    // Only the coefficients that some constraint touches take part.
+    let mut touched: Vec<usize> = constraints
+        .iter()
+        .flat_map(|k| k.terms.iter().map(|t| t.0))
+        .collect();
+    touched.sort_unstable();
+    touched.dedup();
+    let column = |i: usize| touched.binary_search(&i).expect("touched");
+    let mut a = DMatrix::<f64>::zeros(constraints.len(), touched.len());
+    for (r, k) in constraints.iter().enumerate() {
         for &(i, w) in &k.terms {
-            a[(r, i)] += w;
+            a[(r, column(i))] += w;
         }
     }
-    let u = DVector::from_iterator(ncoef, c.iter().map(|ci| n.dot(ci)));
-    let aat = &a * a.transpose();
-    let y = aat.pseudo_inverse(1e-14).expect("pseudo-inverse") * (&a * &u);
-    let correction = a.transpose() * y;
-    for i in 0..ncoef {
-        c[i] -= n * correction[i];
+    let u = DVector::from_iterator(touched.len(), touched.iter().map(|&i| n.dot(&c[i])));
+    let pinv = a.clone().pseudo_inverse(1e-12).expect("pseudo-inverse");
+    let correction = pinv * (&a * &u);
+    for (k, &i) in touched.iter().enumerate() {
+        c[i] -= n * correction[k];
     }
+    debug_assert!(ncoef >= touched.len());
 }
 
 /// `max |n · v(x)|` over `points` (which must lie on the wall tagged `tag`) for a
