@@ -1,11 +1,26 @@
 //! Import of 2D triangle meshes from Gmsh `.msh` files (format 4.1 and 2.2, ASCII).
 //!
-//! Triangles (element type 2) form the mesh; line elements (type 1) that belong to a
-//! physical group tag the boundary edges they cover, by the group's name (or its
-//! number when unnamed). Nodes used by no triangle are dropped and the rest
-//! renumbered in file order. A mesh whose triangles are all clockwise (a surface
-//! with a downward normal) is flipped; a mix of orientations is an error.
-//! Every error names the file and, for syntax errors, the line.
+//! Sections read: `$MeshFormat`, `$PhysicalNames`, `$Entities` (4.1: the physical
+//! groups of curves), `$Nodes`, `$Elements`; others (`$Periodic`, `$NodeData`,
+//! comments, …) are skipped.
+//!
+//! - Triangles (element type 2) form the mesh. Points (type 15) are ignored. Any
+//!   other element type (quadrilaterals, second-order elements, 3D elements) is an
+//!   error: psmpm reads first-order triangle meshes.
+//! - Line elements (type 1) that belong to a physical group tag the boundary edge
+//!   they cover, by the group's name from `$PhysicalNames` (or its number as a
+//!   string when unnamed). When a curve is in several physical groups, the first
+//!   one listed is used. Lines on interior curves tag nothing.
+//! - Nodes used by no triangle are dropped and the rest renumbered in file order.
+//! - All nodes must lie in one plane `z = const` (usually `z = 0`).
+//! - A mesh whose triangles are all clockwise (a surface whose normal points
+//!   down, −z) is flipped to counter-clockwise; a mix of orientations is an error
+//!   of the mesh validation ([`MeshError::InvertedTriangle`]).
+//!
+//! Every error names the file; syntax errors also give the 1-based line and what
+//! was expected there (`mesh.msh:17: expected 4 values in a $Elements entity block
+//! header (…), found 3: `2 1 2``). Binary files are rejected with a hint to save
+//! them as ASCII.
 
 use super::{MeshError, TriMesh, Vec2};
 use std::collections::HashMap;
@@ -16,36 +31,51 @@ use std::path::Path;
 pub enum GmshError {
     /// The file could not be read.
     #[error("{file}: cannot read: {message}")]
-    Io { file: String, message: String },
+    Io {
+        /// The path, as given.
+        file: String,
+        /// The operating system's message.
+        message: String,
+    },
     /// The file is not a valid ASCII `.msh` file of a supported kind.
     #[error("{file}:{line}: {message}")]
     Syntax {
+        /// The file name.
         file: String,
+        /// 1-based line number (one past the last line at end of file).
         line: usize,
+        /// What was expected and what was found.
         message: String,
     },
-    /// The file parsed but describes no valid mesh.
+    /// The file parsed but describes no usable mesh (no nodes, no triangles, not planar).
     #[error("{file}: {message}")]
-    Content { file: String, message: String },
+    Content {
+        /// The file name.
+        file: String,
+        /// What is missing or wrong.
+        message: String,
+    },
     /// The triangles do not form a valid mesh.
     #[error("{file}: invalid mesh: {source}")]
-    Mesh { file: String, source: MeshError },
+    Mesh {
+        /// The file name.
+        file: String,
+        /// The validation failure.
+        source: MeshError,
+    },
 }
 
-/// Reads a `.msh` file.
+/// Reads a `.msh` file (see the [module documentation](self) for what is read).
+///
+/// A file that is not valid UTF-8 is decoded lossily, so that a binary file is
+/// reported by its `$MeshFormat` line ("binary .msh is not supported").
 pub fn read_msh(path: &Path) -> Result<TriMesh, GmshError> {
     let file = path.display().to_string();
-    let text = std::fs::read(path).map_err(|e| GmshError::Io {
+    let bytes = std::fs::read(path).map_err(|e| GmshError::Io {
         file: file.clone(),
         message: e.to_string(),
     })?;
-    let text = String::from_utf8(text).map_err(|_| GmshError::Content {
-        file: file.clone(),
-        message:
-            "not a text file (binary .msh is not supported: save as ASCII with Mesh.Binary = 0)"
-                .into(),
-    })?;
-    parse_msh(&text, &file)
+    parse_msh(&String::from_utf8_lossy(&bytes), &file)
 }
 
 /// A line-oriented reader that knows where it is.
@@ -83,8 +113,9 @@ impl<'a> Reader<'a> {
         let f: Vec<&str> = line.split_whitespace().collect();
         if f.len() < n || (!at_least && f.len() != n) {
             return Err(self.error(format!(
-                "expected {}{n} fields in {what}, found {}: `{line}`",
+                "expected {}{n} value{} in {what}, found {}: `{line}`",
                 if at_least { "at least " } else { "" },
+                if n == 1 { "" } else { "s" },
                 f.len()
             )));
         }
@@ -138,6 +169,18 @@ fn element_info(kind: i64) -> Option<(&'static str, usize)> {
     })
 }
 
+/// The name and node count of an element type psmpm reads (line, triangle, point),
+/// or an error naming the type.
+fn supported_element(r: &Reader, kind: i64) -> Result<(&'static str, usize), GmshError> {
+    match element_info(kind) {
+        None => Err(r.error(format!("unknown element type {kind}"))),
+        Some(info) if matches!(kind, 1 | 2 | 15) => Ok(info),
+        Some((name, _)) => Err(r.error(format!(
+            "{name} elements (type {kind}) are not supported: psmpm reads first-order triangle meshes"
+        ))),
+    }
+}
+
 /// Parses the text of a `.msh` file; `source` names it in errors.
 pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
     let mut r = Reader {
@@ -151,7 +194,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
     let mut nodes: HashMap<i64, [f64; 3]> = HashMap::new();
     let mut node_order: Vec<i64> = Vec::new();
     let mut triangles: Vec<([i64; 3], usize)> = Vec::new();
-    let mut lines: Vec<([i64; 2], i64)> = Vec::new(); // nodes, physical tag
+    let mut lines: Vec<([i64; 2], i64, usize)> = Vec::new(); // nodes, physical tag, line
     let mut seen_nodes = false;
     let mut seen_elements = false;
     loop {
@@ -162,7 +205,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
         };
         match header {
             "$MeshFormat" => {
-                let f = r.fields("$MeshFormat", 3, false)?;
+                let f = r.fields("$MeshFormat (version file-type data-size)", 3, false)?;
                 version = Some(match f[0] {
                     "2.2" => 22,
                     "4.1" => 41,
@@ -185,7 +228,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                 )));
             }
             "$PhysicalNames" => {
-                let f = r.fields("the number of physical names", 1, false)?;
+                let f = r.fields("the $PhysicalNames count", 1, false)?;
                 let n = r.count(f[0], "the number of physical names")?;
                 for _ in 0..n {
                     let line = r.next("a physical name")?;
@@ -206,7 +249,11 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                 r.expect_end("PhysicalNames")?;
             }
             "$Entities" if version == Some(41) => {
-                let f = r.fields("$Entities counts", 4, false)?;
+                let f = r.fields(
+                    "the $Entities header (numPoints numCurves numSurfaces numVolumes)",
+                    4,
+                    false,
+                )?;
                 let counts: Vec<usize> = f
                     .iter()
                     .map(|s| r.count(s, "an entity count"))
@@ -215,10 +262,14 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                     r.next("a point entity")?;
                 }
                 for _ in 0..counts[1] {
-                    let f = r.fields("a curve entity", 8, true)?;
+                    let f = r.fields(
+                        "a curve entity (tag minX minY minZ maxX maxY maxZ numPhysicalTags …)",
+                        8,
+                        true,
+                    )?;
                     let tag = r.int(f[0], "a curve tag")?;
                     let nphys = r.count(f[7], "the number of physical tags")?;
-                    if f.len() < 8 + nphys {
+                    if f.len() - 8 < nphys {
                         return Err(
                             r.error("curve entity lists fewer physical tags than it announces")
                         );
@@ -227,7 +278,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                         curve_physical.insert(tag, r.int(f[8], "a physical tag")?);
                     }
                 }
-                for _ in 0..counts[2] + counts[3] {
+                for _ in 0..counts[2].saturating_add(counts[3]) {
                     r.next("a surface or volume entity")?;
                 }
                 r.expect_end("Entities")?;
@@ -235,10 +286,10 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
             "$Nodes" => {
                 seen_nodes = true;
                 if version == Some(22) {
-                    let f = r.fields("the number of nodes", 1, false)?;
+                    let f = r.fields("the $Nodes count", 1, false)?;
                     let n = r.count(f[0], "the number of nodes")?;
                     for _ in 0..n {
-                        let f = r.fields("a node (id x y z)", 4, false)?;
+                        let f = r.fields("a node (tag x y z)", 4, false)?;
                         let id = r.int(f[0], "a node id")?;
                         let xyz = [
                             r.float(f[1], "x")?,
@@ -251,16 +302,24 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                         node_order.push(id);
                     }
                 } else {
-                    let f = r.fields("$Nodes header (4 integers)", 4, false)?;
+                    let f = r.fields(
+                        "the $Nodes header (numEntityBlocks numNodes minNodeTag maxNodeTag)",
+                        4,
+                        false,
+                    )?;
                     let blocks = r.count(f[0], "the number of node blocks")?;
                     for _ in 0..blocks {
-                        let f = r.fields("a node block header (4 integers)", 4, false)?;
+                        let f = r.fields(
+                            "a $Nodes entity block header (entityDim entityTag parametric numNodesInBlock)",
+                            4,
+                            false,
+                        )?;
                         let parametric = r.int(f[2], "the parametric flag")?;
                         if parametric != 0 {
                             return Err(r.error("parametric nodes are not supported"));
                         }
                         let n = r.count(f[3], "the number of nodes in the block")?;
-                        let mut ids = Vec::with_capacity(n);
+                        let mut ids = Vec::with_capacity(n.min(1 << 16));
                         for _ in 0..n {
                             let f = r.fields("a node tag", 1, false)?;
                             ids.push(r.int(f[0], "a node tag")?);
@@ -284,8 +343,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
             "$Elements" => {
                 seen_elements = true;
                 let mut push = |r: &Reader, kind: i64, nodes_of: &[&str], physical: Option<i64>| {
-                    let (name, count) = element_info(kind)
-                        .ok_or_else(|| r.error(format!("unknown element type {kind}")))?;
+                    let (name, count) = supported_element(r, kind)?;
                     if nodes_of.len() != count {
                         return Err(r.error(format!(
                             "a {name} needs {count} nodes, found {}",
@@ -299,27 +357,22 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                     match kind {
                         1 => {
                             if let Some(p) = physical {
-                                lines.push(([ids[0], ids[1]], p));
+                                lines.push(([ids[0], ids[1]], p, r.pos));
                             }
                         }
                         2 => triangles.push(([ids[0], ids[1], ids[2]], r.pos)),
-                        15 => {}
-                        _ => {
-                            return Err(r.error(format!(
-                                "{name} elements are not supported: psmpm reads first-order triangle meshes"
-                            )))
-                        }
+                        _ => {} // points
                     }
                     Ok(())
                 };
                 if version == Some(22) {
-                    let f = r.fields("the number of elements", 1, false)?;
+                    let f = r.fields("the $Elements count", 1, false)?;
                     let n = r.count(f[0], "the number of elements")?;
                     for _ in 0..n {
-                        let f = r.fields("an element", 3, true)?;
+                        let f = r.fields("an element (tag type numTags tags… nodes…)", 3, true)?;
                         let kind = r.int(f[1], "an element type")?;
                         let ntags = r.count(f[2], "the number of element tags")?;
-                        if f.len() < 3 + ntags {
+                        if f.len() - 3 < ntags {
                             return Err(r.error("element lists fewer tags than it announces"));
                         }
                         let physical = if ntags > 0 {
@@ -330,20 +383,26 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
                         push(&r, kind, &f[3 + ntags..], physical)?;
                     }
                 } else {
-                    let f = r.fields("$Elements header (4 integers)", 4, false)?;
+                    let f = r.fields("the $Elements header (numEntityBlocks numElements minElementTag maxElementTag)", 4, false)?;
                     let blocks = r.count(f[0], "the number of element blocks")?;
                     for _ in 0..blocks {
-                        let f = r.fields("an element block header (4 integers)", 4, false)?;
+                        let f = r.fields(
+                            "a $Elements entity block header (entityDim entityTag elementType numElementsInBlock)",
+                            4,
+                            false,
+                        )?;
                         let entity = r.int(f[1], "an entity tag")?;
                         let kind = r.int(f[2], "an element type")?;
                         let n = r.count(f[3], "the number of elements in the block")?;
+                        // Name an unsupported type at the block header.
+                        supported_element(&r, kind)?;
                         let physical = if kind == 1 {
                             curve_physical.get(&entity).copied()
                         } else {
                             None
                         };
                         for _ in 0..n {
-                            let f = r.fields("an element", 2, true)?;
+                            let f = r.fields("an element (tag nodes…)", 2, true)?;
                             push(&r, kind, &f[1..], physical)?;
                         }
                     }
@@ -372,16 +431,22 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
     if !seen_elements || triangles.is_empty() {
         return Err(content("no triangles (element type 2) in the file".into()));
     }
+    let undefined = |id: i64, line: usize| GmshError::Syntax {
+        file: source.to_string(),
+        line,
+        message: format!("element refers to undefined node {id}"),
+    };
+    for (ends, _, line) in &lines {
+        if let Some(&id) = ends.iter().find(|id| !nodes.contains_key(id)) {
+            return Err(undefined(id, *line));
+        }
+    }
     // Keep used nodes in file order.
     let mut used: HashMap<i64, usize> = HashMap::new();
     for (tri, line) in &triangles {
         for id in tri {
             if !nodes.contains_key(id) {
-                return Err(GmshError::Syntax {
-                    file: source.to_string(),
-                    line: *line,
-                    message: format!("element refers to undefined node {id}"),
-                });
+                return Err(undefined(*id, *line));
             }
             used.insert(*id, 0);
         }
@@ -418,7 +483,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
         file: source.to_string(),
         source: e,
     })?;
-    for ([a, b], physical) in lines {
+    for ([a, b], physical, _) in lines {
         let (Some(&a), Some(&b)) = (used.get(&a), used.get(&b)) else {
             continue;
         };
@@ -437,13 +502,40 @@ mod tests {
     use super::*;
 
     fn data(name: &str) -> std::path::PathBuf {
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../tests/data")
-            .join(name)
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data")).join(name)
     }
 
     fn area(m: &TriMesh) -> f64 {
         (0..m.num_triangles()).map(|t| m.area(t)).sum()
+    }
+
+    fn tag_of(m: &TriMesh, e: &crate::mesh::Edge) -> String {
+        m.tags()[e.tag.expect("boundary edge tagged")].clone()
+    }
+
+    fn sorted_tags(m: &TriMesh) -> Vec<String> {
+        let mut tags = m.tags().to_vec();
+        tags.sort();
+        tags
+    }
+
+    /// Every boundary edge on a side of the unit square carries that side's name.
+    fn assert_unit_square_sides(m: &TriMesh) {
+        for e in m.edges().iter().filter(|e| e.is_boundary()) {
+            let [a, b] = e.vertices.map(|v| m.vertices()[v]);
+            let side = if a.x == 0.0 && b.x == 0.0 {
+                "left"
+            } else if a.x == 1.0 && b.x == 1.0 {
+                "right"
+            } else if a.y == 0.0 && b.y == 0.0 {
+                "bottom"
+            } else if a.y == 1.0 && b.y == 1.0 {
+                "top"
+            } else {
+                continue;
+            };
+            assert_eq!(tag_of(m, e), side, "edge {a:?}–{b:?}");
+        }
     }
 
     #[test]
@@ -452,37 +544,166 @@ mod tests {
         let b = read_msh(&data("square_v22.msh")).unwrap();
         assert_eq!(a.vertices(), b.vertices());
         assert_eq!(a.triangles(), b.triangles());
+        assert_eq!(a.tags(), b.tags());
+        assert!((50..=400).contains(&a.num_triangles()));
         assert!((area(&a) - 1.0).abs() < 1e-12);
         a.require_tagged_boundary().unwrap();
-        b.require_tagged_boundary().unwrap();
-        let mut tags = a.tags().to_vec();
-        tags.sort();
-        assert_eq!(tags, ["bottom", "left", "right", "top"]);
+        assert_eq!(sorted_tags(&a), ["bottom", "left", "right", "top"]);
+        assert_unit_square_sides(&a);
+        assert_unit_square_sides(&b);
     }
 
     #[test]
-    fn reads_the_square_with_a_hole_and_the_l_shape() {
+    fn reads_the_square_with_a_hole_in_both_formats() {
         let m = read_msh(&data("square_hole.msh")).unwrap();
+        let v22 = read_msh(&data("square_hole_v22.msh")).unwrap();
+        assert_eq!(m.vertices(), v22.vertices());
+        assert_eq!(m.triangles(), v22.triangles());
+        assert!((50..=400).contains(&m.num_triangles()));
         m.require_tagged_boundary().unwrap();
+        assert_eq!(sorted_tags(&m), ["bottom", "hole", "left", "right", "top"]);
+        assert_unit_square_sides(&m);
+        // The hole's edges: on the circle, enclosing the polygon whose area is missing.
         let hole = m.tag_id("hole").unwrap();
-        let hole_edges: Vec<_> = m.edges().iter().filter(|e| e.tag == Some(hole)).collect();
-        assert!(hole_edges.len() >= 12);
-        for e in hole_edges {
-            for v in e.vertices {
-                assert!(((m.vertices()[v] - Vec2::new(0.5, 0.5)).norm() - 0.2).abs() < 1e-9);
+        let mut enclosed = 0.0;
+        let mut count = 0;
+        for e in m.edges().iter().filter(|e| e.tag == Some(hole)) {
+            let [a, b] = e.vertices.map(|v| m.vertices()[v]);
+            for p in [a, b] {
+                assert!(((p - Vec2::new(0.5, 0.5)).norm() - 0.2).abs() < 1e-9);
             }
+            enclosed += 0.5 * (a.x * b.y - a.y * b.x);
+            count += 1;
         }
-        // Area of the square minus the inscribed polygon of the circle.
-        let expected = 1.0 - std::f64::consts::PI * 0.04;
-        assert!((area(&m) - expected).abs() < 0.01);
-        assert_eq!(m.locate(Vec2::new(0.5, 0.5), None), None);
-        let l = read_msh(&data("lshape.msh")).unwrap();
-        l.require_tagged_boundary().unwrap();
-        assert!((area(&l) - 0.75).abs() < 1e-12);
-        assert_eq!(l.locate(Vec2::new(0.75, 0.75), None), None);
+        assert!(count >= 12);
+        // Boundary edges run counter-clockwise around the domain: clockwise round the hole.
+        assert!(enclosed < 0.0);
+        assert!((area(&m) - (1.0 + enclosed)).abs() < 1e-12);
+        assert!((-enclosed - std::f64::consts::PI * 0.04).abs() < 0.01);
     }
 
+    #[test]
+    fn reads_the_l_shape() {
+        let l = read_msh(&data("lshape.msh")).unwrap();
+        l.require_tagged_boundary().unwrap();
+        assert_eq!(l.tags(), ["wall"]);
+        assert!((area(&l) - 0.75).abs() < 1e-12);
+        assert!(l.vertices().contains(&Vec2::new(0.5, 0.5)));
+    }
+
+    #[test]
+    fn rejects_binary_files_and_quadrilaterals_with_their_line() {
+        let binary = data("square_binary.msh");
+        match read_msh(&binary).unwrap_err() {
+            GmshError::Syntax {
+                file,
+                line,
+                message,
+            } => {
+                assert_eq!(file, binary.display().to_string());
+                assert_eq!(line, 2);
+                assert!(
+                    message.contains("binary .msh is not supported"),
+                    "{message}"
+                );
+                assert!(message.contains("Mesh.Binary = 0"), "{message}");
+            }
+            other => panic!("expected a syntax error, got {other}"),
+        }
+        let quads = data("quads.msh");
+        let text = std::fs::read_to_string(&quads).unwrap();
+        let err = read_msh(&quads).unwrap_err();
+        let (line, message) = syntax(err);
+        assert_eq!(line, line_of(&text, "2 1 3 78"));
+        assert!(
+            message.contains("quadrilateral elements (type 3) are not supported"),
+            "{message}"
+        );
+        let missing = read_msh(Path::new("/nonexistent/mesh.msh")).unwrap_err();
+        assert!(matches!(missing, GmshError::Io { .. }));
+        assert!(missing
+            .to_string()
+            .starts_with("/nonexistent/mesh.msh: cannot read"));
+    }
+
+    /// A unit square in format 2.2: lines tagged by physical group 7 (`wall`).
     const GOOD_22: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 7 \"wall\"\n$EndPhysicalNames\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n$EndNodes\n$Elements\n6\n1 1 2 7 1 1 2\n2 1 2 7 1 2 3\n3 1 2 7 1 3 4\n4 1 2 7 1 4 1\n5 2 2 1 1 1 2 3\n6 2 2 1 1 1 3 4\n$EndElements\n";
+
+    /// A unit square in format 4.1: node tags 10…40 and an unused node 25 between
+    /// them; curves 1–3 and the interior diagonal 5 in physical group 7 (`wall`),
+    /// curve 4 in the unnamed group 8; a point element; a comment section.
+    const GOOD_41: &str = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+1
+1 7 \"wall\"
+$EndPhysicalNames
+$Comments
+anything at all
+$EndComments
+$Entities
+4 5 1 0
+1 0 0 0 0
+2 1 0 0 0
+3 1 1 0 0
+4 0 1 0 0
+1 0 0 0 1 0 0 1 7 2 1 -2
+2 1 0 0 1 1 0 1 7 2 2 -3
+3 0 1 0 1 1 0 1 7 2 3 -4
+4 0 0 0 0 1 0 1 8 2 4 -1
+5 0 0 0 1 1 0 1 7 2 1 -3
+1 0 0 0 1 1 0 0 4 1 2 3 4
+$EndEntities
+$Nodes
+2 5 10 40
+0 1 0 1
+10
+0 0 0
+2 1 0 4
+20
+25
+30
+40
+1 0 0
+0.5 0.25 0
+1 1 0
+0 1 0
+$EndNodes
+$Elements
+7 9 1 9
+0 1 15 1
+9 10
+1 1 1 1
+1 10 20
+1 2 1 1
+2 20 30
+1 3 1 1
+3 30 40
+1 4 1 1
+4 40 10
+1 5 1 1
+7 10 30
+2 1 2 2
+5 10 20 30
+6 10 30 40
+$EndElements
+";
+
+    /// The 1-based number of the first line equal to `needle`.
+    fn line_of(text: &str, needle: &str) -> usize {
+        1 + text
+            .lines()
+            .position(|l| l.trim() == needle)
+            .unwrap_or_else(|| panic!("`{needle}` not in the text"))
+    }
+
+    fn syntax(err: GmshError) -> (usize, String) {
+        match err {
+            GmshError::Syntax { line, message, .. } => (line, message),
+            other => panic!("expected a syntax error, got {other}"),
+        }
+    }
 
     fn syntax_line(text: &str) -> (usize, String) {
         match parse_msh(text, "bad.msh").unwrap_err() {
@@ -499,65 +720,201 @@ mod tests {
     }
 
     #[test]
-    fn a_small_handwritten_file_parses() {
-        let m = parse_msh(GOOD_22, "good.msh").unwrap();
-        assert_eq!(m.num_triangles(), 2);
-        m.require_tagged_boundary().unwrap();
-        // Clockwise input is flipped.
-        let cw = GOOD_22
-            .replace("5 2 2 1 1 1 2 3", "5 2 2 1 1 1 3 2")
-            .replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 4 3");
-        assert_eq!(parse_msh(&cw, "cw.msh").unwrap().num_triangles(), 2);
+    fn handwritten_files_parse_in_both_formats() {
+        let a = parse_msh(GOOD_22, "good.msh").unwrap();
+        assert_eq!(a.num_triangles(), 2);
+        assert_eq!(a.tags(), ["wall"]);
+        a.require_tagged_boundary().unwrap();
+
+        let b = parse_msh(GOOD_41, "good.msh").unwrap();
+        // Node 25 is dropped; the rest keep file order.
+        assert_eq!(b.vertices(), a.vertices());
+        assert_eq!(b.triangles(), a.triangles());
+        b.require_tagged_boundary().unwrap();
+        // Unnamed group 8 tags the left side by its number; the interior diagonal tags nothing.
+        assert_eq!(sorted_tags(&b), ["8", "wall"]);
+        let left = b.tag_id("8").unwrap();
+        let tagged: Vec<_> = b.edges().iter().filter(|e| e.tag == Some(left)).collect();
+        assert_eq!(tagged.len(), 1);
+        assert_eq!(tagged[0].vertices.map(|v| b.vertices()[v].x), [0.0, 0.0]);
+        assert!(b.edges().iter().all(|e| e.is_boundary() || e.tag.is_none()));
     }
 
     #[test]
-    fn malformed_files_give_located_errors() {
+    fn clockwise_meshes_are_flipped_and_mixed_ones_rejected() {
+        let cw = GOOD_22
+            .replace("5 2 2 1 1 1 2 3", "5 2 2 1 1 1 3 2")
+            .replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 4 3");
+        let m = parse_msh(&cw, "cw.msh").unwrap();
+        assert_eq!(m.num_triangles(), 2);
+        assert!((area(&m) - 1.0).abs() < 1e-15);
+        m.require_tagged_boundary().unwrap();
+        let mixed = GOOD_22.replace("5 2 2 1 1 1 2 3", "5 2 2 1 1 1 3 2");
+        assert!(matches!(
+            parse_msh(&mixed, "mixed.msh"),
+            Err(GmshError::Mesh {
+                source: MeshError::InvertedTriangle { triangle: 0 },
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn nodes_must_be_planar() {
+        // Constant z is fine.
+        let lifted = GOOD_41
+            .replace("0 0 0\n2 1", "0 0 0.5\n2 1")
+            .replace("1 0 0\n0.5", "1 0 0.5\n0.5")
+            .replace("1 1 0\n0 1 0\n", "1 1 0.5\n0 1 0.5\n");
+        assert_eq!(parse_msh(&lifted, "z.msh").unwrap().num_triangles(), 2);
+        let z = GOOD_22.replace("3 1 1 0\n", "3 1 1 0.5\n");
+        match parse_msh(&z, "z.msh").unwrap_err() {
+            GmshError::Content { file, message } => {
+                assert_eq!(file, "z.msh");
+                assert!(message.contains("z = 0.5"), "{message}");
+            }
+            other => panic!("expected a content error, got {other}"),
+        }
+    }
+
+    #[test]
+    fn malformed_2_2_files_give_located_errors() {
         assert!(syntax_line("hello\n").1.contains("$MeshFormat"));
+        assert!(syntax_line("").1.contains("end of file"));
         assert!(syntax_line("$MeshFormat\n4.1 1 8\n$EndMeshFormat\n")
             .1
             .contains("binary"));
         assert!(syntax_line("$MeshFormat\n3.0 0 8\n$EndMeshFormat\n")
             .1
-            .contains("version"));
+            .contains("version 3.0"));
         let (line, msg) = syntax_line(&GOOD_22.replace("2 1 0 0\n", "2 1 x 0\n"));
-        assert_eq!(line, 11);
+        assert_eq!(line, line_of(GOOD_22, "2 1 0 0"));
         assert!(msg.contains("`x`"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_22.replace("2 1 0 0\n", "2 1 1e999 0\n"));
+        assert_eq!(line, line_of(GOOD_22, "2 1 0 0"));
+        assert!(msg.contains("finite"), "{msg}");
         let (line, msg) = syntax_line(&GOOD_22.replace("$EndNodes", "$EndNods"));
-        assert_eq!(line, 14);
+        assert_eq!(line, line_of(GOOD_22, "$EndNodes"));
         assert!(msg.contains("$EndNodes"));
+        let (line, msg) = syntax_line(&GOOD_22.replace("\n4\n1 0 0 0", "\n-4\n1 0 0 0"));
+        assert_eq!(line, line_of(GOOD_22, "$Nodes") + 1);
+        assert!(msg.contains("non-negative"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_22.replace("4 0 1 0\n", "3 0 1 0\n"));
+        assert_eq!(line, line_of(GOOD_22, "4 0 1 0"));
+        assert!(msg.contains("node 3 is defined twice"), "{msg}");
         // Truncated in the middle of element 5.
-        let (line, msg) = syntax_line(&GOOD_22[..GOOD_22.len() - 40]);
-        assert_eq!(line, 21);
+        let cut = &GOOD_22[..GOOD_22.find("5 2 2 1 1 1 2 3").unwrap() + 6];
+        let (line, msg) = syntax_line(cut);
+        assert_eq!(line, line_of(GOOD_22, "5 2 2 1 1 1 2 3"));
         assert!(msg.contains("fewer tags"), "{msg}");
-        let (_, msg) = syntax_line(&GOOD_22[..GOOD_22.len() - 13]);
-        assert!(msg.contains("end of file"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_22.replace("$EndElements\n", ""));
+        assert_eq!(line, GOOD_22.lines().count());
+        assert!(msg.contains("end of file, expected $EndElements"), "{msg}");
         let (_, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 3 2 1 1 1 3 4 2"));
         assert!(msg.contains("quadrilateral"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 9 2 1 1 1 3 4 2 1 1 1"));
+        assert!(msg.contains("second-order triangle"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 99 2 1 1 1 3 4"));
+        assert!(msg.contains("unknown element type 99"), "{msg}");
         let (line, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 3 9"));
-        assert_eq!(line, 22);
+        assert_eq!(line, line_of(GOOD_22, "6 2 2 1 1 1 3 4"));
         assert!(msg.contains("undefined node 9"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_22.replace("4 1 2 7 1 4 1", "4 1 2 7 1 4 8"));
+        assert_eq!(line, line_of(GOOD_22, "4 1 2 7 1 4 1"));
+        assert!(msg.contains("undefined node 8"), "{msg}");
         let (_, msg) = syntax_line(&GOOD_22.replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 3"));
         assert!(msg.contains("needs 3 nodes"), "{msg}");
-        let no_tri = GOOD_22
-            .replace("5 2 2 1 1 1 2 3\n6 2 2 1 1 1 3 4\n", "")
-            .replace("\n6\n1 1", "\n4\n1 1");
-        assert!(matches!(
-            parse_msh(&no_tri, "x.msh"),
-            Err(GmshError::Content { .. })
-        ));
-        let z = GOOD_22.replace("3 1 1 0\n", "3 1 1 0.5\n");
-        assert!(matches!(
-            parse_msh(&z, "x.msh"),
-            Err(GmshError::Content { .. })
-        ));
-        let degenerate = GOOD_22.replace("3 1 1 0\n", "3 2 0 0\n");
+        let (_, msg) = syntax_line(&GOOD_22.replace("1 7 \"wall\"", "1 7"));
+        assert!(msg.contains("quoted physical name"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_22.replace("$EndElements", "$EndElements\nstray"));
+        assert!(msg.contains("section header"), "{msg}");
+    }
+
+    #[test]
+    fn malformed_4_1_files_give_located_errors() {
+        let (line, msg) = syntax_line(&GOOD_41.replace("1 2 1 1\n", "1 2 1\n"));
+        assert_eq!(line, line_of(GOOD_41, "1 2 1 1"));
+        assert!(
+            msg.starts_with("expected 4 values in a $Elements entity block header"),
+            "{msg}"
+        );
+        assert!(msg.contains("found 3: `1 2 1`"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_41.replace("0.5 0.25 0", "0.5 0,25 0"));
+        assert_eq!(line, line_of(GOOD_41, "0.5 0.25 0"));
+        assert!(msg.contains("`0,25`"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_41.replace("6 10 30 40", "6 10 30 41"));
+        assert_eq!(line, line_of(GOOD_41, "6 10 30 40"));
+        assert!(msg.contains("undefined node 41"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_41.replace("2 1 0 4", "2 1 1 4"));
+        assert_eq!(line, line_of(GOOD_41, "2 1 0 4"));
+        assert!(msg.contains("parametric"), "{msg}");
+        let (line, msg) =
+            syntax_line(&GOOD_41.replace("1 0 0 0 1 0 0 1 7 2 1 -2", "1 0 0 0 1 0 0 5 7"));
+        assert_eq!(line, line_of(GOOD_41, "1 0 0 0 1 0 0 1 7 2 1 -2"));
+        assert!(msg.contains("fewer physical tags"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_41.replace("2 1 2 2\n", "2 1 3 2\n"));
+        assert_eq!(line, line_of(GOOD_41, "2 1 2 2"));
+        assert!(
+            msg.contains("quadrilateral elements (type 3) are not supported"),
+            "{msg}"
+        );
+        let (line, msg) = syntax_line(&GOOD_41.replace("6 10 30 40", "6 10 30"));
+        assert_eq!(line, line_of(GOOD_41, "6 10 30 40"));
+        assert!(msg.contains("a triangle needs 3 nodes, found 2"), "{msg}");
+        // Truncated inside $Nodes.
+        let cut = &GOOD_41[..GOOD_41.find("30\n40\n").unwrap()];
+        let (line, msg) = syntax_line(cut);
+        assert_eq!(line, cut.lines().count() + 1);
+        assert!(msg.contains("end of file, expected a node tag"), "{msg}");
+        // Huge counts run into the end of the file, not out of memory.
+        let (_, msg) = syntax_line(
+            &GOOD_41.replace("4 5 1 0\n", "4 5 9223372036854775807 9223372036854775807\n"),
+        );
+        assert!(msg.contains("end of file"), "{msg}");
+        let (_, msg) = syntax_line(&GOOD_41.replace("2 1 0 4", "2 1 0 9223372036854775807"));
+        assert!(
+            msg.contains("expected 1 value in a node tag, found 3"),
+            "{msg}"
+        );
+        // Sections missing.
+        let start = GOOD_41.find("$Nodes").unwrap();
+        let end = GOOD_41.find("$Elements").unwrap();
+        let no_nodes = format!("{}{}", &GOOD_41[..start], &GOOD_41[end..]);
+        match parse_msh(&no_nodes, "x.msh").unwrap_err() {
+            GmshError::Content { message, .. } => {
+                assert!(message.contains("no $Nodes"), "{message}")
+            }
+            other => panic!("expected a content error, got {other}"),
+        }
+        let no_elements = &GOOD_41[..end];
+        match parse_msh(no_elements, "x.msh").unwrap_err() {
+            GmshError::Content { message, .. } => {
+                assert!(message.contains("no triangles"), "{message}")
+            }
+            other => panic!("expected a content error, got {other}"),
+        }
+        let degenerate = GOOD_41.replace("1 1 0\n0 1 0\n", "2 0 0\n0 1 0\n");
         assert!(matches!(
             parse_msh(&degenerate, "x.msh"),
-            Err(GmshError::Mesh { .. })
+            Err(GmshError::Mesh {
+                source: MeshError::DegenerateTriangle { .. },
+                ..
+            })
         ));
-        let missing = read_msh(Path::new("/nonexistent/mesh.msh")).unwrap_err();
-        assert!(missing
-            .to_string()
-            .starts_with("/nonexistent/mesh.msh: cannot read"));
+    }
+
+    #[test]
+    fn no_truncation_or_deleted_line_panics() {
+        for text in [GOOD_22, GOOD_41] {
+            for end in 0..text.len() {
+                let _ = parse_msh(&text[..end], "cut.msh");
+            }
+            let lines: Vec<&str> = text.lines().collect();
+            for skip in 0..lines.len() {
+                let mut without = lines.clone();
+                without.remove(skip);
+                let _ = parse_msh(&without.join("\n"), "skip.msh");
+            }
+        }
     }
 }
