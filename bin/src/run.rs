@@ -19,7 +19,7 @@ pub struct RunArgs {
     #[arg(long)]
     basis: Option<String>,
     /// Mass strategy: consistent, lumped, partial (lump rows touching empty elements),
-    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate[:THRESHOLD].
+    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate or deactivate:THRESHOLD.
     #[arg(long)]
     mass: Option<String>,
     /// Block grid NXxNY (1D: number of elements, e.g. 8x1).
