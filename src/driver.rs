@@ -18,7 +18,7 @@
 //!
 //! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
 
-use crate::effect::{Effect, ParticleBasis};
+use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{MassKind, MassReport, MassStrategy, StepContext};
 use crate::material::{det, Material};
 use crate::particles::Particles;
@@ -96,6 +96,9 @@ pub struct StepReport {
     pub strain: f64,
     /// Potential energy of the effects (gravity).
     pub potential: f64,
+    /// Work done on the body by the non-conservative effects (body forces,
+    /// traction, damping) since the start, `Σ_n Δt F^n · v̂^n`.
+    pub work: f64,
     /// Total mass.
     pub mass: f64,
     /// Total momentum (x, and y in 2D).
@@ -124,9 +127,10 @@ pub struct PhaseTimes {
 }
 
 impl StepReport {
-    /// Kinetic + strain + potential energy.
+    /// Kinetic + strain + potential energy minus the work of the non-conservative
+    /// effects: constant up to the time-integration error.
     pub fn total_energy(&self) -> f64 {
-        self.kinetic + self.strain + self.potential
+        self.kinetic + self.strain + self.potential - self.work
     }
 }
 
@@ -159,6 +163,11 @@ where
     values: Vec<T>,
     rhs: Vec<Vec<T>>,
     velocity: Vec<Vec<T>>,
+    /// Forces of the non-conservative effects (for their work); empty without any.
+    work_force: Vec<Vec<T>>,
+    /// Scratch for [`Effect::adjust_forces`]; empty without effects.
+    adjust: Vec<Vec<T>>,
+    work: f64,
     occupied: Vec<bool>,
     touches_empty: Vec<bool>,
     last_report: MassReport,
@@ -218,8 +227,17 @@ where
                     })
                 }
             }
-            particles.sigma[p] = material.stress(&particles.f[p]);
+            particles.sigma[p] = particles.sigma0[p] + material.stress(&particles.f[p]);
         }
+        let scratch = |needed: bool| {
+            if needed {
+                vec![vec![T::zero(); n]; D]
+            } else {
+                Vec::new()
+            }
+        };
+        let work_force = scratch(effects.iter().any(|e| e.does_work()));
+        let adjust = scratch(!effects.is_empty());
         let pattern = SymmetricPattern::new(&basis);
         let mass = M::prepare(&pattern, &fixed, mass_kind);
         let stride = basis.max_functions_per_element();
@@ -229,6 +247,9 @@ where
             values: vec![T::zero(); pattern.nnz()],
             rhs: vec![vec![T::zero(); n]; D],
             velocity: vec![vec![T::zero(); n]; D],
+            work_force,
+            adjust,
+            work: 0.0,
             len: vec![0; np],
             occupied: vec![false; basis.num_elements()],
             touches_empty: vec![false; n],
@@ -323,15 +344,42 @@ where
                 }
             }
         }
-        let view = ParticleBasis {
-            stride: self.stride,
-            len: &self.len,
-            index: &self.index,
-            phi: &self.phi,
-        };
-        for effect in &self.effects {
-            effect.add_forces(&self.particles, &view, &mut self.rhs);
+        if self.effects.is_empty() {
+            return;
         }
+        let state = StepState {
+            time: self.time,
+            dt: self.dt.to_f64(),
+            basis: ParticleBasis {
+                stride: self.stride,
+                len: &self.len,
+                index: &self.index,
+                phi: &self.phi,
+            },
+        };
+        let tracks_work = !self.work_force.is_empty();
+        if tracks_work {
+            zero(&mut self.work_force);
+        }
+        for effect in &self.effects {
+            if effect.does_work() {
+                effect.add_forces(&self.particles, &state, &mut self.work_force);
+            } else {
+                effect.add_forces(&self.particles, &state, &mut self.rhs);
+            }
+        }
+        if tracks_work {
+            add_into(&mut self.rhs, &self.work_force);
+        }
+        // Corrections from the total force (damping, eq. (49)), all from the same total.
+        zero(&mut self.adjust);
+        for effect in &self.effects {
+            if effect.does_work() {
+                effect.adjust_forces(&self.rhs, &self.velocity, &mut self.work_force);
+            }
+            effect.adjust_forces(&self.rhs, &self.velocity, &mut self.adjust);
+        }
+        add_into(&mut self.rhs, &self.adjust);
     }
 
     /// Marks the functions whose support contains an element without particles.
@@ -347,6 +395,25 @@ where
                     self.touches_empty[i] = true;
                 }
             }
+        }
+    }
+
+    /// Projects the particle velocities onto the basis, `M v̂ = Σ_p m_p phi_i v_p`
+    /// (eqs. (20)–(21)), with the factorised mass of the step.
+    fn project_velocities(&mut self) {
+        zero(&mut self.velocity);
+        let parts = &self.particles;
+        for p in 0..parts.len() {
+            let base = p * self.stride;
+            for s in base..base + self.len[p] {
+                let w = parts.mass[p] * self.phi[s];
+                for k in 0..D {
+                    self.velocity[k][self.index[s]] += w * parts.v[p][k];
+                }
+            }
+        }
+        for k in 0..D {
+            self.mass.solve(k, &mut self.velocity[k]);
         }
     }
 
@@ -374,6 +441,16 @@ where
         self.last_condition = self
             .estimate_condition
             .then(|| self.mass.condition_estimate(&self.pattern));
+        // Power of the non-conservative forces with the velocity at the start of the
+        // step, v̂ⁿ (at the first step projected from the initial particle velocities).
+        let power_start = if self.work_force.is_empty() {
+            0.0
+        } else {
+            if self.step == 0 {
+                self.project_velocities();
+            }
+            power(&self.work_force, &self.velocity)
+        };
         for k in 0..D {
             self.mass.solve(k, &mut self.rhs[k]);
         }
@@ -406,6 +483,13 @@ where
             self.mass.solve(k, &mut self.velocity[k]);
         }
         let after_projection = clock.elapsed().as_secs_f64();
+        // Work of the non-conservative effects over the step with the mean of the
+        // start and end velocities, the rule under which the kinetic energy of the
+        // symplectic Euler update changes: `W += Δt F · (v̂ⁿ + v̂ⁿ⁺¹) / 2`.
+        if !self.work_force.is_empty() {
+            self.work +=
+                0.5 * (power_start + power(&self.work_force, &self.velocity)) * dt.to_f64();
+        }
         t_solve += after_projection - before_projection;
         // eqs. (22)–(31).
         for p in 0..parts.len() {
@@ -432,7 +516,7 @@ where
                 });
             }
             parts.f[p] = f;
-            parts.sigma[p] = self.material.stress(&f);
+            parts.sigma[p] = parts.sigma0[p] + self.material.stress(&f);
             parts.volume[p] = parts.volume0[p] * j;
             parts.x[p] += v_hat * dt;
             parts.u[p] += v_hat * dt;
@@ -470,6 +554,12 @@ where
             max_speed = max_speed.max(speed2.sqrt());
             strain +=
                 parts.volume0[p].to_f64() * self.material.energy_density(&parts.f[p]).to_f64();
+            if parts.sigma0[p] != SMatrix::<T, D, D>::zeros() {
+                // First-order work of the initial stress: V⁰ σ⁰ : (sym F − I).
+                let f = &parts.f[p];
+                let e = (f + f.transpose()) * T::of(0.5) - SMatrix::<T, D, D>::identity();
+                strain += parts.volume0[p].to_f64() * parts.sigma0[p].dot(&e).to_f64();
+            }
             mass += m;
             for k in 0..D {
                 momentum[k] += m * parts.v[p][k].to_f64();
@@ -485,12 +575,38 @@ where
                 .iter()
                 .map(|e| e.potential_energy(parts))
                 .fold(0.0, |a, b| a + b),
+            work: self.work,
             mass,
             momentum,
             max_speed,
             mass_report: self.last_report,
             condition: self.last_condition,
             phases: self.phases,
+        }
+    }
+}
+
+/// `Σ_k Σ_i F_{k,i} v̂_{k,i}`.
+fn power<T: Scalar>(force: &[Vec<T>], velocity: &[Vec<T>]) -> f64 {
+    let mut power = 0.0;
+    for (f, v) in force.iter().zip(velocity) {
+        for (a, b) in f.iter().zip(v) {
+            power += (*a * *b).to_f64();
+        }
+    }
+    power
+}
+
+fn zero<T: Scalar>(buffers: &mut [Vec<T>]) {
+    for b in buffers {
+        b.iter_mut().for_each(|v| *v = T::zero());
+    }
+}
+
+fn add_into<T: Scalar>(target: &mut [Vec<T>], source: &[Vec<T>]) {
+    for (t, s) in target.iter_mut().zip(source) {
+        for (a, b) in t.iter_mut().zip(s) {
+            *a += *b;
         }
     }
 }

@@ -1,9 +1,25 @@
-//! Effects: the physics a scene asks for beyond elasticity. Only the effects a scene
-//! lists are assembled; a scene without gravity never evaluates it.
+//! Effects: the physics a scene asks for beyond elasticity, as composable pieces.
+//!
+//! Only the effects a scene lists are assembled; a scene without gravity never
+//! evaluates it (the test `scenes::only_declared_effects_are_evaluated` shows it).
+//!
+//! An effect contributes to the right-hand side `F` of `M a = F` (paper eq. (17))
+//! in one or both of two places of the step:
+//! - [`Effect::add_forces`]: external forces `F^ext` from particle quantities
+//!   (gravity and prescribed body forces, paper eq. (16); traction, eq. (14));
+//! - [`Effect::adjust_forces`]: a correction from the assembled total force
+//!   `F = F^trac − F^int + F^body` and the velocity coefficients (local damping,
+//!   paper eq. (49)).
+//!
+//! Energy bookkeeping: a conservative effect reports its potential energy
+//! ([`Effect::potential_energy`]); a non-conservative one says so with
+//! [`Effect::does_work`], and the driver accumulates its work
+//! `W += Δt Σ_i F_i · v̂_i` with the projected velocity coefficients of the step, so
+//! that `kinetic + strain + potential − W` is the conserved total.
 
 use crate::particles::Particles;
 use crate::sparse::Scalar;
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 /// Basis values of every particle at the start of a step, as the driver evaluated
 /// them: particle `p` has `len[p]` entries at `p * stride ..`.
@@ -18,19 +34,54 @@ pub struct ParticleBasis<'a, T: Scalar, const D: usize> {
     pub phi: &'a [T],
 }
 
+impl<T: Scalar, const D: usize> ParticleBasis<'_, T, D> {
+    /// Adds `phi_i(x_p) f` to `forces[k][i]` for the functions of particle `p`.
+    #[inline]
+    pub fn scatter(&self, p: usize, f: &SVector<T, D>, forces: &mut [Vec<T>]) {
+        let base = p * self.stride;
+        for a in 0..self.len[p] {
+            let (i, phi) = (self.index[base + a], self.phi[base + a]);
+            for k in 0..D {
+                forces[k][i] += f[k] * phi;
+            }
+        }
+    }
+}
+
+/// Where the step is when an effect is asked for its forces.
+pub struct StepState<'a, T: Scalar, const D: usize> {
+    /// Time at the start of the step, `t_n`.
+    pub time: f64,
+    /// Time step `Δt`.
+    pub dt: f64,
+    /// Basis values at the particles.
+    pub basis: ParticleBasis<'a, T, D>,
+}
+
 /// A force contribution (and its potential energy, if it has one).
 pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     /// Name for output.
     fn name(&self) -> &'static str;
-    /// Adds the effect's force coefficients `F_{k,i}` to `forces[k][i]`.
+    /// Adds the effect's external force coefficients `F_{k,i}` to `forces[k][i]`.
     fn add_forces(
         &self,
-        particles: &Particles<T, D>,
-        basis: &ParticleBasis<T, D>,
-        forces: &mut [Vec<T>],
-    );
+        _particles: &Particles<T, D>,
+        _state: &StepState<T, D>,
+        _forces: &mut [Vec<T>],
+    ) {
+    }
+    /// Adds a correction computed from the total force `total` (everything assembled
+    /// so far) and the velocity coefficients `velocity` of the previous step to
+    /// `forces`. Called after every effect's [`add_forces`](Self::add_forces).
+    fn adjust_forces(&self, _total: &[Vec<T>], _velocity: &[Vec<T>], _forces: &mut [Vec<T>]) {}
     /// Potential energy of the particles in the effect's field (zero if none).
-    fn potential_energy(&self, particles: &Particles<T, D>) -> f64;
+    fn potential_energy(&self, _particles: &Particles<T, D>) -> f64 {
+        0.0
+    }
+    /// `true` for a non-conservative effect whose work the driver accumulates.
+    fn does_work(&self) -> bool {
+        false
+    }
 }
 
 /// Uniform gravity `g`: `F^body_{k,i} = Σ_p m_p phi_i(x_p) g_k` (paper eq. (16)),
@@ -48,18 +99,13 @@ impl<T: Scalar, const D: usize> Effect<T, D> for Gravity<T, D> {
     fn add_forces(
         &self,
         particles: &Particles<T, D>,
-        basis: &ParticleBasis<T, D>,
+        state: &StepState<T, D>,
         forces: &mut [Vec<T>],
     ) {
         for p in 0..particles.len() {
-            let base = p * basis.stride;
-            for a in 0..basis.len[p] {
-                let (i, phi) = (basis.index[base + a], basis.phi[base + a]);
-                let w = particles.mass[p] * phi;
-                for k in 0..D {
-                    forces[k][i] += w * self.g[k];
-                }
-            }
+            state
+                .basis
+                .scatter(p, &(self.g * particles.mass[p]), forces);
         }
     }
     fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
@@ -69,5 +115,159 @@ impl<T: Scalar, const D: usize> Effect<T, D> for Gravity<T, D> {
             .zip(&particles.mass)
             .map(|(x, m)| -(m.to_f64()) * self.g.dot(x).to_f64())
             .sum()
+    }
+}
+
+/// A body-force field `b(x⁰, t)` per unit mass.
+pub type ForceField<T, const D: usize> =
+    Box<dyn Fn(&SVector<T, D>, f64) -> SVector<T, D> + Send + Sync>;
+
+/// A prescribed body force per unit mass `b(x⁰, t)`, evaluated at each particle's
+/// reference position and the start-of-step time: `F_{k,i} = Σ_p m_p phi_i(x_p) b_k`
+/// (paper eq. (16)); used for manufactured solutions (paper eqs. (42)–(46)).
+pub struct BodyForce<T: Scalar, const D: usize> {
+    /// Name for output.
+    pub label: &'static str,
+    /// The field `b(x⁰, t)`.
+    pub field: ForceField<T, D>,
+}
+
+impl<T: Scalar, const D: usize> Effect<T, D> for BodyForce<T, D> {
+    fn name(&self) -> &'static str {
+        self.label
+    }
+    fn add_forces(
+        &self,
+        particles: &Particles<T, D>,
+        state: &StepState<T, D>,
+        forces: &mut [Vec<T>],
+    ) {
+        for p in 0..particles.len() {
+            let b = (self.field)(&particles.x0[p], state.time);
+            state.basis.scatter(p, &(b * particles.mass[p]), forces);
+        }
+    }
+    fn does_work(&self) -> bool {
+        true
+    }
+}
+
+/// A traction on boundary particles (paper eq. (14) with the boundary integral
+/// carried by particles): each selected particle carries the force
+/// `t · length / n` (the traction `t` per unit length over the loaded boundary
+/// length, shared equally by the `n` selected particles), scaled by a linear ramp
+/// from 0 at `t = 0` to 1 at `t = ramp` (sudden load for `ramp = 0`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Traction<T: Scalar, const D: usize> {
+    /// Selected particles.
+    pub particles: Vec<usize>,
+    /// Force per particle at full load.
+    pub force: SVector<T, D>,
+    /// Ramp time.
+    pub ramp: f64,
+}
+
+impl<T: Scalar, const D: usize> Effect<T, D> for Traction<T, D> {
+    fn name(&self) -> &'static str {
+        "traction"
+    }
+    fn add_forces(
+        &self,
+        _particles: &Particles<T, D>,
+        state: &StepState<T, D>,
+        forces: &mut [Vec<T>],
+    ) {
+        let scale = if self.ramp > 0.0 {
+            (state.time / self.ramp).min(1.0)
+        } else {
+            1.0
+        };
+        let f = self.force * T::of(scale);
+        for &p in &self.particles {
+            state.basis.scatter(p, &f, forces);
+        }
+    }
+    fn does_work(&self) -> bool {
+        true
+    }
+}
+
+/// Local non-viscous damping, paper eq. (49), per coefficient:
+/// `F^damp_{k,i} = −α |F_{k,i}| sign(v̂_{k,i})` with `F = F^trac − F^int + F^body`.
+///
+/// The paper prints `−α sign(v̂) F`. Read literally, that multiplies `F` by `1 − α`
+/// whether it points along the motion or against it: it rescales `F` (a change of
+/// mass) and dissipates nothing. The dissipative form, which we implement, always
+/// opposes the velocity: `−α |F| sign(v̂)` (Cundall's local damping). `v̂` is the
+/// projected velocity of the previous step (zero at the first step: no damping).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalDamping {
+    /// Damping factor `α ∈ [0, 1)`.
+    pub alpha: f64,
+}
+
+impl<T: Scalar, const D: usize> Effect<T, D> for LocalDamping {
+    fn name(&self) -> &'static str {
+        "damping"
+    }
+    fn adjust_forces(&self, total: &[Vec<T>], velocity: &[Vec<T>], forces: &mut [Vec<T>]) {
+        let alpha = T::of(self.alpha);
+        for k in 0..D {
+            for ((f, &t), &v) in forces[k].iter_mut().zip(&total[k]).zip(&velocity[k]) {
+                if v > T::zero() {
+                    *f -= alpha * t.abs();
+                } else if v < T::zero() {
+                    *f += alpha * t.abs();
+                }
+            }
+        }
+    }
+    fn does_work(&self) -> bool {
+        true
+    }
+}
+
+/// An initial stress state `σ⁰(x⁰)`, added to the material stress of each particle:
+/// `σ_p = σ⁰_p + σ(F_p)` (e.g. a geostatic state). Set up once by the driver; the
+/// strain energy includes its first-order work `V⁰ σ⁰ : (sym F − I)`.
+pub trait InitialStress<T: Scalar, const D: usize> {
+    /// `σ⁰` at reference position `x0`.
+    fn sigma0(&self, x0: &SVector<T, D>) -> SMatrix<T, D, D>;
+}
+
+/// Geostatic initial stress: `σ⁰_vv = ρ g (surface − x_v)` along the last axis
+/// (`g` negative downwards, so compression is negative) and `σ⁰_hh = k0 σ⁰_vv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Geostatic {
+    /// Height of the free surface.
+    pub surface: f64,
+    /// Density.
+    pub density: f64,
+    /// Gravity along the last axis (negative downwards).
+    pub gravity: f64,
+    /// Lateral earth-pressure coefficient.
+    pub k0: f64,
+}
+
+impl<T: Scalar, const D: usize> InitialStress<T, D> for Geostatic {
+    fn sigma0(&self, x0: &SVector<T, D>) -> SMatrix<T, D, D> {
+        let depth = self.surface - x0[D - 1].to_f64();
+        let vertical = -self.density * self.gravity.abs() * depth.max(0.0);
+        let mut s = SMatrix::<T, D, D>::zeros();
+        for k in 0..D - 1 {
+            s[(k, k)] = T::of(self.k0 * vertical);
+        }
+        s[(D - 1, D - 1)] = T::of(vertical);
+        s
+    }
+}
+
+/// A uniform initial stress.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UniformStress<const D: usize>(pub SMatrix<f64, D, D>);
+
+impl<T: Scalar, const D: usize> InitialStress<T, D> for UniformStress<D> {
+    fn sigma0(&self, _x0: &SVector<T, D>) -> SMatrix<T, D, D> {
+        SMatrix::<T, D, D>::from_fn(|i, j| T::of(self.0[(i, j)]))
     }
 }

@@ -44,5 +44,6 @@ pub mod particles;
 pub mod plot;
 pub mod projection;
 pub mod scene;
+pub mod simulation;
 pub mod sparse;
 pub mod ulfem;

@@ -80,6 +80,15 @@ impl MassKind {
         }
     }
 
+    /// The form [`MassKind::parse`] reads back (`partial:0.1`, `deactivate:0.01`).
+    pub fn spec(self) -> String {
+        match self {
+            MassKind::Partial(LumpRule::Threshold(tau)) => format!("partial:{tau}"),
+            MassKind::Deactivate { threshold } => format!("deactivate:{threshold}"),
+            other => other.name().to_string(),
+        }
+    }
+
     /// Name for output.
     pub fn name(self) -> &'static str {
         match self {

@@ -183,6 +183,38 @@ impl<T: Scalar, const D: usize> Material<T, D> for NeoHookean {
     }
 }
 
+/// The model a scene chose, dispatched at run time (one `match` per particle
+/// evaluation, negligible next to the basis work).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyMaterial {
+    /// Linear elastic.
+    Linear(LinearElastic),
+    /// Neo-Hookean.
+    NeoHookean(NeoHookean),
+}
+
+impl<T: Scalar, const D: usize> Material<T, D> for AnyMaterial {
+    #[inline]
+    fn stress(&self, f: &SMatrix<T, D, D>) -> SMatrix<T, D, D> {
+        match self {
+            AnyMaterial::Linear(m) => m.stress(f),
+            AnyMaterial::NeoHookean(m) => m.stress(f),
+        }
+    }
+    fn energy_density(&self, f: &SMatrix<T, D, D>) -> T {
+        match self {
+            AnyMaterial::Linear(m) => Material::<T, D>::energy_density(m, f),
+            AnyMaterial::NeoHookean(m) => Material::<T, D>::energy_density(m, f),
+        }
+    }
+    fn elastic(&self) -> &Elastic {
+        match self {
+            AnyMaterial::Linear(m) => &m.constants,
+            AnyMaterial::NeoHookean(m) => &m.constants,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -19,6 +19,9 @@ pub struct Particles<T: Scalar, const D: usize> {
     pub f: Vec<SMatrix<T, D, D>>,
     /// Cauchy stresses `σ_p`.
     pub sigma: Vec<SMatrix<T, D, D>>,
+    /// Initial stresses `σ⁰_p`, added to the material's stress (zero unless a scene
+    /// declares an initial-stress state).
+    pub sigma0: Vec<SMatrix<T, D, D>>,
     /// Initial volumes `V_p⁰`.
     pub volume0: Vec<T>,
     /// Current volumes `V_p = J_p V_p⁰` (eq. (28)).
@@ -40,6 +43,7 @@ impl<T: Scalar, const D: usize> Particles<T, D> {
             u: vec![SVector::zeros(); n],
             f: vec![SMatrix::identity(); n],
             sigma: vec![SMatrix::zeros(); n],
+            sigma0: vec![SMatrix::zeros(); n],
             mass: volumes.iter().map(|&v| v * rho).collect(),
             volume0: volumes.clone(),
             volume: volumes,

@@ -1,25 +1,25 @@
 //! Benchmark B5a (column under self-weight, thesis §4.3) in 2D and 1D, and B2 in 1D.
 
 use psmpm::bases::BasisKind;
-use psmpm::scene::{run, run_2d, MassKind, Scene};
+use psmpm::mass::MassKind;
+use psmpm::scene::Scene;
+use psmpm::simulation::{run, run_2d, Summary};
 
 /// Relative error of the mid-height particle's displacement against the exact one.
-fn column_2d(basis: BasisKind, blocks: (usize, usize), t_end: f64) -> (f64, psmpm::scene::Summary) {
+fn column_2d(basis: BasisKind, blocks: (usize, usize), t_end: f64) -> (f64, Summary) {
     let mut s = Scene::builtin("column-small").unwrap();
     s.basis = basis;
-    s.blocks = blocks;
-    s.t_end = t_end;
+    s.set_blocks(blocks.0, blocks.1).unwrap();
+    s.time.t_end = t_end;
+    // The particle nearest to (W/2, H/2).
+    s.output.tracked = vec![vec![1.0, 12.5]];
     let out = run_2d(&s, &mut |_| {}).unwrap();
-    let p = &out.particles;
-    // Particle nearest to (W/2, H/2).
-    let mid = (0..p.len())
-        .min_by(|&a, &b| {
-            let d = |i: usize| (p.x0[i][0] - 1.0).powi(2) + (p.x0[i][1] - 12.5).powi(2);
-            d(a).total_cmp(&d(b))
-        })
-        .unwrap();
-    let exact = s.exact_displacement([p.x0[mid][0], p.x0[mid][1]], t_end)[1];
-    ((p.u[mid][1] - exact).abs() / exact.abs(), out.summary)
+    let mid = &out.tracked[0];
+    let (ours, exact) = (
+        mid.displacement.last().unwrap()[1],
+        mid.exact_displacement.last().unwrap()[1],
+    );
+    ((ours - exact).abs() / exact.abs(), out.summary)
 }
 
 #[test]
@@ -44,14 +44,14 @@ fn column_tracks_the_exact_displacement() {
 fn scene_1d(name: &str, basis: BasisKind, elements: usize) -> f64 {
     let mut s = Scene::builtin(name).unwrap();
     s.basis = basis;
-    s.blocks = (elements, 1);
-    s.particles_per_block = (16, 1);
+    s.set_blocks(elements, 1).unwrap();
+    s.set_particles_per_block([16, 1]);
     if name.starts_with("vibrating") {
-        s.dt = 1e-5;
-        s.t_end = 0.02;
+        s.set_dt(1e-5);
+        s.time.t_end = 0.02;
     } else {
-        s.dt = 1e-4;
-        s.t_end = 0.05;
+        s.set_dt(1e-4);
+        s.time.t_end = 0.05;
     }
     run(&s, &mut |_| {}).unwrap().error.unwrap()
 }
@@ -117,7 +117,7 @@ fn every_strategy_conserves_mass() {
     for mass in [MassKind::Lumped, MassKind::Consistent] {
         let mut s = Scene::builtin("vibrating-bar").unwrap();
         s.mass = mass;
-        s.t_end = 0.2;
+        s.time.t_end = 0.2;
         let mut masses = Vec::new();
         run(&s, &mut |r| masses.push(r.mass)).unwrap();
         let m0 = masses[0];

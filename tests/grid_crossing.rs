@@ -8,23 +8,24 @@
 //! run is the largest over all particles.
 
 use psmpm::bases::BasisKind;
-use psmpm::scene::{run_2d, Scene};
+use psmpm::scene::{Reference, Scene};
+use psmpm::simulation::run_2d;
 
 fn roughness(basis: BasisKind, v0: f64) -> f64 {
     let mut s = Scene::builtin("vibrating-bar").unwrap();
     s.basis = basis;
-    s.v0 = v0;
-    s.dt = 1e-3;
-    s.t_end = 5.0;
+    s.reference = Some(Reference::VibratingBar { v0 });
+    s.set_dt(1e-3);
+    s.time.t_end = 5.0;
     let (blocks, per_block) = match basis {
-        BasisKind::Pl => ((12, 1), (8, 6)),
-        _ => ((4, 1), (24, 6)),
+        BasisKind::Pl => ((12, 1), [8, 6]),
+        _ => ((4, 1), [24, 6]),
     };
-    s.blocks = blocks;
-    s.particles_per_block = per_block;
+    s.set_blocks(blocks.0, blocks.1).unwrap();
+    s.set_particles_per_block(per_block);
     // Track every particle of the middle row.
-    s.tracked = (0..96)
-        .map(|i| [(i as f64 + 0.5) * 25.0 / 96.0, 2.0 * 3.5 / 6.0])
+    s.output.tracked = (0..96)
+        .map(|i| vec![(i as f64 + 0.5) * 25.0 / 96.0, 2.0 * 3.5 / 6.0])
         .collect();
     let out = run_2d(&s, &mut |_| {}).unwrap();
     let omega = std::f64::consts::PI * 10.0 / 25.0;
@@ -33,8 +34,8 @@ fn roughness(basis: BasisKind, v0: f64) -> f64 {
         let v: Vec<f64> = t.velocity.iter().map(|v| v[0]).collect();
         let second: Vec<f64> = v.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();
         let rms = (second.iter().map(|d| d * d).sum::<f64>() / second.len() as f64).sqrt();
-        let smooth_rms =
-            (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt() * (omega * s.dt).powi(2);
+        let smooth_rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+            * (omega * 1e-3f64).powi(2);
         if smooth_rms > 0.0 {
             worst = worst.max(rms / smooth_rms);
         }

@@ -1,7 +1,8 @@
 //! Every built-in scene runs (shortened) and its summary is pinned: error at the end,
 //! energies at a few times, and a tracked particle's displacement and velocity.
 
-use psmpm::scene::{run_1d, run_2d, Scene, BUILTIN};
+use psmpm::scene::{Scene, BUILTIN};
+use psmpm::simulation::{build_effects, run_1d, run_2d};
 
 fn sig(x: f64) -> String {
     format!("{x:.4e}")
@@ -10,19 +11,19 @@ fn sig(x: f64) -> String {
 #[test]
 fn builtin_scene_summaries() {
     let mut out = String::new();
-    for (name, _) in BUILTIN {
+    for (name, _, _) in BUILTIN {
         let mut s = Scene::builtin(name).unwrap();
-        s.t_end = if name.starts_with("vibrating") {
-            1.0
-        } else {
-            0.05
+        s.time.t_end = match name {
+            "vibrating-bar-thesis" => 0.002,
+            "axis-aligned" => 0.0045,
+            n if n.starts_with("vibrating") => 1.0,
+            _ => 0.05,
         };
-        s.tracked = vec![if s.dim == 1 {
-            [12.5, 0.0]
-        } else if name.starts_with("vibrating") {
-            [12.5, 1.0]
-        } else {
-            [1.0, 12.5]
+        s.output.tracked = vec![match name {
+            _ if s.dim == 1 => vec![12.5],
+            "axis-aligned" => vec![0.25, 0.47],
+            n if n.starts_with("vibrating") => vec![12.5, 1.0],
+            _ => vec![1.0, 12.5],
         }];
         let mut energies = Vec::new();
         let steps = s.steps();
@@ -65,14 +66,16 @@ fn builtin_scene_summaries() {
 /// gravity; an effect in the driver's list is called exactly once per step.
 #[test]
 fn only_declared_effects_are_evaluated() {
-    use psmpm::effect::{Effect, ParticleBasis};
+    use psmpm::effect::{Effect, StepState};
     use psmpm::particles::Particles;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
+    let none = Particles::<f64, 2>::new(Vec::new(), Vec::new(), 1.0);
     let bar = Scene::builtin("vibrating-bar").unwrap();
-    assert!(bar.effects::<2>().is_empty());
+    assert!(build_effects(&bar, &none).unwrap().is_empty());
     let column = Scene::builtin("column-small").unwrap();
-    let names: Vec<&str> = column.effects::<2>().iter().map(|e| e.name()).collect();
+    let effects = build_effects(&column, &none).unwrap();
+    let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
     assert_eq!(names, ["gravity"]);
 
     static CALLS: AtomicUsize = AtomicUsize::new(0);
@@ -81,11 +84,8 @@ fn only_declared_effects_are_evaluated() {
         fn name(&self) -> &'static str {
             "counting"
         }
-        fn add_forces(&self, _: &Particles<f64, 1>, _: &ParticleBasis<f64, 1>, _: &mut [Vec<f64>]) {
+        fn add_forces(&self, _: &Particles<f64, 1>, _: &StepState<f64, 1>, _: &mut [Vec<f64>]) {
             CALLS.fetch_add(1, Ordering::SeqCst);
-        }
-        fn potential_energy(&self, _: &Particles<f64, 1>) -> f64 {
-            0.0
         }
     }
     use nalgebra::Vector1;

@@ -26,6 +26,8 @@ pub enum Format {
     Table,
     /// JSON for scripts.
     Json,
+    /// Comma-separated values.
+    Csv,
 }
 
 #[derive(Debug, Subcommand)]
@@ -37,10 +39,11 @@ enum Command {
     /// prints the L² errors of f and ∂f/∂x with their observed orders. With
     /// --mesh, projects on that Gmsh mesh instead (one level).
     Project(project::ProjectArgs),
-    /// Run a built-in scene and print per-step diagnostics and a summary.
+    /// Run a scene and print per-step diagnostics and a summary.
     ///
-    /// Scenes: vibrating-bar (B2), column-small (B5a), and their 1D versions
-    /// vibrating-bar-1d and column-small-1d. Energies are in J per unit thickness.
+    /// SCENE is a built-in scene (`mpm-cli scenes` lists them) or a scene file
+    /// FILE.toml (`mpm-cli scene show NAME` prints one to start from). Energies
+    /// are per unit thickness. Exit status 1 if the run fails numerically.
     Run(run::RunArgs),
 }
 

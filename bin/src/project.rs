@@ -100,6 +100,24 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
             let text = serde_json::to_string_pretty(&rows).expect("rows serialise");
             println!("{text}");
         }
+        Format::Csv => {
+            println!("basis,mass,n,functions,error,order,error_dx,order_dx,seconds");
+            let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
+            for r in &rows {
+                println!(
+                    "{},{},{},{},{},{},{},{},{}",
+                    r.basis,
+                    r.mass,
+                    r.n.map_or_else(String::new, |n| n.to_string()),
+                    r.functions,
+                    r.error,
+                    opt(r.order),
+                    r.error_dx,
+                    opt(r.order_dx),
+                    r.seconds
+                );
+            }
+        }
         Format::Table => {
             let mut table = Table::new(&[
                 "basis",

@@ -1,116 +1,137 @@
-//! `mpm-cli run`: run a built-in scene and print per-step diagnostics.
+//! `mpm-cli run`: run a scene and print per-step diagnostics and a summary.
 
 use crate::error::CliError;
 use crate::table::{sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
-use psmpm::basis::basis::powell_sabin::SplitPoint;
 use psmpm::driver::StepReport;
-use psmpm::scene::{self, Grid, MassKind, RunError, Scene};
+use psmpm::mass::MassKind;
+use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene};
+use psmpm::simulation::{self, RunError, Summary};
 use serde_json::json;
+
+/// The options that choose and adjust a scene (shared by `run`, `compare`, `converge`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SceneArgs {
+    /// Built-in scene (see `mpm-cli scenes`) or a scene file FILE.toml; the options
+    /// below override the scene's values.
+    pub scene: String,
+    /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
+    #[arg(long)]
+    pub basis: Option<String>,
+    /// Mass strategy: consistent, lumped, partial (lump rows touching empty elements),
+    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate or deactivate:THRESHOLD.
+    #[arg(long)]
+    pub mass: Option<String>,
+    /// Block grid NXxNY of a block mesh (1D: number of elements, e.g. 8x1).
+    #[arg(long, value_name = "NXxNY")]
+    pub blocks: Option<String>,
+    /// Particles per block PXxPY (1D: per element, e.g. 4x1).
+    #[arg(long, value_name = "PXxPY")]
+    pub particles: Option<String>,
+    /// PS split points: incentre or centroid (the thesis' tables).
+    #[arg(long)]
+    pub split: Option<String>,
+    /// Triangulation of each block: four-triangles (the seeds' grid) or delaunay
+    /// (Delaunay of block corners and centres, the thesis' tables).
+    #[arg(long)]
+    pub layout: Option<String>,
+    /// Time step (replaces the scene's dt or Courant number).
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// End time.
+    #[arg(long)]
+    pub t_end: Option<f64>,
+    /// Estimate the mass-matrix condition number every step (about 60 extra solves).
+    #[arg(long)]
+    pub condition: bool,
+}
 
 /// Arguments of `mpm-cli run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// Built-in scene (vibrating-bar, column-small, vibrating-bar-1d, column-small-1d)
-    /// or a scene file FILE.toml; command-line options override the scene's values.
-    scene: String,
-    /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Print diagnostics every N steps (0: summary only; default: the scene's
+    /// `output.diagnostics_every`, else about 20 rows).
     #[arg(long)]
-    basis: Option<String>,
-    /// Mass strategy: consistent, lumped, partial (lump rows touching empty elements),
-    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate or deactivate:THRESHOLD.
-    #[arg(long)]
-    mass: Option<String>,
-    /// Block grid NXxNY (1D: number of elements, e.g. 8x1).
-    #[arg(long, value_name = "NXxNY")]
-    blocks: Option<String>,
-    /// Particles per block PXxPY (1D: per element, e.g. 4x1).
-    #[arg(long, value_name = "PXxPY")]
-    particles: Option<String>,
-    /// PS split points: incentre (default) or centroid (the thesis' tables).
-    #[arg(long)]
-    split: Option<String>,
-    /// Triangulation of the rectangle: blocks (4 triangles per block, default) or
-    /// block-delaunay (Delaunay of block corners and centres, the thesis' tables).
-    #[arg(long)]
-    grid: Option<String>,
-    /// Time step.
-    #[arg(long)]
-    dt: Option<f64>,
-    /// End time.
-    #[arg(long)]
-    t_end: Option<f64>,
-    /// Estimate the mass-matrix condition number every step (about 60 extra solves).
-    #[arg(long)]
-    condition: bool,
-    /// Print diagnostics every N steps (0: summary only).
-    #[arg(long, default_value_t = 100)]
-    diag_every: usize,
+    diag_every: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
-fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
+/// Parses `AxB`.
+pub fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
     let bad = || CliError::Input(format!("{what} must look like 4x1, got `{text}`"));
     let (a, b) = text.split_once('x').ok_or_else(bad)?;
     Ok((a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?))
 }
 
-/// The scene with the command line's overrides applied.
-fn scene(args: &RunArgs) -> Result<Scene, CliError> {
-    let mut s = if args.scene.ends_with(".toml") {
-        let text = std::fs::read_to_string(&args.scene)
-            .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", args.scene)))?;
-        Scene::from_toml(&text, &args.scene).map_err(|e| CliError::Input(e.to_string()))?
+/// Reads a scene: a built-in name or a `.toml` file (a relative Gmsh path in it is
+/// taken relative to the file).
+pub fn read_scene(name: &str) -> Result<Scene, CliError> {
+    if name.ends_with(".toml") {
+        let text = std::fs::read_to_string(name)
+            .map_err(|e| CliError::Input(format!("{name}: cannot read: {e}")))?;
+        let mut s = Scene::from_toml(&text, name).map_err(|e| CliError::Input(e.to_string()))?;
+        if let MeshSpec::Gmsh { file } = &mut s.mesh {
+            let path = std::path::Path::new(file.as_str());
+            if path.is_relative() {
+                if let Some(dir) = std::path::Path::new(name).parent() {
+                    *file = dir.join(path).to_string_lossy().into_owned();
+                }
+            }
+        }
+        Ok(s)
     } else {
-        Scene::builtin(&args.scene).map_err(CliError::Input)?
-    };
+        Scene::builtin(name).map_err(CliError::Input)
+    }
+}
+
+/// The scene with the command line's overrides applied, validated.
+pub fn scene(args: &SceneArgs) -> Result<Scene, CliError> {
+    let mut s = read_scene(&args.scene)?;
+    let input = |e: psmpm::scene::SceneError| CliError::Input(e.to_string());
     if let Some(b) = &args.basis {
-        s.basis = BasisKind::parse(b).map_err(CliError::Input)?;
-    } else if s.dim == 1 {
-        s.basis = BasisKind::Bspline;
+        s.basis = BasisKind::parse(b).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
     }
     if let Some(m) = &args.mass {
-        s.mass = MassKind::parse(m).map_err(CliError::Input)?;
+        s.mass = MassKind::parse(m).map_err(|m| CliError::Input(format!("--mass: {m}")))?;
     }
     if let Some(b) = &args.blocks {
-        s.blocks = pair(b, "--blocks")?;
+        let (nx, ny) = pair(b, "--blocks")?;
+        s.set_blocks(nx, ny).map_err(input)?;
     }
     if let Some(p) = &args.particles {
-        s.particles_per_block = pair(p, "--particles")?;
+        let (px, py) = pair(p, "--particles")?;
+        s.set_particles_per_block([px, py]);
     }
     if let Some(split) = &args.split {
-        s.split = match split.as_str() {
-            "incentre" => SplitPoint::Incentre,
-            "centroid" => SplitPoint::Centroid,
-            other => {
-                return Err(CliError::Input(format!(
-                    "unknown split point `{other}` (known: incentre, centroid)"
-                )))
-            }
-        };
+        s.split = parse_split(split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
     }
-    if let Some(grid) = &args.grid {
-        s.grid = match grid.as_str() {
-            "blocks" => Grid::Blocks,
-            "block-delaunay" => Grid::BlockDelaunay,
+    if let Some(layout) = &args.layout {
+        let l = match layout.as_str() {
+            "four-triangles" => BlockLayout::FourTriangles,
+            "delaunay" => BlockLayout::Delaunay,
             other => {
                 return Err(CliError::Input(format!(
-                    "unknown grid `{other}` (known: blocks, block-delaunay)"
+                    "--layout: unknown layout `{other}` (known: four-triangles, delaunay)"
                 )))
             }
         };
+        s.set_layout(l).map_err(input)?;
     }
     if let Some(dt) = args.dt {
-        s.dt = dt;
+        s.set_dt(dt);
     }
     if let Some(t) = args.t_end {
-        s.t_end = t;
+        s.time.t_end = t;
     }
-    s.condition = args.condition;
-    s.validate().map_err(CliError::Input)?;
+    if args.condition {
+        s.output.condition = true;
+    }
+    s.validate().map_err(input)?;
     Ok(s)
 }
 
@@ -121,6 +142,7 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         "kinetic": r.kinetic,
         "strain": r.strain,
         "potential": r.potential,
+        "work": r.work,
         "total": r.total_energy(),
         "mass": r.mass,
         "momentum": r.momentum,
@@ -145,6 +167,22 @@ const COLUMNS: [&str; 10] = [
     "condition",
 ];
 
+fn row_csv(r: &StepReport) -> String {
+    [
+        r.step.to_string(),
+        r.time.to_string(),
+        r.kinetic.to_string(),
+        r.strain.to_string(),
+        r.potential.to_string(),
+        r.total_energy().to_string(),
+        r.max_speed.to_string(),
+        r.mass_report.active.to_string(),
+        r.mass_report.lumped_rows.to_string(),
+        r.condition.map_or_else(String::new, |c| c.to_string()),
+    ]
+    .join(",")
+}
+
 fn row_cells(r: &StepReport) -> Vec<String> {
     vec![
         r.step.to_string(),
@@ -162,61 +200,96 @@ fn row_cells(r: &StepReport) -> Vec<String> {
 
 /// Runs the scene and prints diagnostics and the summary.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
-    let s = scene(&args)?;
+    let s = scene(&args.scene)?;
+    let every = args
+        .diag_every
+        .unwrap_or(if s.output.diagnostics_every > 0 {
+            s.output.diagnostics_every
+        } else {
+            (s.steps() / 20).max(1)
+        });
     let mut table = Table::new(&COLUMNS);
-    let every = args.diag_every;
-    let json_mode = args.format == Format::Json;
+    let format = args.format;
+    let mut csv_header = true;
     let mut on_step = |r: &StepReport| {
         if every > 0 && r.step % every == 0 {
-            if json_mode {
-                println!("{}", row_json(r));
-            } else {
-                table.push(row_cells(r));
+            match format {
+                Format::Json => println!("{}", row_json(r)),
+                Format::Csv => {
+                    if std::mem::take(&mut csv_header) {
+                        println!("{}", COLUMNS.join(","));
+                    }
+                    println!("{}", row_csv(r));
+                }
+                Format::Table => table.push(row_cells(r)),
             }
         }
     };
-    let summary = scene::run(&s, &mut on_step).map_err(|e| match e {
+    let summary = simulation::run(&s, &mut on_step).map_err(|e| match e {
         RunError::Setup(m) => CliError::Input(m),
-        RunError::Step(step) => CliError::Numerical(step.to_string()),
     })?;
-    if json_mode {
-        let value = serde_json::to_value(&summary).expect("summary serialises");
-        println!("{value}");
-    } else {
-        if every > 0 {
-            print!("{}", table.render());
-            println!();
+    match format {
+        Format::Json => println!("{}", summary_json(&summary)),
+        Format::Csv => {}
+        Format::Table => {
+            if every > 0 {
+                print!("{}", table.render());
+                println!();
+            }
+            print!("{}", summary_text(&summary));
         }
-        println!(
-            "{} · {} · {} mass · {} functions · {} particles · {} steps to t = {}",
-            summary.scene,
-            summary.basis,
-            summary.mass,
-            summary.functions,
-            summary.particles,
-            summary.steps,
-            summary.t_end
-        );
-        println!(
-            "error E_u = {} · max condition {} · energy {} → {} (drift {:.2e}) · {} · {:.2} s ({:.1} µs/step)",
-            summary.error.map_or("-".into(), sci),
-            summary.max_condition.map_or("-".into(), sci),
-            sci(summary.energy_initial),
-            sci(summary.energy_final),
-            summary.energy_drift,
-            if summary.stable { "stable" } else { "UNSTABLE" },
-            summary.seconds,
-            1e6 * summary.seconds / summary.steps.max(1) as f64
-        );
-        let p = &summary.phases;
-        let total = (p.evaluate + p.assemble + p.solve + p.update).max(f64::MIN_POSITIVE);
-        println!(
-            "phases: evaluate {:.0} % · assemble {:.0} % · solve {:.0} % · update {:.0} %",
-            100.0 * p.evaluate / total,
-            100.0 * p.assemble / total,
-            100.0 * p.solve / total,
-            100.0 * p.update / total
-        );
     }
-    Ok(())
+    match &summary.failure {
+        Some(reason) => Err(CliError::Numerical(reason.clone())),
+        None => Ok(()),
+    }
+}
+
+/// The summary as one JSON object.
+pub fn summary_json(summary: &Summary) -> serde_json::Value {
+    serde_json::to_value(summary).unwrap_or_else(|e| json!({ "error": e.to_string() }))
+}
+
+/// The summary for reading at a glance.
+pub fn summary_text(summary: &Summary) -> String {
+    let mut out = String::new();
+    out += &format!(
+        "{} · {} · {} mass · {} functions · {} particles · {} steps of {} to t = {}\n",
+        summary.scene,
+        summary.basis,
+        summary.mass,
+        summary.functions,
+        summary.particles,
+        summary.steps,
+        sci(summary.dt),
+        summary.t_end
+    );
+    let error = match (summary.error, summary.error_measure) {
+        (Some(e), Some(m)) => format!("error {m} = {}", sci(e)),
+        _ => "no reference solution".into(),
+    };
+    out += &format!(
+        "{error} · {} · energy {} → {} (drift {:.2e}) · max condition {} · lumped rows ≤ {}\n",
+        if summary.stable { "stable" } else { "UNSTABLE" },
+        sci(summary.energy_initial),
+        sci(summary.energy_final),
+        summary.energy_drift,
+        summary.max_condition.map_or("-".into(), sci),
+        summary.max_lumped_rows,
+    );
+    if let Some(reason) = &summary.failure {
+        out += &format!("stopped: {reason}\n");
+    }
+    let p = &summary.phases;
+    let total = (p.evaluate + p.assemble + p.solve + p.update).max(f64::MIN_POSITIVE);
+    out += &format!(
+        "wall time {:.2} s ({:.1} µs/step): evaluate {:.0} % · assemble {:.0} % · solve {:.0} % · update {:.0} %\n",
+        summary.seconds,
+        1e6 * summary.seconds / summary.steps.max(1) as f64,
+        100.0 * p.evaluate / total,
+        100.0 * p.assemble / total,
+        100.0 * p.solve / total,
+        100.0 * p.update / total
+    );
+    out
 }

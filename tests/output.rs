@@ -1,0 +1,335 @@
+//! The output files read back by an independent reader: Python's `meshio`
+//! (pinned in `.ci/run`), so that what ParaView-style tools see is what was written.
+//!
+//! These tests need `python3` with `meshio`; they fail (never skip) without them.
+
+use nalgebra::{Matrix1, Matrix2, Vector1, Vector2};
+use psmpm::output::{OutputDir, OutputError};
+use psmpm::particles::Particles;
+use psmpm_basis::mesh::generators::block_grid;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The meshio version `.ci/run` installs and these tests were written against.
+const MESHIO: &str = "5.3.5";
+
+/// Reads every `.vtu` in `vtus` with meshio and every `.pvd` in `pvds` with
+/// `xml.etree`; floats come back as Python `repr` strings (exact round trip).
+const SCRIPT: &str = r#"
+import json, sys
+try:
+    import meshio
+except ImportError as e:
+    print(f"cannot import meshio: {e}", file=sys.stderr)
+    sys.exit(3)
+import xml.etree.ElementTree as ET
+
+def floats(a):
+    return [repr(float(x)) for x in a.ravel()]
+
+out = {"meshio": meshio.__version__, "vtu": {}, "pvd": {}}
+for path in sys.argv[1:]:
+    if path.endswith(".pvd"):
+        root = ET.parse(path).getroot()
+        assert root.tag == "VTKFile" and root.get("type") == "Collection", root.attrib
+        out["pvd"][path] = [[repr(float(d.get("timestep"))), d.get("file")]
+                            for d in root.find("Collection").findall("DataSet")]
+        continue
+    m = meshio.read(path)
+    out["vtu"][path] = {
+        "points": {"shape": list(m.points.shape), "values": floats(m.points)},
+        "cells": [[c.type, [[int(i) for i in cell] for cell in c.data]] for c in m.cells],
+        "point_data": {k: {"shape": list(v.shape), "values": floats(v)}
+                       for k, v in m.point_data.items()},
+        "cell_data": {k: [[int(i) for i in block.ravel()] for block in v]
+                      for k, v in m.cell_data.items()},
+    }
+print(json.dumps(out))
+"#;
+
+fn install_hint() -> String {
+    format!(
+        "these tests read the output back with meshio: run `python3 -m pip install meshio=={MESHIO}`"
+    )
+}
+
+/// Runs the reader script on `files` and returns its JSON.
+fn read_back(files: &[PathBuf]) -> Value {
+    let output = Command::new("python3")
+        .arg("-c")
+        .arg(SCRIPT)
+        .args(files)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run python3 ({e}); {}", install_hint()));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if output.status.code() == Some(3) {
+        panic!("{}; {}", stderr.trim(), install_hint());
+    }
+    assert!(
+        output.status.success(),
+        "the meshio reader failed ({}):\n{stderr}",
+        output.status
+    );
+    serde_json::from_slice(&output.stdout).expect("the reader prints JSON")
+}
+
+/// A fresh, empty directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let path = std::env::temp_dir().join(format!("psmpm-output-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&path);
+        TempDir(path)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The `.vtu` entry of the reader's JSON for `path`.
+fn vtu<'a>(json: &'a Value, path: &Path) -> &'a Value {
+    &json["vtu"][path.to_str().unwrap()]
+}
+
+/// An array of `repr` strings, parsed as `f64`, with its shape.
+fn array(value: &Value) -> (Vec<usize>, Vec<f64>) {
+    let shape = value["shape"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_u64().unwrap() as usize)
+        .collect();
+    let values = value["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap().parse::<f64>().unwrap())
+        .collect();
+    (shape, values)
+}
+
+/// Bit-for-bit equality of float arrays (so `-0.0` and `0.0` differ).
+fn assert_exact(name: &str, got: &[f64], expected: &[f64]) {
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        bits(got),
+        bits(expected),
+        "{name}: read {got:?}, wrote {expected:?}"
+    );
+}
+
+/// The cell blocks as `(type, connectivity)`.
+fn cells(value: &Value) -> Vec<(String, Vec<Vec<usize>>)> {
+    serde_json::from_value(value["cells"].clone()).unwrap()
+}
+
+/// Checks a particle file against `p`: points, one vertex per particle, and each
+/// point-data array in the documented layout.
+fn check_particles<const D: usize>(file: &Value, p: &Particles<f64, D>) {
+    let n = p.len();
+    let pad =
+        |v: &[f64]| -> Vec<f64> { (0..3).map(|k| v.get(k).copied().unwrap_or(0.0)).collect() };
+    let vec3 = |vs: &[nalgebra::SVector<f64, D>]| -> Vec<f64> {
+        vs.iter().flat_map(|v| pad(v.as_slice())).collect()
+    };
+
+    let (shape, points) = array(&file["points"]);
+    assert_eq!(shape, [n, 3]);
+    assert_exact("points", &points, &vec3(&p.x));
+
+    let expected_cells: Vec<Vec<usize>> = (0..n).map(|i| vec![i]).collect();
+    assert_eq!(cells(file), [("vertex".to_string(), expected_cells)]);
+
+    let data = file["point_data"].as_object().unwrap();
+    let mut names: Vec<&str> = data.keys().map(|k| k.as_str()).collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["displacement", "mass", "stress", "velocity", "volume"]
+    );
+    for (name, components, expected) in [
+        ("velocity", 3, vec3(&p.v)),
+        ("displacement", 3, vec3(&p.u)),
+        ("volume", 0, p.volume.clone()),
+        ("mass", 0, p.mass.clone()),
+        (
+            "stress",
+            9,
+            p.sigma
+                .iter()
+                .flat_map(|s| {
+                    (0..9).map(move |k| {
+                        let (r, c) = (k / 3, k % 3);
+                        if r < D && c < D {
+                            s[(r, c)]
+                        } else {
+                            0.0
+                        }
+                    })
+                })
+                .collect(),
+        ),
+    ] {
+        let (shape, values) = array(&data[name]);
+        let expected_shape = if components == 0 {
+            vec![n]
+        } else {
+            vec![n, components]
+        };
+        assert_eq!(shape, expected_shape, "shape of {name}");
+        assert_exact(name, &values, &expected);
+    }
+}
+
+/// Three 2D particles whose every value differs (and a non-symmetric stress, to
+/// pin the component order).
+fn particles_2d(shift: f64) -> Particles<f64, 2> {
+    let mut p = Particles::new(
+        vec![
+            Vector2::new(0.1 + shift, 0.2),
+            Vector2::new(0.7, 1.0 / 3.0),
+            Vector2::new(-1.5e-7, 9.75),
+        ],
+        vec![0.01, 0.02, 1.0 / 7.0],
+        1000.0,
+    );
+    for i in 0..3 {
+        let a = i as f64 + shift;
+        p.v[i] = Vector2::new(1.0 + a, -2.0 - a / 3.0);
+        p.u[i] = Vector2::new(1e-5 * (a + 1.0), -0.0 - a);
+        p.sigma[i] = Matrix2::new(1e5 * (a + 1.0), 2.5 + a, -3.25 - a, 4e-3 * a);
+        p.volume[i] *= 1.0 + 0.1 * a;
+    }
+    p
+}
+
+#[test]
+fn particles_2d_mesh_and_collection_read_back_with_meshio() {
+    let dir = TempDir::new("2d");
+    let mut out = OutputDir::create(dir.0.join("run"), 2).unwrap();
+
+    // Steps 0..=4 at cadence 2: frames at steps 0, 2, 4.
+    let dt = 0.125;
+    let mut written = Vec::new();
+    for step in 0..=4 {
+        let p = particles_2d(step as f64);
+        if out.particles_frame(step, step as f64 * dt, &p).unwrap() {
+            written.push((step as f64 * dt, p));
+        }
+    }
+    assert_eq!(written.len(), 3);
+
+    let mesh = block_grid(0.0, 1.0, 0.0, 1.0, 2, 2).unwrap();
+    let field: Vec<f64> = mesh
+        .vertices()
+        .iter()
+        .map(|v| v.x * v.x - v.y / 3.0)
+        .collect();
+    let mesh_path = out
+        .write_mesh(&mesh, Some(("temperature", &field)))
+        .unwrap();
+    let pvd = out.finish().unwrap();
+    assert_eq!(mesh_path, dir.0.join("run/mesh.vtu"));
+    assert_eq!(pvd, dir.0.join("run/particles.pvd"));
+
+    let frames: Vec<PathBuf> = (0..3)
+        .map(|i| dir.0.join(format!("run/particles_{i:05}.vtu")))
+        .collect();
+    let mut files = frames.clone();
+    files.push(mesh_path.clone());
+    files.push(pvd.clone());
+    let json = read_back(&files);
+
+    for (path, (_, p)) in frames.iter().zip(&written) {
+        check_particles(vtu(&json, path), p);
+    }
+
+    // The mesh: vertices, triangles, the element index and the caller's field.
+    let m = vtu(&json, &mesh_path);
+    let (shape, points) = array(&m["points"]);
+    assert_eq!(shape, [mesh.num_vertices(), 3]);
+    let expected: Vec<f64> = mesh
+        .vertices()
+        .iter()
+        .flat_map(|v| [v.x, v.y, 0.0])
+        .collect();
+    assert_exact("mesh points", &points, &expected);
+    let triangles: Vec<Vec<usize>> = mesh.triangles().iter().map(|t| t.to_vec()).collect();
+    assert_eq!(triangles.len(), 16);
+    assert_eq!(cells(m), [("triangle".to_string(), triangles)]);
+    let element: Vec<Vec<usize>> =
+        serde_json::from_value(m["cell_data"]["element"].clone()).unwrap();
+    assert_eq!(element, [(0..16).collect::<Vec<usize>>()]);
+    let (shape, values) = array(&m["point_data"]["temperature"]);
+    assert_eq!(shape, [mesh.num_vertices()]);
+    assert_exact("temperature", &values, &field);
+
+    // The collection: times and relative file names, in order, files present.
+    let entries: Vec<(String, String)> =
+        serde_json::from_value(json["pvd"][pvd.to_str().unwrap()].clone()).unwrap();
+    assert_eq!(entries.len(), 3);
+    for (i, ((time, file), (t, _))) in entries.iter().zip(&written).enumerate() {
+        assert_eq!(time.parse::<f64>().unwrap(), *t);
+        assert_eq!(*file, format!("particles_{i:05}.vtu"));
+        assert!(dir.0.join("run").join(file).is_file());
+    }
+    let text = std::fs::read_to_string(&pvd).unwrap();
+    assert!(text.contains("<VTKFile type=\"Collection\""));
+    assert_eq!(text.matches("<DataSet ").count(), 3);
+    assert!(text.contains("timestep=\"2.5e-1\""), "{text}");
+    assert_eq!(out.frames().len(), 3);
+}
+
+#[test]
+fn particles_1d_read_back_with_meshio() {
+    let dir = TempDir::new("1d");
+    let mut out = OutputDir::create(&dir.0, 1).unwrap();
+    let mut p = Particles::new(
+        vec![
+            Vector1::new(0.125),
+            Vector1::new(2.5),
+            Vector1::new(-1.0 / 3.0),
+            Vector1::new(7.0),
+        ],
+        vec![0.25, 0.5, 0.75, 1.0],
+        7800.0,
+    );
+    for i in 0..p.len() {
+        let a = i as f64;
+        p.v[i] = Vector1::new(0.3 * a - 1.0);
+        p.u[i] = Vector1::new(-1e-9 * (a + 1.0));
+        p.sigma[i] = Matrix1::new(-2e8 + a);
+        p.volume[i] = 0.25 * (a + 1.0) * (1.0 + 1e-3 * a);
+    }
+    let path = out.write_particles(0.5, &p).unwrap();
+    let pvd = out.finish().unwrap();
+    let json = read_back(&[path.clone(), pvd.clone()]);
+    check_particles(vtu(&json, &path), &p);
+    let entries: Vec<(String, String)> =
+        serde_json::from_value(json["pvd"][pvd.to_str().unwrap()].clone()).unwrap();
+    assert_eq!(
+        entries,
+        [("0.5".to_string(), "particles_00000.vtu".to_string())]
+    );
+}
+
+#[test]
+fn an_output_directory_that_cannot_be_created_is_an_error() {
+    let dir = TempDir::new("blocked");
+    std::fs::create_dir_all(&dir.0).unwrap();
+    let file = dir.0.join("a-file");
+    std::fs::write(&file, "not a directory").unwrap();
+    let err = OutputDir::create(file.join("out"), 1).unwrap_err();
+    assert!(matches!(err, OutputError::CreateDir { .. }), "{err:?}");
+    let message = err.to_string();
+    assert!(message.contains("a-file"), "{message}");
+    assert!(
+        message.starts_with("cannot create output directory"),
+        "{message}"
+    );
+}
