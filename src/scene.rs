@@ -101,6 +101,45 @@ pub struct Scene {
     /// What to record.
     #[serde(default)]
     pub output: OutputSpec,
+    /// The resolution each basis gets when bases are compared (`mpm-cli compare`),
+    /// chosen so that they have about the same number of functions.
+    #[serde(default, rename = "resolution", skip_serializing_if = "Vec::is_empty")]
+    pub resolutions: Vec<Resolution>,
+    /// How refinement studies refine the scene (`mpm-cli converge`).
+    #[serde(default)]
+    pub study: StudySpec,
+}
+
+/// The resolution of one basis in comparisons: every field given replaces the
+/// scene's value when the scene is switched to `basis`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Resolution {
+    /// The basis this resolution is for.
+    #[serde(with = "basis_name")]
+    pub basis: BasisKind,
+    /// Blocks of a `blocks` mesh (`[elements, 1]` for an interval).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<[usize; 2]>,
+    /// Target edge length of a `polygon` mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_length: Option<f64>,
+    /// Particles per block of every body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_block: Option<Vec<usize>>,
+}
+
+/// How a refinement study refines a scene: level `l` multiplies the block counts
+/// along the `refine` axes (all axes by default) and the elements of an interval by
+/// `2^l`, divides a polygon's edge length by `2^l` (and multiplies particle counts
+/// along every axis by `2^l`, keeping particles per element about constant). The
+/// time step and particles per block stay.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudySpec {
+    /// Axes whose block counts are refined (empty: all).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refine: Vec<Component>,
 }
 
 /// The mesh of a scene.
@@ -347,8 +386,11 @@ pub enum Reference {
         /// Displacement amplitude.
         u0: f64,
     },
-    /// B5c: the static stress profile of paper eq. (48); error: the largest
-    /// `|σ_yy − σ_yy^exact| / σ_yy(0)` over particles at the end.
+    /// B5c: the static stress profile of a column under self-weight; error: the
+    /// largest `|σ_yy − σ_yy^exact| / |σ_yy(0)|` over particles at the end. The
+    /// exact profile is that of the project's linear law `σ = E (F − 1)`
+    /// ([`crate::exact::column_equilibrium_stress_linear`]); paper eq. (48) belongs
+    /// to a slightly different law and differs by about `κ² |σ_yy(0)|`.
     ColumnEquilibrium,
 }
 
@@ -974,6 +1016,83 @@ impl Scene {
     pub fn set_dt(&mut self, dt: f64) {
         self.time.dt = Some(dt);
         self.time.courant = None;
+    }
+
+    /// The scene for `basis`, with the resolution the scene gives that basis (see
+    /// [`Scene::resolutions`]), validated.
+    pub fn with_basis(&self, basis: BasisKind) -> Result<Scene, SceneError> {
+        let mut s = self.clone();
+        s.basis = basis;
+        if let Some(r) = self.resolutions.iter().find(|r| r.basis == basis) {
+            if let Some([nx, ny]) = r.blocks {
+                s.set_blocks(nx, ny)?;
+            }
+            if let Some(h) = r.edge_length {
+                match &mut s.mesh {
+                    MeshSpec::Polygon { edge_length, .. } => *edge_length = h,
+                    _ => return Err(bad("resolution.edge_length", "the mesh is not a polygon")),
+                }
+            }
+            if let Some(p) = &r.per_block {
+                for body in &mut s.bodies {
+                    body.per_block = Some(p.clone());
+                    body.count = None;
+                }
+            }
+        }
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The scene refined `level` times as [`StudySpec`] says, validated.
+    pub fn refined(&self, level: u32) -> Result<Scene, SceneError> {
+        let mut s = self.clone();
+        let factor = 1usize
+            .checked_shl(level)
+            .filter(|f| *f <= 4096)
+            .ok_or_else(|| bad("study", format!("level {level} is too fine")))?;
+        let refine = |axis: usize| {
+            self.study.refine.is_empty() || self.study.refine.iter().any(|c| c.index() == axis)
+        };
+        match &mut s.mesh {
+            MeshSpec::Blocks { blocks, .. } => {
+                for (axis, n) in blocks.iter_mut().enumerate() {
+                    if refine(axis) {
+                        *n *= factor;
+                    }
+                }
+            }
+            MeshSpec::Interval { elements, .. } => *elements *= factor,
+            MeshSpec::Polygon { edge_length, .. } => {
+                *edge_length /= factor as f64;
+                for body in &mut s.bodies {
+                    if let Some(c) = &mut body.count {
+                        c.iter_mut().for_each(|n| *n *= factor);
+                    }
+                }
+            }
+            MeshSpec::Gmsh { .. } => {
+                return Err(bad("mesh.kind", "a Gmsh mesh cannot be refined by a study"))
+            }
+        }
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The mesh size `h` a refinement study reports: the block width along the
+    /// first refined axis, the element length of an interval, the edge length of a
+    /// polygon mesh (`None` for Gmsh meshes).
+    pub fn mesh_size(&self) -> Option<f64> {
+        match &self.mesh {
+            MeshSpec::Blocks { x, y, blocks, .. } => {
+                let axis = self.study.refine.first().map_or(0, |c| c.index());
+                let r = if axis == 0 { x } else { y };
+                Some((r[1] - r[0]) / blocks[axis] as f64)
+            }
+            MeshSpec::Interval { x, elements } => Some((x[1] - x[0]) / *elements as f64),
+            MeshSpec::Polygon { edge_length, .. } => Some(*edge_length),
+            MeshSpec::Gmsh { .. } => None,
+        }
     }
 
     /// Block counts of a `blocks` mesh (`[elements, 1]` for an interval).

@@ -137,11 +137,46 @@ pub struct Outcome<const D: usize> {
     pub failure: Option<StepError>,
 }
 
+/// The particles of a run, in its dimension, as observers see them after a step.
+#[derive(Clone, Copy)]
+pub enum ParticlesRef<'a> {
+    /// A 1D run.
+    One(&'a Particles<f64, 1>),
+    /// A 2D run.
+    Two(&'a Particles<f64, 2>),
+}
+
+/// Particle sets that can be shown to observers.
+pub trait AsParticlesRef {
+    /// The view.
+    fn view(&self) -> ParticlesRef<'_>;
+}
+
+impl AsParticlesRef for Particles<f64, 1> {
+    fn view(&self) -> ParticlesRef<'_> {
+        ParticlesRef::One(self)
+    }
+}
+
+impl AsParticlesRef for Particles<f64, 2> {
+    fn view(&self) -> ParticlesRef<'_> {
+        ParticlesRef::Two(self)
+    }
+}
+
+/// A callback after every step, with the step's report and the particles.
+pub type Observer<'a> = dyn FnMut(&StepReport, ParticlesRef<'_>) + 'a;
+
 /// Runs `scene` (1D or 2D), calling `on_step` after every step.
 pub fn run(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Summary, RunError> {
+    observe(scene, &mut |r, _| on_step(r))
+}
+
+/// Runs `scene` (1D or 2D), showing every step's report and particles to `observer`.
+pub fn observe(scene: &Scene, observer: &mut Observer) -> Result<Summary, RunError> {
     match scene.dim {
-        2 => run_2d(scene, on_step).map(|o| o.summary),
-        _ => run_1d(scene, on_step).map(|o| o.summary),
+        2 => run_2d_observed(scene, observer).map(|o| o.summary),
+        _ => run_1d_observed(scene, observer).map(|o| o.summary),
     }
 }
 
@@ -202,6 +237,15 @@ fn smallest_edge(mesh: &TriMesh) -> f64 {
 
 /// Runs a 2D scene and returns its particles too.
 pub fn run_2d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<2>, RunError> {
+    run_2d_observed(scene, &mut |r, _| on_step(r))
+}
+
+/// Runs a 1D scene and returns its particles too.
+pub fn run_1d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<1>, RunError> {
+    run_1d_observed(scene, &mut |r, _| on_step(r))
+}
+
+fn run_2d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<2>, RunError> {
     scene.validate()?;
     if scene.dim != 2 {
         return Err(RunError::Setup(format!("dim: the scene is {}D", scene.dim)));
@@ -218,8 +262,7 @@ pub fn run_2d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Out
     }
 }
 
-/// Runs a 1D scene and returns its particles too.
-pub fn run_1d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<1>, RunError> {
+fn run_1d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<1>, RunError> {
     scene.validate()?;
     let MeshSpec::Interval { x, elements } = scene.mesh else {
         return Err(RunError::Setup(
@@ -241,8 +284,11 @@ fn dispatch_mass<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     basis: B,
     h: f64,
-    on_step: &mut dyn FnMut(&StepReport),
-) -> Result<Outcome<D>, RunError> {
+    on_step: &mut Observer,
+) -> Result<Outcome<D>, RunError>
+where
+    Particles<f64, D>: AsParticlesRef,
+{
     match scene.mass {
         MassKind::Lumped => run_with::<D, B, Lumped<f64>>(scene, basis, h, on_step),
         _ => run_with::<D, B, SparseMass<f64>>(scene, basis, h, on_step),
@@ -474,8 +520,11 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
     scene: &Scene,
     basis: B,
     h: f64,
-    on_step: &mut dyn FnMut(&StepReport),
-) -> Result<Outcome<D>, RunError> {
+    on_step: &mut Observer,
+) -> Result<Outcome<D>, RunError>
+where
+    Particles<f64, D>: AsParticlesRef,
+{
     let m = &scene.material;
     let elastic = Elastic::new(m.young, m.poisson, m.density)
         .map_err(|e| RunError::Setup(format!("material: {e}")))?;
@@ -614,7 +663,7 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
             }
             rms.finish_step();
         }
-        on_step(&r);
+        on_step(&r, driver.particles.view());
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
         drift = drift.max((r.total_energy() - e0).abs());
         growth = growth.max(r.total_energy() - e0);
@@ -643,8 +692,13 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
             (0..parts.len())
                 .map(|p| {
                     let y = parts.x[p][D - 1] - origin[D - 1];
-                    let exact =
-                        exact::column_equilibrium_stress(y, height, density, gravity.abs(), young);
+                    let exact = exact::column_equilibrium_stress_linear(
+                        y,
+                        height,
+                        density,
+                        gravity.abs(),
+                        young,
+                    );
                     (parts.sigma[p][(D - 1, D - 1)] - exact).abs() / sigma_base
                 })
                 .fold(0.0, f64::max)

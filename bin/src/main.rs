@@ -3,9 +3,12 @@
 //! Exit status: 0 on success, 2 for usage and input errors (unknown basis, bad
 //! mesh file, value out of range), 1 for a computation that failed numerically.
 
+mod compare;
+mod converge;
 mod error;
 mod project;
 mod run;
+mod scenes;
 mod table;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -45,6 +48,24 @@ enum Command {
     /// FILE.toml (`mpm-cli scene show NAME` prints one to start from). Energies
     /// are per unit thickness. Exit status 1 if the run fails numerically.
     Run(run::RunArgs),
+    /// List the built-in scenes, one line each.
+    Scenes(scenes::ScenesArgs),
+    /// Show a scene as a scene file.
+    #[command(subcommand)]
+    Scene(scenes::SceneCommand),
+    /// Run a scene with several bases (and mass strategies) side by side.
+    ///
+    /// Each basis runs at the resolution the scene gives it (its `[[resolution]]`
+    /// tables), so that the variants have about the same number of functions, as in
+    /// the thesis' PS 42 against PL 38 functions. Variants run in parallel; the
+    /// results equal those of running them one by one.
+    Compare(compare::CompareArgs),
+    /// Refinement study: error, observed order and wall time per level and basis.
+    ///
+    /// Level l refines the scene's blocks by 2^l along the axes its `[study]` names
+    /// (polygon meshes: edge length / 2^l). With --out, also writes the log-log
+    /// error-vs-h and work-precision (error vs wall time) plots.
+    Converge(converge::ConvergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +73,10 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Project(args) => project::run(args),
         Command::Run(args) => run::run(args),
+        Command::Scenes(args) => scenes::list(args),
+        Command::Scene(command) => scenes::scene(command),
+        Command::Compare(args) => compare::compare(args),
+        Command::Converge(args) => converge::converge(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -10,19 +10,10 @@ use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene};
 use psmpm::simulation::{self, RunError, Summary};
 use serde_json::json;
 
-/// The options that choose and adjust a scene (shared by `run`, `compare`, `converge`).
+/// The options that adjust a scene's resolution and time (shared by `run`,
+/// `compare`, `converge`).
 #[derive(Debug, Clone, clap::Args)]
-pub struct SceneArgs {
-    /// Built-in scene (see `mpm-cli scenes`) or a scene file FILE.toml; the options
-    /// below override the scene's values.
-    pub scene: String,
-    /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
-    #[arg(long)]
-    pub basis: Option<String>,
-    /// Mass strategy: consistent, lumped, partial (lump rows touching empty elements),
-    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate or deactivate:THRESHOLD.
-    #[arg(long)]
-    pub mass: Option<String>,
+pub struct Overrides {
     /// Block grid NXxNY of a block mesh (1D: number of elements, e.g. 8x1).
     #[arg(long, value_name = "NXxNY")]
     pub blocks: Option<String>,
@@ -47,11 +38,62 @@ pub struct SceneArgs {
     pub condition: bool,
 }
 
+impl Overrides {
+    /// Applies the overrides to `s` and validates it.
+    pub fn apply(&self, mut s: Scene) -> Result<Scene, CliError> {
+        let input = |e: psmpm::scene::SceneError| CliError::Input(e.to_string());
+        if let Some(b) = &self.blocks {
+            let (nx, ny) = pair(b, "--blocks")?;
+            s.set_blocks(nx, ny).map_err(input)?;
+        }
+        if let Some(p) = &self.particles {
+            let (px, py) = pair(p, "--particles")?;
+            s.set_particles_per_block([px, py]);
+        }
+        if let Some(split) = &self.split {
+            s.split = parse_split(split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
+        }
+        if let Some(layout) = &self.layout {
+            let l = match layout.as_str() {
+                "four-triangles" => BlockLayout::FourTriangles,
+                "delaunay" => BlockLayout::Delaunay,
+                other => {
+                    return Err(CliError::Input(format!(
+                        "--layout: unknown layout `{other}` (known: four-triangles, delaunay)"
+                    )))
+                }
+            };
+            s.set_layout(l).map_err(input)?;
+        }
+        if let Some(dt) = self.dt {
+            s.set_dt(dt);
+        }
+        if let Some(t) = self.t_end {
+            s.time.t_end = t;
+        }
+        if self.condition {
+            s.output.condition = true;
+        }
+        s.validate().map_err(input)?;
+        Ok(s)
+    }
+}
+
 /// Arguments of `mpm-cli run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
+    /// Built-in scene (see `mpm-cli scenes`) or a scene file FILE.toml; the options
+    /// below override the scene's values.
+    scene: String,
+    /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
+    #[arg(long)]
+    basis: Option<String>,
+    /// Mass strategy: consistent, lumped, partial (lump rows touching empty elements),
+    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate or deactivate:THRESHOLD.
+    #[arg(long)]
+    mass: Option<String>,
     #[command(flatten)]
-    scene: SceneArgs,
+    overrides: Overrides,
     /// Print diagnostics every N steps (0: summary only; default: the scene's
     /// `output.diagnostics_every`, else about 20 rows).
     #[arg(long)]
@@ -89,50 +131,16 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
     }
 }
 
-/// The scene with the command line's overrides applied, validated.
-pub fn scene(args: &SceneArgs) -> Result<Scene, CliError> {
+/// The scene of `run` with the command line's choices applied, validated.
+fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     let mut s = read_scene(&args.scene)?;
-    let input = |e: psmpm::scene::SceneError| CliError::Input(e.to_string());
     if let Some(b) = &args.basis {
         s.basis = BasisKind::parse(b).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
     }
     if let Some(m) = &args.mass {
         s.mass = MassKind::parse(m).map_err(|m| CliError::Input(format!("--mass: {m}")))?;
     }
-    if let Some(b) = &args.blocks {
-        let (nx, ny) = pair(b, "--blocks")?;
-        s.set_blocks(nx, ny).map_err(input)?;
-    }
-    if let Some(p) = &args.particles {
-        let (px, py) = pair(p, "--particles")?;
-        s.set_particles_per_block([px, py]);
-    }
-    if let Some(split) = &args.split {
-        s.split = parse_split(split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
-    }
-    if let Some(layout) = &args.layout {
-        let l = match layout.as_str() {
-            "four-triangles" => BlockLayout::FourTriangles,
-            "delaunay" => BlockLayout::Delaunay,
-            other => {
-                return Err(CliError::Input(format!(
-                    "--layout: unknown layout `{other}` (known: four-triangles, delaunay)"
-                )))
-            }
-        };
-        s.set_layout(l).map_err(input)?;
-    }
-    if let Some(dt) = args.dt {
-        s.set_dt(dt);
-    }
-    if let Some(t) = args.t_end {
-        s.time.t_end = t;
-    }
-    if args.condition {
-        s.output.condition = true;
-    }
-    s.validate().map_err(input)?;
-    Ok(s)
+    args.overrides.apply(s)
 }
 
 fn row_json(r: &StepReport) -> serde_json::Value {
@@ -200,7 +208,7 @@ fn row_cells(r: &StepReport) -> Vec<String> {
 
 /// Runs the scene and prints diagnostics and the summary.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
-    let s = scene(&args.scene)?;
+    let s = scene(&args)?;
     let every = args
         .diag_every
         .unwrap_or(if s.output.diagnostics_every > 0 {

@@ -1,0 +1,203 @@
+//! `mpm-cli compare`: the same scene with several bases and mass strategies, side by
+//! side, each basis at the resolution the scene gives it (`[[resolution]]`), so that
+//! the variants have about the same number of functions.
+//!
+//! Variants run on separate threads (up to `--jobs`); each run is single-threaded and
+//! deterministic, so the results are identical to running them one by one (only the
+//! wall times differ, and they are measured under the contention of the parallel runs).
+
+use crate::error::CliError;
+use crate::run::{read_scene, summary_json, Overrides};
+use crate::table::{sci, Table};
+use crate::Format;
+use psmpm::bases::BasisKind;
+use psmpm::mass::MassKind;
+use psmpm::scene::Scene;
+use psmpm::simulation::{self, RunError, Summary};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// Arguments of `mpm-cli compare`.
+#[derive(Debug, clap::Args)]
+pub struct CompareArgs {
+    /// Built-in scene (see `mpm-cli scenes`) or a scene file FILE.toml.
+    scene: String,
+    /// Bases to compare, comma-separated (default: ps,pl in 2D, bspline,pl1d in 1D).
+    #[arg(long, value_delimiter = ',')]
+    basis: Vec<String>,
+    /// Mass strategies to compare, comma-separated (default: the scene's).
+    #[arg(long, value_delimiter = ',')]
+    mass: Vec<String>,
+    /// Variants run at the same time (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    #[command(flatten)]
+    overrides: Overrides,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// The variants of a comparison, in output order.
+pub fn variants(
+    base: &Scene,
+    bases: &[String],
+    masses: &[String],
+    overrides: &Overrides,
+) -> Result<Vec<Scene>, CliError> {
+    let bases: Vec<BasisKind> = if bases.is_empty() {
+        BasisKind::ALL
+            .into_iter()
+            .filter(|b| b.dim() == base.dim)
+            .collect()
+    } else {
+        bases
+            .iter()
+            .map(|b| BasisKind::parse(b).map_err(|m| CliError::Input(format!("--basis: {m}"))))
+            .collect::<Result<_, _>>()?
+    };
+    let masses: Vec<MassKind> = if masses.is_empty() {
+        vec![base.mass]
+    } else {
+        masses
+            .iter()
+            .map(|m| MassKind::parse(m).map_err(|e| CliError::Input(format!("--mass: {e}"))))
+            .collect::<Result<_, _>>()?
+    };
+    let mut out = Vec::new();
+    for &b in &bases {
+        let with_basis = base
+            .with_basis(b)
+            .map_err(|e| CliError::Input(format!("--basis {}: {e}", b.name())))?;
+        for &m in &masses {
+            let mut s = with_basis.clone();
+            s.mass = m;
+            out.push(overrides.apply(s)?);
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `scenes` on up to `jobs` threads; results in the order of `scenes`.
+pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, RunError>> {
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<Result<Summary, RunError>>>> =
+        Mutex::new(vec![None; scenes.len()]);
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, scenes.len().max(1)) {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                let Some(scene) = scenes.get(k) else { break };
+                let r = simulation::run(scene, &mut |_| {});
+                if let Ok(mut all) = results.lock() {
+                    all[k] = Some(r);
+                }
+            });
+        }
+    });
+    results
+        .into_inner()
+        .unwrap_or_default()
+        .into_iter()
+        .map(|r| r.unwrap_or_else(|| Err(RunError::Setup("a run did not finish".into()))))
+        .collect()
+}
+
+const COLUMNS: [&str; 11] = [
+    "basis",
+    "mass",
+    "functions",
+    "particles",
+    "steps",
+    "error",
+    "max_condition",
+    "lumped_rows",
+    "energy_drift",
+    "stable",
+    "seconds",
+];
+
+/// Runs the comparison and prints it.
+pub fn compare(args: CompareArgs) -> Result<(), CliError> {
+    let base = read_scene(&args.scene)?;
+    let scenes = variants(&base, &args.basis, &args.mass, &args.overrides)?;
+    let jobs = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    if jobs == 0 {
+        return Err(CliError::Input("--jobs must be at least 1".into()));
+    }
+    let results = run_all(&scenes, jobs);
+    let mut summaries = Vec::new();
+    for r in results {
+        summaries.push(r.map_err(|RunError::Setup(m)| CliError::Input(m))?);
+    }
+    print_summaries(&summaries, args.format);
+    match summaries.iter().find_map(|s| s.failure.clone()) {
+        Some(reason) => Err(CliError::Numerical(format!(
+            "a variant failed: {reason} (the table shows it as unstable)"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Prints summaries side by side.
+pub fn print_summaries(summaries: &[Summary], format: Format) {
+    match format {
+        Format::Json => {
+            let all: Vec<_> = summaries.iter().map(summary_json).collect();
+            println!("{}", serde_json::Value::Array(all));
+        }
+        Format::Csv => {
+            println!("{}", COLUMNS.join(","));
+            let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
+            for s in summaries {
+                println!(
+                    "{},{},{},{},{},{},{},{},{},{},{}",
+                    s.basis,
+                    s.mass,
+                    s.functions,
+                    s.particles,
+                    s.steps,
+                    opt(s.error),
+                    opt(s.max_condition),
+                    s.max_lumped_rows,
+                    s.energy_drift,
+                    s.stable,
+                    s.seconds
+                );
+            }
+        }
+        Format::Table => {
+            let mut table = Table::new(&COLUMNS);
+            for s in summaries {
+                table.push(vec![
+                    s.basis.to_string(),
+                    s.mass.clone(),
+                    s.functions.to_string(),
+                    s.particles.to_string(),
+                    s.steps.to_string(),
+                    s.error.map_or_else(|| "-".into(), sci),
+                    s.max_condition.map_or_else(|| "-".into(), sci),
+                    s.max_lumped_rows.to_string(),
+                    sci(s.energy_drift),
+                    if s.stable { "yes" } else { "NO" }.to_string(),
+                    format!("{:.2}", s.seconds),
+                ]);
+            }
+            print!("{}", table.render());
+            if let Some(s) = summaries.first() {
+                let measure = s.error_measure.unwrap_or("none");
+                println!(
+                    "{}: error = {measure}, to t = {}; wall times measured side by side",
+                    s.scene, s.t_end
+                );
+            }
+            for s in summaries {
+                if let Some(reason) = &s.failure {
+                    println!("{} {}: {reason}", s.basis, s.mass);
+                }
+            }
+        }
+    }
+}
