@@ -476,7 +476,7 @@ pub fn parse_split(name: &str) -> Result<SplitPoint, String> {
 }
 
 /// The built-in scenes: name, one line, TOML text.
-pub const BUILTIN: [(&str, &str, &str); 6] = [
+pub const BUILTIN: [(&str, &str, &str); 10] = [
     (
         "vibrating-bar",
         "B2: elastic bar L = 25, H = 2 vibrating in its first mode (v0 = 0.1)",
@@ -496,6 +496,26 @@ pub const BUILTIN: [(&str, &str, &str); 6] = [
         "axis-aligned",
         "B4: neo-Hookean manufactured solution on an unstructured unit square",
         include_str!("../scenes/axis-aligned.toml"),
+    ),
+    (
+        "bar-large",
+        "B3: bar L = 1, W = 0.05 in its first mode at 7 % strain (the paper's variant), to t = 20",
+        include_str!("../scenes/bar-large.toml"),
+    ),
+    (
+        "bar-large-thesis",
+        "B3 as in the thesis: L = 25, H = 2, PS 8 x 1 blocks (78 functions, 20 ppe), to t = 20",
+        include_str!("../scenes/bar-large-thesis.toml"),
+    ),
+    (
+        "column-large",
+        "B5b: column H = 1, W = 0.1 at 18 % strain, one empty block row above, to t = 2.5",
+        include_str!("../scenes/column-large.toml"),
+    ),
+    (
+        "column-damped",
+        "B5c: the B5b column with local damping (alpha = 0.6) settling to equilibrium, to t = 10",
+        include_str!("../scenes/column-damped.toml"),
     ),
     (
         "vibrating-bar-1d",

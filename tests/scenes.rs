@@ -16,13 +16,15 @@ fn builtin_scene_summaries() {
         s.time.t_end = match name {
             "vibrating-bar-thesis" => 0.002,
             "axis-aligned" => 0.0045,
-            n if n.starts_with("vibrating") => 1.0,
+            n if n.starts_with("vibrating") || n.starts_with("bar") => 1.0,
             _ => 0.05,
         };
         s.output.tracked = vec![match name {
             _ if s.dim == 1 => vec![12.5],
             "axis-aligned" => vec![0.25, 0.47],
-            n if n.starts_with("vibrating") => vec![12.5, 1.0],
+            "bar-large" => vec![0.5, 0.025],
+            "column-large" | "column-damped" => vec![0.05, 0.5],
+            n if n.starts_with("vibrating") || n.starts_with("bar") => vec![12.5, 1.0],
             _ => vec![1.0, 12.5],
         }];
         let mut energies = Vec::new();
