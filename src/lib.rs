@@ -43,6 +43,7 @@ pub mod output;
 pub mod particles;
 pub mod plot;
 pub mod projection;
+pub mod reproduction;
 pub mod scene;
 pub mod simulation;
 pub mod sparse;

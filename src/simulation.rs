@@ -680,8 +680,9 @@ where
     let seconds = clock.elapsed().as_secs_f64();
     let end = driver.report();
     let parts = &driver.particles;
-    let error = solution.map(|s| match s {
-        Solution::AxisAligned(_) => rms.value(),
+    let error = solution.and_then(|s| match s {
+        // Paper eq. (47) needs at least one step.
+        Solution::AxisAligned(_) => (rms.steps() > 0).then(|| rms.value()),
         Solution::Equilibrium {
             height,
             density,
@@ -689,7 +690,7 @@ where
             young,
         } => {
             let sigma_base = (height * density * gravity).abs();
-            (0..parts.len())
+            let worst = (0..parts.len())
                 .map(|p| {
                     let y = parts.x[p][D - 1] - origin[D - 1];
                     let exact = exact::column_equilibrium_stress_linear(
@@ -701,7 +702,8 @@ where
                     );
                     (parts.sigma[p][(D - 1, D - 1)] - exact).abs() / sigma_base
                 })
-                .fold(0.0, f64::max)
+                .fold(0.0, f64::max);
+            Some(worst)
         }
         _ => {
             // Thesis eq. (4.4): E_u = sqrt(Σ_p V_p |û_p − u(x_p⁰, t)|²).
@@ -711,7 +713,7 @@ where
                 let d2: f64 = (0..D).map(|k| (parts.u[p][k] - exact[k]).powi(2)).sum();
                 err2 += parts.volume[p] * d2;
             }
-            err2.sqrt()
+            Some(err2.sqrt())
         }
     });
     let scale = scale.max(f64::MIN_POSITIVE);

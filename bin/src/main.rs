@@ -7,6 +7,7 @@ mod compare;
 mod converge;
 mod error;
 mod project;
+mod reproduce;
 mod run;
 mod scenes;
 mod table;
@@ -66,6 +67,11 @@ enum Command {
     /// (polygon meshes: edge length / 2^l). With --out, also writes the log-log
     /// error-vs-h and work-precision (error vs wall time) plots.
     Converge(converge::ConvergeArgs),
+    /// Reproduce the seeds' benchmarks B2–B5: tables (markdown) and SVG figures.
+    ///
+    /// The full studies take about 15 minutes on 2 cores; --quick runs the coarse
+    /// versions the test suite pins.
+    Reproduce(reproduce::ReproduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -77,6 +83,7 @@ fn main() -> ExitCode {
         Command::Scene(command) => scenes::scene(command),
         Command::Compare(args) => compare::compare(args),
         Command::Converge(args) => converge::converge(args),
+        Command::Reproduce(args) => reproduce::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
