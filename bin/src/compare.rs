@@ -188,9 +188,11 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
             print!("{}", table.render());
             if let Some(s) = summaries.first() {
                 let measure = s.error_measure.unwrap_or("none");
+                let t_end = summaries.iter().map(|s| s.t_end).fold(0.0, f64::max);
                 println!(
-                    "{}: error = {measure}, to t = {}; wall times measured side by side",
-                    s.scene, s.t_end
+                    "{}: error {measure} at the end (or where a run stopped), t = {}; wall times measured side by side",
+                    s.scene,
+                    (t_end * 1e9).round() / 1e9
                 );
             }
             for s in summaries {

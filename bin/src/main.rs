@@ -3,6 +3,7 @@
 //! Exit status: 0 on success, 2 for usage and input errors (unknown basis, bad
 //! mesh file, value out of range), 1 for a computation that failed numerically.
 
+mod basis_cmd;
 mod compare;
 mod converge;
 mod error;
@@ -69,9 +70,13 @@ enum Command {
     Converge(converge::ConvergeArgs),
     /// Reproduce the seeds' benchmarks B2–B5: tables (markdown) and SVG figures.
     ///
-    /// The full studies take about 15 minutes on 2 cores; --quick runs the coarse
+    /// The full studies take about 2 minutes on one core; --quick runs the coarse
     /// versions the test suite pins.
     Reproduce(reproduce::ReproduceArgs),
+    /// Pictures of the bases: a mesh with its PS refinement and control triangles,
+    /// or one basis function.
+    #[command(subcommand)]
+    Basis(basis_cmd::BasisCommand),
 }
 
 fn main() -> ExitCode {
@@ -84,6 +89,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::compare(args),
         Command::Converge(args) => converge::converge(args),
         Command::Reproduce(args) => reproduce::run(args),
+        Command::Basis(command) => basis_cmd::basis(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,125 @@
+//! `mpm-cli basis plot`: the pictures a teacher shows when explaining Powell–Sabin
+//! splines: a mesh with its PS refinement, PS points and control triangles, or one
+//! basis function as a shaded surface.
+
+use crate::error::CliError;
+use crate::run::{pair, read_scene};
+use psmpm::bases::BasisKind;
+use psmpm::basis::basis::linear::Linear;
+use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+use psmpm::basis::mesh::generators::block_grid;
+use psmpm::basis::{Basis, TriMesh};
+use psmpm::plot::{basis_function_plot, mesh_plot, BasisPlotOptions, MeshPlotOptions};
+use psmpm::scene::parse_split;
+use std::path::PathBuf;
+
+/// `mpm-cli basis ...`.
+#[derive(Debug, clap::Subcommand)]
+pub enum BasisCommand {
+    /// Draw a mesh with its PS refinement and control triangles, or (with
+    /// --function K) basis function K as a shaded plot, as SVG.
+    ///
+    /// The mesh is the block grid of --blocks on the unit square (default 2x2), the
+    /// mesh of a scene (--scene NAME or FILE.toml), or a Gmsh file (--mesh FILE.msh).
+    Plot(PlotArgs),
+}
+
+/// Arguments of `mpm-cli basis plot`.
+#[derive(Debug, clap::Args)]
+pub struct PlotArgs {
+    /// Block grid NXxNY of the unit square (4 triangles per block).
+    #[arg(long, value_name = "NXxNY", conflicts_with_all = ["scene", "mesh"])]
+    blocks: Option<String>,
+    /// Use the mesh of this scene (built-in name or FILE.toml).
+    #[arg(long, conflicts_with = "mesh")]
+    scene: Option<String>,
+    /// Use this Gmsh mesh.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// Draw basis function K instead of the mesh.
+    #[arg(long, value_name = "K")]
+    function: Option<usize>,
+    /// Basis of the function plot: ps or pl.
+    #[arg(long, default_value = "ps")]
+    basis: String,
+    /// PS split points: incentre or centroid.
+    #[arg(long, default_value = "incentre")]
+    split: String,
+    /// Output file.
+    #[arg(long, default_value = "basis.svg")]
+    out: PathBuf,
+}
+
+fn mesh(args: &PlotArgs) -> Result<TriMesh, CliError> {
+    if let Some(path) = &args.mesh {
+        return psmpm::basis::mesh::gmsh::read_msh(path)
+            .map_err(|e| CliError::Input(e.to_string()));
+    }
+    if let Some(name) = &args.scene {
+        let scene = read_scene(name)?;
+        if scene.dim != 2 {
+            return Err(CliError::Input(format!(
+                "--scene: `{name}` is 1D; basis plots are 2D"
+            )));
+        }
+        return psmpm::simulation::triangulation(&scene)
+            .map_err(|e| CliError::Input(e.to_string()));
+    }
+    let (nx, ny) = pair(args.blocks.as_deref().unwrap_or("2x2"), "--blocks")?;
+    if nx == 0 || ny == 0 || nx > 64 || ny > 64 {
+        return Err(CliError::Input(format!(
+            "--blocks: each count must be in 1..=64 for a picture, got {nx}x{ny}"
+        )));
+    }
+    block_grid(0.0, nx as f64, 0.0, ny as f64, nx, ny).map_err(|e| CliError::Input(e.to_string()))
+}
+
+/// Runs a `basis` subcommand.
+pub fn basis(command: BasisCommand) -> Result<(), CliError> {
+    let BasisCommand::Plot(args) = command;
+    let split: SplitPoint =
+        parse_split(&args.split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
+    let kind =
+        BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+    let mesh = mesh(&args)?;
+    let plot_error =
+        |e: psmpm::plot::PlotError| CliError::Input(format!("{}: {e}", args.out.display()));
+    let functions = match (args.function, kind) {
+        (None, BasisKind::Ps) => {
+            let ps = PowellSabin::<f64>::new(mesh, split).map_err(|e| CliError::Input(e.to_string()))?;
+            let options = MeshPlotOptions {
+                title: format!(
+                    "Powell–Sabin refinement and control triangles ({} triangles, {} functions)",
+                    ps.mesh().num_triangles(),
+                    ps.num_functions()
+                ),
+                ..MeshPlotOptions::default()
+            };
+            mesh_plot(&args.out, &ps, &options).map_err(plot_error)?;
+            ps.num_functions()
+        }
+        (None, _) => {
+            return Err(CliError::Input(
+                "--basis: the mesh picture shows the PS refinement; use --basis ps, or --function K for a PL function".into(),
+            ))
+        }
+        (Some(k), BasisKind::Ps) => {
+            let ps = PowellSabin::<f64>::new(mesh, split).map_err(|e| CliError::Input(e.to_string()))?;
+            basis_function_plot(&args.out, &ps, k, &BasisPlotOptions::default()).map_err(plot_error)?;
+            ps.num_functions()
+        }
+        (Some(k), BasisKind::Pl) => {
+            let pl = Linear::<f64>::new(mesh);
+            basis_function_plot(&args.out, &pl, k, &BasisPlotOptions::default()).map_err(plot_error)?;
+            pl.num_functions()
+        }
+        (Some(_), other) => {
+            return Err(CliError::Input(format!(
+                "--basis: `{}` is 1D; basis plots are 2D (ps or pl)",
+                other.name()
+            )))
+        }
+    };
+    println!("wrote {} ({functions} functions)", args.out.display());
+    Ok(())
+}
