@@ -1,0 +1,169 @@
+//! The effects a scene can declare, each checked against what it must do physically:
+//! traction and damping reach the static solution, a body force does what gravity
+//! does with its work booked instead of a potential, a geostatic initial stress
+//! holds a column at rest, and damping's work closes the energy balance.
+
+use psmpm::scene::{
+    Body, BoundaryCondition, Component, EffectSpec, InitialVelocity, MaterialModel, MaterialSpec,
+    MeshSpec, Reference, Scene, TimeSpec,
+};
+use psmpm::simulation::{run, run_1d, run_2d};
+
+/// A 1D bar `[0, 1]`, E = 100, ρ = 1, fixed at x = 0, with `effects`.
+fn bar_1d(effects: Vec<EffectSpec>, t_end: f64) -> Scene {
+    let mut s = Scene::builtin("vibrating-bar-1d").unwrap();
+    s.name = "bar".into();
+    s.mesh = MeshSpec::Interval {
+        x: [0.0, 1.0],
+        elements: 8,
+    };
+    s.material = MaterialSpec {
+        model: MaterialModel::LinearElastic,
+        young: 100.0,
+        poisson: 0.0,
+        density: 1.0,
+    };
+    s.bodies = vec![Body {
+        min: vec![0.0],
+        max: vec![1.0],
+        per_block: Some(vec![4]),
+        count: None,
+    }];
+    s.initial_velocity = InitialVelocity::Rest;
+    s.boundaries = vec![BoundaryCondition {
+        tag: "left".into(),
+        fix: vec![Component::X],
+    }];
+    s.effects = effects;
+    s.time = TimeSpec {
+        dt: Some(1e-3),
+        courant: None,
+        t_end,
+    };
+    s.reference = None;
+    s.resolutions.clear();
+    s.validate().unwrap();
+    s
+}
+
+#[test]
+fn traction_with_damping_settles_to_the_static_solution() {
+    // A compressive traction t = −2 on the last particle (x0 = 0.984): σ = t below
+    // it, so u(x0) = t x0 / E exactly for the linear law on F (compressive, so that
+    // the bar stays inside its mesh).
+    let s = bar_1d(
+        vec![
+            EffectSpec::Traction {
+                min: vec![0.97],
+                max: vec![1.0],
+                traction: vec![-2.0],
+                length: 1.0,
+                ramp: 0.5,
+            },
+            EffectSpec::Damping { alpha: 0.6 },
+        ],
+        10.0,
+    );
+    let mut kinetic = Vec::new();
+    let out = run_1d(&s, &mut |r| kinetic.push(r.kinetic)).unwrap();
+    assert!(out.summary.stable, "{:?}", out.summary);
+    let p = &out.particles;
+    // Away from the loaded particle (the C¹ basis spreads its point load over about
+    // an element, 0.125).
+    for k in (0..p.len()).filter(|&k| p.x0[k][0] < 0.84) {
+        let exact = -2.0 * p.x0[k][0] / 100.0;
+        assert!(
+            (p.u[k][0] - exact).abs() < 2e-3 * 0.02,
+            "particle {k} at {}: u = {}, exact {exact}",
+            p.x0[k][0],
+            p.u[k][0]
+        );
+    }
+    // At rest, and the energy balance (with the traction's and damping's work) closed.
+    let peak = kinetic.iter().copied().fold(0.0, f64::max);
+    let last = *kinetic.last().unwrap();
+    assert!(last < 1e-6 * peak, "kinetic {last} of peak {peak}");
+    assert!(
+        out.summary.energy_drift < 2e-2,
+        "{}",
+        out.summary.energy_drift
+    );
+}
+
+#[test]
+fn a_body_force_moves_the_column_as_gravity_does_and_books_its_work() {
+    let mut gravity = Scene::builtin("column-small").unwrap();
+    gravity.time.t_end = 0.05;
+    gravity.reference = None;
+    let mut body = gravity.clone();
+    body.effects = vec![EffectSpec::BodyForce {
+        value: vec![0.0, -9.81],
+    }];
+    let (mut g_energy, mut b_energy) = (Vec::new(), Vec::new());
+    let g = run_2d(&gravity, &mut |r| g_energy.push((r.potential, r.work))).unwrap();
+    let b = run_2d(&body, &mut |r| b_energy.push((r.potential, r.work))).unwrap();
+    for (pg, pb) in g.particles.u.iter().zip(&b.particles.u) {
+        assert!(
+            (pg - pb).norm() <= 1e-12 * pg.norm().max(1e-12),
+            "{pg} vs {pb}"
+        );
+    }
+    // Gravity has a potential and no work; the body force the other way round, and
+    // the work equals the drop in gravitational potential to the integrator's order.
+    let (g_last, b_last) = (g_energy.last().unwrap(), b_energy.last().unwrap());
+    assert_eq!(g_last.1, 0.0);
+    assert_eq!(b_last.0, 0.0);
+    let potential_drop = g_energy[0].0 - g_last.0;
+    assert!(
+        (b_last.1 - potential_drop).abs() < 1e-2 * potential_drop.abs(),
+        "work {} vs potential drop {potential_drop}",
+        b_last.1
+    );
+    assert!(g.summary.energy_drift < 1e-3 && b.summary.energy_drift < 1e-3);
+}
+
+#[test]
+fn a_geostatic_initial_stress_holds_the_column_at_rest() {
+    let mut plain = Scene::builtin("column-small").unwrap();
+    plain.time.t_end = 0.05;
+    plain.reference = None;
+    let mut geostatic = plain.clone();
+    geostatic.effects.push(EffectSpec::GeostaticStress {
+        surface: 25.0,
+        k0: 0.0,
+    });
+    let speed = |s: &Scene| {
+        let mut max = 0.0f64;
+        run(s, &mut |r| max = max.max(r.max_speed)).unwrap();
+        max
+    };
+    let (v_plain, v_geo) = (speed(&plain), speed(&geostatic));
+    // What remains is the particle quadrature's imbalance of the discrete internal
+    // force against the weight (measured: 6 % of the free settling speed).
+    assert!(v_plain > 0.1, "{v_plain}");
+    assert!(
+        v_geo < 0.1 * v_plain,
+        "geostatic {v_geo} vs plain {v_plain}"
+    );
+}
+
+#[test]
+fn damping_brings_the_column_to_rest_with_its_work_in_the_balance() {
+    let mut s = Scene::builtin("column-damped").unwrap();
+    s.time.t_end = 3.0;
+    assert!(matches!(s.reference, Some(Reference::ColumnEquilibrium)));
+    let mut history = Vec::new();
+    let summary = run(&s, &mut |r| history.push((r.kinetic, r.work))).unwrap();
+    assert!(summary.stable, "{summary:?}");
+    let peak = history.iter().map(|h| h.0).fold(0.0, f64::max);
+    let last = history.last().unwrap();
+    assert!(last.0 < 1e-2 * peak, "kinetic {} of peak {peak}", last.0);
+    // Damping only removes energy: its work is negative and the balance closes.
+    assert!(last.1 < 0.0);
+    assert!(summary.energy_drift < 1e-2, "{}", summary.energy_drift);
+    assert!(
+        summary.error.unwrap() < 0.1,
+        "σ_yy error {:?}",
+        summary.error
+    );
+}
