@@ -1,0 +1,305 @@
+//! `scenes`, `scene show`, `compare`, `converge` and `basis plot`: output pinned with
+//! snapshots (wall times removed), round trips, and determinism across threads.
+
+use assert_cmd::Command;
+use serde_json::Value;
+
+fn cli() -> Command {
+    Command::cargo_bin("mpm-cli").unwrap()
+}
+
+fn stdout(args: &[&str]) -> String {
+    let out = cli().args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("psmpm-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Drops the `seconds` values (the only machine-dependent numbers) from JSON.
+fn without_seconds(mut v: Value) -> Value {
+    match &mut v {
+        Value::Object(map) => {
+            map.remove("seconds");
+            for (_, x) in map.iter_mut() {
+                *x = without_seconds(x.take());
+            }
+        }
+        Value::Array(items) => {
+            for x in items.iter_mut() {
+                *x = without_seconds(x.take());
+            }
+        }
+        _ => {}
+    }
+    v
+}
+
+/// Rounds every float to 4 significant digits so that snapshots are stable.
+fn rounded(v: Value) -> Value {
+    match v {
+        Value::Number(n) if n.is_f64() => {
+            let x = n.as_f64().unwrap();
+            let r: f64 = format!("{x:.3e}").parse().unwrap();
+            serde_json::json!(r)
+        }
+        Value::Object(map) => {
+            Value::Object(map.into_iter().map(|(k, x)| (k, rounded(x))).collect())
+        }
+        Value::Array(items) => Value::Array(items.into_iter().map(rounded).collect()),
+        other => other,
+    }
+}
+
+#[test]
+fn scenes_lists_every_builtin_in_every_format() {
+    let table = stdout(&["scenes"]);
+    insta::assert_snapshot!("scenes_table", table);
+    let json: Value = serde_json::from_str(&stdout(&["scenes", "--format", "json"])).unwrap();
+    let names: Vec<&str> = json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    let expected: Vec<&str> = psmpm::scene::BUILTIN.iter().map(|b| b.0).collect();
+    assert_eq!(names, expected);
+    let csv = stdout(&["scenes", "--format", "csv"]);
+    assert_eq!(csv.lines().count(), expected.len() + 1);
+    assert!(csv.starts_with("name,dim,basis,error,description\n"));
+}
+
+#[test]
+fn scene_show_round_trips_for_every_builtin_scene() {
+    let dir = temp_dir("show");
+    for (name, _, _) in psmpm::scene::BUILTIN {
+        let text = stdout(&["scene", "show", name]);
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, &text).unwrap();
+        // `run` accepts it back, and it is the same scene.
+        let back = psmpm::scene::Scene::from_toml(&text, "shown").unwrap();
+        assert_eq!(back, psmpm::scene::Scene::builtin(name).unwrap(), "{name}");
+        // A normalised file shows as TOML that parses to the same scene again.
+        let again = stdout(&["scene", "show", path.to_str().unwrap()]);
+        assert_eq!(
+            psmpm::scene::Scene::from_toml(&again, "again").unwrap(),
+            back,
+            "{name}"
+        );
+    }
+    let out = cli()
+        .args([
+            "run",
+            dir.join("vibrating-bar-1d.toml").to_str().unwrap(),
+            "--t-end",
+            "0.01",
+            "--diag-every",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn compare_ps_and_pl_side_by_side_identically_on_one_and_two_threads() {
+    let args = [
+        "compare",
+        "vibrating-bar",
+        "--basis",
+        "ps,pl",
+        "--t-end",
+        "1",
+        "--condition",
+        "--format",
+        "json",
+    ];
+    let one = without_seconds(
+        serde_json::from_str(&stdout(&[&args[..], &["--jobs", "1"]].concat())).unwrap(),
+    );
+    let two = without_seconds(
+        serde_json::from_str(&stdout(&[&args[..], &["--jobs", "2"]].concat())).unwrap(),
+    );
+    // Bit-identical results whatever the thread count.
+    assert_eq!(one, two);
+    let rows = one.as_array().unwrap();
+    assert_eq!(rows[0]["basis"], "ps");
+    assert_eq!(rows[0]["functions"], 42);
+    assert_eq!(rows[1]["basis"], "pl");
+    assert_eq!(rows[1]["functions"], 38);
+    insta::assert_json_snapshot!("compare_vibrating_bar", rounded(one));
+    let table = stdout(&[
+        "compare",
+        "vibrating-bar",
+        "--basis",
+        "ps,pl",
+        "--t-end",
+        "1",
+    ]);
+    let header: Vec<&str> = table.lines().next().unwrap().split_whitespace().collect();
+    assert_eq!(
+        header,
+        [
+            "basis",
+            "mass",
+            "functions",
+            "particles",
+            "steps",
+            "error",
+            "max_condition",
+            "lumped_rows",
+            "energy_drift",
+            "stable",
+            "seconds"
+        ]
+    );
+    let csv = stdout(&[
+        "compare",
+        "vibrating-bar",
+        "--basis",
+        "ps,pl",
+        "--t-end",
+        "1",
+        "--format",
+        "csv",
+    ]);
+    assert_eq!(csv.lines().count(), 3);
+}
+
+#[test]
+fn converge_prints_levels_orders_and_writes_its_plots() {
+    let dir = temp_dir("converge");
+    let json = stdout(&[
+        "converge",
+        "vibrating-bar-1d",
+        "--levels",
+        "3",
+        "--t-end",
+        "0.02",
+        "--dt",
+        "1e-5",
+        "--particles",
+        "16x1",
+        "--format",
+        "json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let rows: Value = without_seconds(serde_json::from_str(&json).unwrap());
+    for row in rows.as_array().unwrap() {
+        for key in [
+            "basis",
+            "level",
+            "h",
+            "functions",
+            "particles",
+            "error",
+            "order",
+        ] {
+            assert!(row.get(key).is_some(), "missing {key}");
+        }
+    }
+    // Orders: B-spline about 3, 1D PL about 2 (the B2 bar in 1D).
+    let order = |basis: &str, level: u64| {
+        rows.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["basis"] == basis && r["level"] == level)
+            .unwrap()["order"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(order("bspline", 2) > 2.7, "{}", order("bspline", 2));
+    assert!(
+        (1.8..2.3).contains(&order("pl1d", 2)),
+        "{}",
+        order("pl1d", 2)
+    );
+    insta::assert_json_snapshot!("converge_vibrating_bar_1d", rounded(rows));
+    for file in [
+        "converge.csv",
+        "converge.json",
+        "error-vs-h.svg",
+        "work-precision.svg",
+    ] {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        assert!(!text.is_empty(), "{file}");
+        if file.ends_with(".svg") {
+            assert!(
+                text.contains("BSPLINE") && text.contains("PL1D"),
+                "{file}: legend"
+            );
+            // One data line per basis, in the first two series colours.
+            for colour in ["#1F77B4", "#FF7F0E"] {
+                let lines = text
+                    .split("<polyline")
+                    .skip(1)
+                    .filter(|l| l.contains(&format!("stroke=\"{colour}\"")))
+                    .count();
+                assert_eq!(lines, 1, "{file}: {colour}");
+            }
+            assert!(
+                !text.contains("stroke=\"#2CA02C\""),
+                "{file}: a third curve"
+            );
+        }
+    }
+    let table = stdout(&[
+        "converge",
+        "vibrating-bar-1d",
+        "--levels",
+        "2",
+        "--t-end",
+        "0.02",
+    ]);
+    assert!(table.starts_with("  basis  level"), "{table}");
+}
+
+#[test]
+fn basis_plot_draws_the_ps_mesh_and_a_function() {
+    let dir = temp_dir("basis");
+    let mesh = dir.join("mesh.svg");
+    let function = dir.join("function.svg");
+    assert!(stdout(&["basis", "plot", "--out", mesh.to_str().unwrap()]).contains("39 functions"));
+    stdout(&[
+        "basis",
+        "plot",
+        "--function",
+        "12",
+        "--out",
+        function.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(&mesh).unwrap();
+    assert!(text.contains("control triangles"));
+    assert_eq!(
+        text.matches("<polygon").count(),
+        13,
+        "one control triangle per vertex"
+    );
+    assert!(std::fs::read_to_string(&function).unwrap().contains("<svg"));
+    let out = cli()
+        .args([
+            "basis",
+            "plot",
+            "--function",
+            "39",
+            "--out",
+            function.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("0..39"));
+}
