@@ -168,6 +168,7 @@ where
     /// Scratch for [`Effect::adjust_forces`]; empty without effects.
     adjust: Vec<Vec<T>>,
     work: f64,
+    constraints: Constraints<T, D>,
     occupied: Vec<bool>,
     touches_empty: Vec<bool>,
     last_report: MassReport,
@@ -197,6 +198,7 @@ where
     ) -> Result<Self, SetupError> {
         let n = basis.num_functions();
         let mut fixed = vec![vec![false; n]; D];
+        let mut general: Vec<Vec<(usize, usize, T)>> = Vec::new();
         for fix in fixes {
             if fix.component >= D {
                 return Err(SetupError::Boundary {
@@ -208,13 +210,16 @@ where
             direction[fix.component] = T::one();
             let constraints = basis.dirichlet(&fix.tag, &direction)?;
             for c in constraints {
-                if !c.is_single() {
-                    return Err(SetupError::Boundary {
-                        tag: fix.tag.clone(),
-                        message: "the basis needs general (multi-term) constraints here, which the driver does not support yet; use a straight boundary".into(),
-                    });
+                if c.is_single() {
+                    fixed[fix.component][c.terms[0].0] = true;
+                } else {
+                    general.push(
+                        c.terms
+                            .iter()
+                            .map(|&(i, w)| (fix.component, i, w))
+                            .collect(),
+                    );
                 }
-                fixed[fix.component][c.terms[0].0] = true;
             }
         }
         for p in 0..particles.len() {
@@ -250,6 +255,7 @@ where
             work_force,
             adjust,
             work: 0.0,
+            constraints: Constraints::new(general, n),
             len: vec![0; np],
             occupied: vec![false; basis.num_elements()],
             touches_empty: vec![false; n],
@@ -271,6 +277,28 @@ where
             time: 0.0,
             last_report: MassReport::default(),
         })
+    }
+
+    /// Adds a slip wall: the velocity component along the unit vector `normal`
+    /// vanishes on the boundary tagged `tag` (for an oblique straight wall, its
+    /// normal). The constraints couple the components of each coefficient and are
+    /// imposed exactly by projection in the mass-matrix norm (see [`Constraints`]).
+    pub fn add_slip_wall(&mut self, tag: &str, normal: &SVector<T, D>) -> Result<(), SetupError> {
+        let constraints = self.basis.dirichlet(tag, normal)?;
+        let mut general = std::mem::take(&mut self.constraints.rows);
+        for c in constraints {
+            let mut row = Vec::new();
+            for &(i, w) in &c.terms {
+                for k in 0..D {
+                    if normal[k] != T::zero() {
+                        row.push((k, i, w * normal[k]));
+                    }
+                }
+            }
+            general.push(row);
+        }
+        self.constraints = Constraints::new(general, self.basis.num_functions());
+        Ok(())
     }
 
     /// Current time.
@@ -415,6 +443,7 @@ where
         for k in 0..D {
             self.mass.solve(k, &mut self.velocity[k]);
         }
+        self.constraints.project(&mut self.velocity);
     }
 
     /// Advances one time step.
@@ -443,6 +472,7 @@ where
             .then(|| self.mass.condition_estimate(&self.pattern));
         // Power of the non-conservative forces with the velocity at the start of the
         // step, v̂ⁿ (at the first step projected from the initial particle velocities).
+        self.constraints.prepare(&mut self.mass);
         let power_start = if self.work_force.is_empty() {
             0.0
         } else {
@@ -454,6 +484,7 @@ where
         for k in 0..D {
             self.mass.solve(k, &mut self.rhs[k]);
         }
+        self.constraints.project(&mut self.rhs);
         let mut t_solve = clock.elapsed().as_secs_f64() - t_assemble;
         // eq. (18): particle velocities; eq. (21): momentum P into `velocity`.
         for v in &mut self.velocity {
@@ -482,6 +513,7 @@ where
         for k in 0..D {
             self.mass.solve(k, &mut self.velocity[k]);
         }
+        self.constraints.project(&mut self.velocity);
         let after_projection = clock.elapsed().as_secs_f64();
         // Work of the non-conservative effects over the step with the mean of the
         // start and end velocities, the rule under which the kinetic energy of the
@@ -595,6 +627,158 @@ fn power<T: Scalar>(force: &[Vec<T>], velocity: &[Vec<T>]) -> f64 {
         }
     }
     power
+}
+
+/// General linear constraints `Σ_e w_e a[k_e][i_e] = 0` on the coefficients (a
+/// wall whose constraint couples several functions or both components of one),
+/// imposed exactly: with the step's mass operator `M` (block-diagonal over
+/// components, as the strategy modified it), the constrained minimiser of
+/// `½ aᵀ M a − aᵀ F` is `a = a₀ − W S⁻¹ C a₀` with `a₀ = M⁻¹ F`, `W = M⁻¹ Cᵀ` and
+/// `S = C W`. `W` and `S` are formed once per step (one solve per constraint and
+/// component); each projection is then a small dense solve. Buffers are sized
+/// once; a constraint whose functions are all inactive (zero pivot) is skipped.
+pub struct Constraints<T: Scalar, const D: usize> {
+    rows: Vec<Vec<(usize, usize, T)>>,
+    /// `W[c][k]`: component `k` of `M⁻¹ Cᵀ e_c`.
+    w: Vec<Vec<Vec<T>>>,
+    /// `S = C W`, then its Cholesky factor (row-major, lower triangle).
+    s: Vec<f64>,
+    /// Pivot kept (`false` for constraints on inactive functions).
+    keep: Vec<bool>,
+    lambda: Vec<f64>,
+}
+
+impl<T: Scalar, const D: usize> Constraints<T, D> {
+    fn new(rows: Vec<Vec<(usize, usize, T)>>, n: usize) -> Self {
+        let m = rows.len();
+        Constraints {
+            w: vec![vec![vec![T::zero(); n]; D]; m],
+            s: vec![0.0; m * m],
+            keep: vec![false; m],
+            lambda: vec![0.0; m],
+            rows,
+        }
+    }
+
+    /// Number of general constraints.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// `true` without general constraints.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// Forms `W` and the Cholesky factor of `S` with the strategy's factorisation.
+    fn prepare<M: MassStrategy<T>>(&mut self, mass: &mut M) {
+        let m = self.rows.len();
+        if m == 0 {
+            return;
+        }
+        for (c, row) in self.rows.iter().enumerate() {
+            for k in 0..D {
+                let w = &mut self.w[c][k];
+                w.iter_mut().for_each(|v| *v = T::zero());
+                let mut any = false;
+                for &(kk, i, weight) in row {
+                    if kk == k {
+                        w[i] += weight;
+                        any = true;
+                    }
+                }
+                if any {
+                    mass.solve(k, w);
+                }
+            }
+        }
+        for c in 0..m {
+            for d in 0..m {
+                self.s[c * m + d] = self.rows[c]
+                    .iter()
+                    .map(|&(k, i, weight)| (weight * self.w[d][k][i]).to_f64())
+                    .sum();
+            }
+        }
+        // In-place Cholesky, skipping the pivots that vanish relative to their own
+        // diagonal (constraints on inactive functions, or dependent on earlier ones;
+        // the scale differs wildly between rows: `S_cc ~ 1 / M_ii`).
+        for j in 0..m {
+            let diagonal = self.s[j * m + j];
+            let mut d = diagonal;
+            for k in 0..j {
+                if self.keep[k] {
+                    d -= self.s[j * m + k] * self.s[j * m + k];
+                }
+            }
+            self.keep[j] = d > 1e-10 * diagonal && diagonal > 0.0;
+            if !self.keep[j] {
+                continue;
+            }
+            let d = d.sqrt();
+            self.s[j * m + j] = d;
+            for i in j + 1..m {
+                let mut v = self.s[i * m + j];
+                for k in 0..j {
+                    if self.keep[k] {
+                        v -= self.s[i * m + k] * self.s[j * m + k];
+                    }
+                }
+                self.s[i * m + j] = v / d;
+            }
+        }
+    }
+
+    /// Projects the solved coefficients `a` onto the constraints.
+    fn project(&mut self, a: &mut [Vec<T>]) {
+        let m = self.rows.len();
+        if m == 0 {
+            return;
+        }
+        for (c, row) in self.rows.iter().enumerate() {
+            self.lambda[c] = row
+                .iter()
+                .map(|&(k, i, weight)| (weight * a[k][i]).to_f64())
+                .sum();
+        }
+        // S λ = C a: forward and back substitution with the kept pivots.
+        for j in 0..m {
+            if !self.keep[j] {
+                self.lambda[j] = 0.0;
+                continue;
+            }
+            let mut v = self.lambda[j];
+            for k in 0..j {
+                if self.keep[k] {
+                    v -= self.s[j * m + k] * self.lambda[k];
+                }
+            }
+            self.lambda[j] = v / self.s[j * m + j];
+        }
+        for j in (0..m).rev() {
+            if !self.keep[j] {
+                continue;
+            }
+            let mut v = self.lambda[j];
+            for i in j + 1..m {
+                if self.keep[i] {
+                    v -= self.s[i * m + j] * self.lambda[i];
+                }
+            }
+            self.lambda[j] = v / self.s[j * m + j];
+        }
+        for c in 0..m {
+            let l = T::of(self.lambda[c]);
+            if self.lambda[c] == 0.0 {
+                continue;
+            }
+            for k in 0..D {
+                for (x, w) in a[k].iter_mut().zip(&self.w[c][k]) {
+                    *x -= l * *w;
+                }
+            }
+        }
+    }
 }
 
 fn zero<T: Scalar>(buffers: &mut [Vec<T>]) {

@@ -278,7 +278,8 @@ pub enum InitialVelocity {
 pub struct BoundaryCondition {
     /// Boundary tag.
     pub tag: String,
-    /// Velocity components held at zero: `x`, `y`.
+    /// Velocity components held at zero: `x`, `y`, or `normal` (a slip wall: the
+    /// component along the wall's normal; the wall must be straight).
     pub fix: Vec<Component>,
 }
 
@@ -290,15 +291,24 @@ pub enum Component {
     X,
     /// Second axis.
     Y,
+    /// The normal of a straight wall (a slip wall, oblique or not).
+    Normal,
 }
 
 impl Component {
-    /// Axis index.
-    pub fn index(self) -> usize {
+    /// Axis index (`None` for the wall normal).
+    pub fn axis(self) -> Option<usize> {
         match self {
-            Component::X => 0,
-            Component::Y => 1,
+            Component::X => Some(0),
+            Component::Y => Some(1),
+            Component::Normal => None,
         }
+    }
+
+    /// Axis index of `x` and `y`; the normal counts as axis 0 (for `study.refine`,
+    /// where only axes are meaningful and validation rejects `normal`).
+    pub fn index(self) -> usize {
+        self.axis().unwrap_or(0)
     }
 }
 
@@ -871,7 +881,13 @@ impl Scene {
             if bc.fix.is_empty() {
                 return Err(bad(format!("boundary[{i}].fix"), "lists no component"));
             }
-            if let Some(c) = bc.fix.iter().find(|c| c.index() >= d) {
+            if bc.fix.contains(&Component::Normal) && bc.fix.len() > 1 {
+                return Err(bad(
+                    format!("boundary[{i}].fix"),
+                    "`normal` fixes the normal component alone; list it on its own",
+                ));
+            }
+            if let Some(c) = bc.fix.iter().find(|c| c.axis().is_some_and(|a| a >= d)) {
                 return Err(bad(
                     format!("boundary[{i}].fix"),
                     format!("component `{c:?}` does not exist in {d}D").to_lowercase(),
@@ -933,6 +949,9 @@ impl Scene {
             _ => return Err(bad("time.dt", "give exactly one of `dt` and `courant`")),
         }
         positive("time.t_end", self.time.t_end)?;
+        if self.study.refine.contains(&Component::Normal) {
+            return Err(bad("study.refine", "lists axes, `x` or `y`"));
+        }
         for (i, t) in self.output.tracked.iter().enumerate() {
             vector(&format!("output.tracked[{i}]"), t)?;
         }

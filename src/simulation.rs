@@ -22,7 +22,7 @@ use crate::mass::{Lumped, MassKind, MassStrategy, SparseMass};
 use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
 use crate::particles::Particles;
 use crate::scene::{
-    BlockLayout, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference, Scene,
+    BlockLayout, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference, Scene,
 };
 use nalgebra::{SMatrix, SVector};
 use psmpm_basis::basis::bspline1d::QuadraticBSpline;
@@ -174,10 +174,27 @@ pub fn run(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Summar
 
 /// Runs `scene` (1D or 2D), showing every step's report and particles to `observer`.
 pub fn observe(scene: &Scene, observer: &mut Observer) -> Result<Summary, RunError> {
+    let mut steps_only = |r: &StepReport, p: ParticlesRef<'_>| {
+        if r.step > 0 {
+            observer(r, p)
+        }
+    };
     match scene.dim {
-        2 => run_2d_observed(scene, observer).map(|o| o.summary),
-        _ => run_1d_observed(scene, observer).map(|o| o.summary),
+        2 => run_2d_observed(scene, &mut steps_only).map(|o| o.summary),
+        _ => run_1d_observed(scene, &mut steps_only).map(|o| o.summary),
     }
+}
+
+/// Runs a 2D scene, showing `observer` the initial state (a report with `step == 0`)
+/// and then every step, and returns its particles and tracked histories.
+pub fn observe_2d(scene: &Scene, observer: &mut Observer) -> Result<Outcome<2>, RunError> {
+    run_2d_observed(scene, observer)
+}
+
+/// Runs a 1D scene, showing `observer` the initial state (a report with `step == 0`)
+/// and then every step, and returns its particles and tracked histories.
+pub fn observe_1d(scene: &Scene, observer: &mut Observer) -> Result<Outcome<1>, RunError> {
+    run_1d_observed(scene, observer)
 }
 
 /// The mesh of a 2D scene and its smallest edge length.
@@ -228,6 +245,43 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
     Ok(mesh)
 }
 
+/// The unit normal of every slip wall (`fix = ["normal"]`): the boundary edges with
+/// the wall's tag must all be parallel (a straight wall).
+fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>, RunError> {
+    let mut walls = Vec::new();
+    for (b, bc) in scene.boundaries.iter().enumerate() {
+        if !bc.fix.contains(&Component::Normal) {
+            continue;
+        }
+        let id = mesh
+            .tag_id(&bc.tag)
+            .map_err(|e| RunError::Setup(format!("boundary[{b}].tag: {e}")))?;
+        let mut normal: Option<Vec2> = None;
+        for e in mesh.edges().iter().filter(|e| e.tag == Some(id)) {
+            let d = mesh.vertices()[e.vertices[1]] - mesh.vertices()[e.vertices[0]];
+            let n = Vec2::new(d[1], -d[0]).normalize();
+            match normal {
+                None => normal = Some(n),
+                Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > 1e-9 => {
+                    return Err(RunError::Setup(format!(
+                        "boundary[{b}].fix: `normal` needs a straight wall, but `{}` bends",
+                        bc.tag
+                    )))
+                }
+                Some(_) => {}
+            }
+        }
+        let n = normal.ok_or_else(|| {
+            RunError::Setup(format!(
+                "boundary[{b}].tag: `{}` has no boundary edge",
+                bc.tag
+            ))
+        })?;
+        walls.push((bc.tag.clone(), [n[0], n[1]]));
+    }
+    Ok(walls)
+}
+
 fn smallest_edge(mesh: &TriMesh) -> f64 {
     mesh.edges()
         .iter()
@@ -237,12 +291,20 @@ fn smallest_edge(mesh: &TriMesh) -> f64 {
 
 /// Runs a 2D scene and returns its particles too.
 pub fn run_2d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<2>, RunError> {
-    run_2d_observed(scene, &mut |r, _| on_step(r))
+    run_2d_observed(scene, &mut |r, _| {
+        if r.step > 0 {
+            on_step(r)
+        }
+    })
 }
 
 /// Runs a 1D scene and returns its particles too.
 pub fn run_1d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<1>, RunError> {
-    run_1d_observed(scene, &mut |r, _| on_step(r))
+    run_1d_observed(scene, &mut |r, _| {
+        if r.step > 0 {
+            on_step(r)
+        }
+    })
 }
 
 fn run_2d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<2>, RunError> {
@@ -252,13 +314,14 @@ fn run_2d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<2>, 
     }
     let mesh = triangulation(scene)?;
     let h = smallest_edge(&mesh);
+    let walls = wall_normals(scene, &mesh)?;
     match scene.basis {
         BasisKind::Ps => {
             let b = PowellSabin::<f64>::new(mesh, scene.split)
                 .map_err(|e| RunError::Setup(format!("basis: {e}")))?;
-            dispatch_mass::<2, _>(scene, b, h, on_step)
+            dispatch_mass::<2, _>(scene, b, h, &walls, on_step)
         }
-        _ => dispatch_mass::<2, _>(scene, Linear::<f64>::new(mesh), h, on_step),
+        _ => dispatch_mass::<2, _>(scene, Linear::<f64>::new(mesh), h, &walls, on_step),
     }
 }
 
@@ -272,11 +335,22 @@ fn run_1d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<1>, 
     let mesh =
         Mesh1d::uniform(x[0], x[1], elements).map_err(|e| RunError::Setup(format!("mesh: {e}")))?;
     let h = (x[1] - x[0]) / elements as f64;
+    // In 1D the normal of a wall is the axis.
+    let walls: Vec<(String, [f64; 2])> = scene
+        .boundaries
+        .iter()
+        .filter(|bc| bc.fix.contains(&Component::Normal))
+        .map(|bc| (bc.tag.clone(), [1.0, 0.0]))
+        .collect();
     match scene.basis {
-        BasisKind::Bspline => {
-            dispatch_mass::<1, _>(scene, QuadraticBSpline::<f64>::new(mesh), h, on_step)
-        }
-        _ => dispatch_mass::<1, _>(scene, Linear1d::<f64>::new(mesh), h, on_step),
+        BasisKind::Bspline => dispatch_mass::<1, _>(
+            scene,
+            QuadraticBSpline::<f64>::new(mesh),
+            h,
+            &walls,
+            on_step,
+        ),
+        _ => dispatch_mass::<1, _>(scene, Linear1d::<f64>::new(mesh), h, &walls, on_step),
     }
 }
 
@@ -284,14 +358,15 @@ fn dispatch_mass<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     basis: B,
     h: f64,
+    walls: &[(String, [f64; 2])],
     on_step: &mut Observer,
 ) -> Result<Outcome<D>, RunError>
 where
     Particles<f64, D>: AsParticlesRef,
 {
     match scene.mass {
-        MassKind::Lumped => run_with::<D, B, Lumped<f64>>(scene, basis, h, on_step),
-        _ => run_with::<D, B, SparseMass<f64>>(scene, basis, h, on_step),
+        MassKind::Lumped => run_with::<D, B, Lumped<f64>>(scene, basis, h, walls, on_step),
+        _ => run_with::<D, B, SparseMass<f64>>(scene, basis, h, walls, on_step),
     }
 }
 
@@ -520,6 +595,7 @@ fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
     scene: &Scene,
     basis: B,
     h: f64,
+    walls: &[(String, [f64; 2])],
     on_step: &mut Observer,
 ) -> Result<Outcome<D>, RunError>
 where
@@ -581,9 +657,11 @@ where
         .boundaries
         .iter()
         .flat_map(|bc| {
-            bc.fix.iter().map(|c| Fix {
-                tag: bc.tag.clone(),
-                component: c.index(),
+            bc.fix.iter().filter_map(|c| {
+                c.axis().map(|component| Fix {
+                    tag: bc.tag.clone(),
+                    component,
+                })
             })
         })
         .collect();
@@ -598,6 +676,10 @@ where
     let mut driver: Driver<f64, D, B, M, AnyMaterial> =
         Driver::new(basis, particles, material, scene.mass, &fixes, effects, dt)?;
     driver.estimate_condition = scene.output.condition;
+    for (tag, normal) in walls {
+        let n = SVector::<f64, D>::from_fn(|k, _| normal[k]);
+        driver.add_slip_wall(tag, &n)?;
+    }
 
     let mut tracked: Vec<Tracked> = scene
         .output
@@ -624,6 +706,9 @@ where
         .collect();
 
     let start = driver.report();
+    // The initial state (step 0); the public entry points other than
+    // `observe_2d`/`observe_1d` pass only steps > 0 on.
+    on_step(&start, driver.particles.view());
     let e0 = start.total_energy();
     let mut scale = e0
         .abs()
