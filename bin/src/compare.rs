@@ -81,6 +81,8 @@ pub fn variants(
 /// Runs `scenes` on up to `jobs` threads; results in the order of `scenes`.
 pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, RunError>> {
     let next = AtomicUsize::new(0);
+    let progress =
+        crate::progress::Progress::new(scenes.iter().map(|s| s.steps() as u64).sum(), "steps");
     let results: Mutex<Vec<Option<Result<Summary, RunError>>>> =
         Mutex::new(vec![None; scenes.len()]);
     std::thread::scope(|scope| {
@@ -88,13 +90,14 @@ pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, RunError>> 
             scope.spawn(|| loop {
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 let Some(scene) = scenes.get(k) else { break };
-                let r = simulation::run(scene, &mut |_| {});
+                let r = simulation::run(scene, &mut |_| progress.inc(1));
                 if let Ok(mut all) = results.lock() {
                     all[k] = Some(r);
                 }
             });
         }
     });
+    progress.finish();
     results
         .into_inner()
         .unwrap_or_default()

@@ -81,6 +81,8 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     let masses: Vec<String> = args.mass.iter().cloned().collect();
     let bases = variants(&base, &args.basis, &masses, &args.overrides)?;
     let mut rows: Vec<Level> = Vec::new();
+    let progress =
+        crate::progress::Progress::new((bases.len() * args.levels as usize) as u64, "runs");
     for scene in &bases {
         let mut previous: Option<(f64, f64)> = None;
         for level in 0..args.levels {
@@ -99,6 +101,7 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
             if let Some(e) = summary.error {
                 previous = Some((h, e));
             }
+            progress.inc(1);
             rows.push(Level {
                 basis: summary.basis,
                 level,
@@ -112,6 +115,7 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
             });
         }
     }
+    progress.finish();
     print_levels(&rows, args.format);
     if let Some(dir) = &args.out {
         write_outputs(dir, &base.name, &rows)?;

@@ -7,6 +7,8 @@ mod basis_cmd;
 mod compare;
 mod converge;
 mod error;
+mod out;
+mod progress;
 mod project;
 mod reproduce;
 mod run;

@@ -2,6 +2,7 @@
 //! markdown tables of `docs/results.md`, with their SVG figures.
 
 use crate::error::CliError;
+use crate::Format;
 use psmpm::plot::line_plot;
 use psmpm::reproduction::{reproduce, Effort, STUDIES};
 use psmpm::simulation::RunError;
@@ -20,6 +21,10 @@ pub struct ReproduceArgs {
     /// Directory for the SVG figures.
     #[arg(long, default_value = "docs/figures")]
     out: PathBuf,
+    /// Output format: table (markdown, as in docs/results.md), json (one object per
+    /// study with its tables) or csv (one block per table).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
 }
 
 /// Runs the studies and prints their tables.
@@ -47,6 +52,53 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
     for name in &names {
         let clock = std::time::Instant::now();
         let report = reproduce(name, effort).map_err(|RunError::Setup(m)| CliError::Input(m))?;
+        let mut files = Vec::new();
+        for figure in &report.figures {
+            let path = args.out.join(&figure.file);
+            line_plot(&path, &figure.plot)
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+            files.push(path.display().to_string());
+        }
+        match args.format {
+            Format::Json => {
+                let tables: Vec<_> = report
+                    .tables
+                    .iter()
+                    .map(|t| {
+                        serde_json::json!({
+                            "title": t.title,
+                            "columns": t.columns,
+                            "rows": t.rows,
+                        })
+                    })
+                    .collect();
+                println!(
+                    "{}",
+                    serde_json::json!({
+                        "study": report.benchmark,
+                        "tables": tables,
+                        "findings": report.findings,
+                        "figures": files,
+                    })
+                );
+                continue;
+            }
+            Format::Csv => {
+                for table in &report.tables {
+                    println!("# {}: {}", report.benchmark, table.title);
+                    println!("{}", table.columns.join(","));
+                    for row in &table.rows {
+                        let cells: Vec<String> = row
+                            .iter()
+                            .map(|c| format!("\"{}\"", c.replace('"', "\"\"")))
+                            .collect();
+                        println!("{}", cells.join(","));
+                    }
+                }
+                continue;
+            }
+            Format::Table => {}
+        }
         println!("## {}\n", report.benchmark.to_uppercase());
         for table in &report.tables {
             println!("{}", table.markdown());
@@ -54,11 +106,8 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
         for finding in &report.findings {
             println!("- {finding}");
         }
-        for figure in &report.figures {
-            let path = args.out.join(&figure.file);
-            line_plot(&path, &figure.plot)
-                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
-            println!("- figure: `{}`", path.display());
+        for file in &files {
+            println!("- figure: `{file}`");
         }
         println!("\n({name}: {:.0} s)\n", clock.elapsed().as_secs_f64());
     }

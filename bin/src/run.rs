@@ -1,14 +1,18 @@
 //! `mpm-cli run`: run a scene and print per-step diagnostics and a summary.
 
 use crate::error::CliError;
+use crate::out::{self, Recorder};
+use crate::progress::Progress;
 use crate::table::{sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::driver::StepReport;
 use psmpm::mass::MassKind;
+use psmpm::particles::Particles;
 use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene};
-use psmpm::simulation::{self, RunError, Summary};
+use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
+use std::path::PathBuf;
 
 /// The options that adjust a scene's resolution and time (shared by `run`,
 /// `compare`, `converge`).
@@ -101,6 +105,15 @@ pub struct RunArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
+    /// Write into DIR: diagnostics.csv (every step), summary.json, particle frames
+    /// (particles.pvd for ParaView), mesh.vtu (2D), tracked.csv and tracked.svg
+    /// (scenes with tracked particles) and energy.svg.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// With --out: a particle frame every N steps (default: about 50 frames; 0: the
+    /// first and last state only, which are always written).
+    #[arg(long, value_name = "N", requires = "out")]
+    out_every: Option<usize>,
 }
 
 /// Parses `AxB`.
@@ -206,7 +219,8 @@ fn row_cells(r: &StepReport) -> Vec<String> {
     ]
 }
 
-/// Runs the scene and prints diagnostics and the summary.
+/// Runs the scene and prints diagnostics and the summary (and writes the files of
+/// `--out`).
 pub fn run(args: RunArgs) -> Result<(), CliError> {
     let s = scene(&args)?;
     let every = args
@@ -216,10 +230,26 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         } else {
             (s.steps() / 20).max(1)
         });
+    let mut recorder = match &args.out {
+        Some(dir) => Some(Recorder::create(dir, args.out_every, &s)?),
+        None => None,
+    };
+    let progress = Progress::new(s.steps() as u64, "steps");
+    let t_end = s.time.t_end;
     let mut table = Table::new(&COLUMNS);
     let format = args.format;
     let mut csv_header = true;
-    let mut on_step = |r: &StepReport| {
+    let mut observer = |r: &StepReport, particles: ParticlesRef<'_>| {
+        if let Some(recorder) = recorder.as_mut() {
+            recorder.observe(r, particles);
+        }
+        if r.step == 0 {
+            return;
+        }
+        if r.step == 1 && r.time > 0.0 {
+            progress.set_total(out::steps_from_dt(t_end, r.time) as u64);
+        }
+        progress.inc(1);
         if every > 0 && r.step % every == 0 {
             match format {
                 Format::Json => println!("{}", row_json(r)),
@@ -233,9 +263,25 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             }
         }
     };
-    let summary = simulation::run(&s, &mut on_step).map_err(|e| match e {
+    let setup = |e: RunError| match e {
         RunError::Setup(m) => CliError::Input(m),
-    })?;
+    };
+    let (summary, tracked, last) = match s.dim {
+        2 => {
+            let o = simulation::observe_2d(&s, &mut observer).map_err(setup)?;
+            (o.summary, o.tracked, Last::Two(o.particles))
+        }
+        _ => {
+            let o = simulation::observe_1d(&s, &mut observer).map_err(setup)?;
+            (o.summary, o.tracked, Last::One(o.particles))
+        }
+    };
+    progress.finish();
+    let written = recorder.map(|r| {
+        let dir = r.path().to_path_buf();
+        r.finish(&summary, &tracked, last.view())
+            .map(|files| out::files_line(&dir, &files))
+    });
     match format {
         Format::Json => println!("{}", summary_json(&summary)),
         Format::Csv => {}
@@ -247,9 +293,32 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             print!("{}", summary_text(&summary));
         }
     }
+    if let Some(written) = written {
+        let line = written?;
+        // stdout stays machine-readable for --format json and csv.
+        match format {
+            Format::Table => println!("{line}"),
+            Format::Json | Format::Csv => eprintln!("{line}"),
+        }
+    }
     match &summary.failure {
         Some(reason) => Err(CliError::Numerical(reason.clone())),
         None => Ok(()),
+    }
+}
+
+/// The particles at the end of a run, in its dimension.
+enum Last {
+    One(Particles<f64, 1>),
+    Two(Particles<f64, 2>),
+}
+
+impl Last {
+    fn view(&self) -> ParticlesRef<'_> {
+        match self {
+            Last::One(p) => p.view(),
+            Last::Two(p) => p.view(),
+        }
     }
 }
 

@@ -97,7 +97,13 @@ fn table_and_summary_for_a_1d_scene() {
         "condition"
     ]));
     assert!(text.contains("column-small-1d · pl1d · consistent mass · 17 functions"));
-    assert!(text.contains("stable"));
+    // Readable at a glance: error, verdict, wall time and time per step.
+    assert!(text.contains("error E_u = "), "{text}");
+    assert!(text.contains(" · stable · "), "{text}");
+    assert!(
+        text.contains("wall time ") && text.contains("µs/step"),
+        "{text}"
+    );
 }
 
 fn input_error(args: &[&str]) -> String {

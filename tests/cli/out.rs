@@ -1,0 +1,580 @@
+//! `mpm-cli run --out DIR`: every file is written, agrees with the printed
+//! diagnostics and summary, and reads back with independent readers (Python's
+//! `meshio` for the `.vtu` files, `xml.etree` for the `.pvd` and the SVGs); write
+//! errors are input errors; no progress bar reaches a captured stderr.
+//!
+//! These tests need `python3` with `meshio` (pinned in `tests/requirements.txt`,
+//! installed by `.ci/run`); they fail (never skip) without them.
+
+use assert_cmd::Command;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// The meshio version `tests/requirements.txt` pins.
+const MESHIO: &str = "5.3.5";
+
+fn cli() -> Command {
+    Command::cargo_bin("mpm-cli").unwrap()
+}
+
+/// Reads `.vtu` files with meshio, `.pvd` files and SVGs with `xml.etree` (which
+/// rejects a file that is not well-formed XML); floats come back as `repr` strings.
+const SCRIPT: &str = r#"
+import json, sys
+try:
+    import meshio
+except ImportError as e:
+    print(f"cannot import meshio: {e}", file=sys.stderr)
+    sys.exit(3)
+import xml.etree.ElementTree as ET
+
+def floats(a):
+    return [repr(float(x)) for x in a.ravel()]
+
+def local(tag):
+    return tag.rsplit("}", 1)[-1]
+
+out = {"vtu": {}, "pvd": {}, "svg": {}}
+for path in sys.argv[1:]:
+    if path.endswith(".pvd"):
+        root = ET.parse(path).getroot()
+        assert root.tag == "VTKFile" and root.get("type") == "Collection", root.attrib
+        out["pvd"][path] = [[repr(float(d.get("timestep"))), d.get("file")]
+                            for d in root.find("Collection").findall("DataSet")]
+    elif path.endswith(".svg"):
+        root = ET.parse(path).getroot()
+        assert local(root.tag) == "svg", root.tag
+        elements = list(root.iter())
+        out["svg"][path] = {
+            "polyline_strokes": [e.get("stroke") for e in elements if local(e.tag) == "polyline"],
+            "circles": sum(1 for e in elements if local(e.tag) == "circle"),
+            "texts": ["".join(e.itertext()).strip() for e in elements if local(e.tag) == "text"],
+        }
+    else:
+        m = meshio.read(path)
+        out["vtu"][path] = {
+            "points": {"shape": list(m.points.shape), "values": floats(m.points)},
+            "cells": [[c.type, len(c.data)] for c in m.cells],
+            "point_data": {k: {"shape": list(v.shape), "values": floats(v)}
+                           for k, v in m.point_data.items()},
+        }
+print(json.dumps(out))
+"#;
+
+fn install_hint() -> String {
+    format!(
+        "these tests read the output back with meshio: run `python3 -m pip install meshio=={MESHIO}` (or `-r tests/requirements.txt`)"
+    )
+}
+
+/// Runs the reader on `files` and returns its JSON.
+fn read_back(files: &[PathBuf]) -> Value {
+    let output = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(SCRIPT)
+        .args(files)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run python3 ({e}); {}", install_hint()));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if output.status.code() == Some(3) {
+        panic!("{}; {}", stderr.trim(), install_hint());
+    }
+    assert!(
+        output.status.success(),
+        "the reader failed ({}):\n{stderr}",
+        output.status
+    );
+    serde_json::from_slice(&output.stdout).expect("the reader prints JSON")
+}
+
+/// A fresh directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let path =
+            std::env::temp_dir().join(format!("psmpm-cli-out-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&path);
+        TempDir(path)
+    }
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn join(&self, file: &str) -> PathBuf {
+        self.0.join(file)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn key(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// A float array of the reader's JSON with its shape.
+fn array(value: &Value) -> (Vec<usize>, Vec<f64>) {
+    let shape = value["shape"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no array in {value}"))
+        .iter()
+        .map(|s| s.as_u64().unwrap() as usize)
+        .collect();
+    let values = value["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap().parse::<f64>().unwrap())
+        .collect();
+    (shape, values)
+}
+
+/// Parses a CSV file: the header and the rows as strings.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    (header, rows)
+}
+
+/// The colour `psmpm::plot` gives series `k`, as it appears in the SVG.
+fn series_stroke(k: usize) -> String {
+    let (r, g, b) = psmpm::plot::series_colour(k);
+    format!("#{r:02X}{g:02X}{b:02X}")
+}
+
+/// Checks an SVG line plot: the legend names in order, one `<polyline>` in the
+/// colour of each line series (`lines[k]`), and `markers` circles at least.
+fn check_plot(svg: &Value, names: &[&str], lines: &[bool], markers: usize) {
+    let texts: Vec<&str> = svg["texts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_str().unwrap())
+        .collect();
+    let strokes: Vec<&str> = svg["polyline_strokes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|s| s.as_str())
+        .collect();
+    for (k, (name, &line)) in names.iter().zip(lines).enumerate() {
+        assert!(texts.contains(name), "legend `{name}` missing in {texts:?}");
+        let count = strokes.iter().filter(|&&s| s == series_stroke(k)).count();
+        assert_eq!(count, usize::from(line), "polylines of series {k} `{name}`");
+    }
+    assert!(svg["circles"].as_u64().unwrap() as usize >= markers);
+}
+
+#[test]
+fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
+    let dir = TempDir::new("bar");
+    std::fs::create_dir_all(dir.path()).unwrap();
+    // The vibrating bar with two tracked particles (the built-in scene tracks one).
+    let root = format!("{}/..", env!("CARGO_MANIFEST_DIR"));
+    let base = std::fs::read_to_string(format!("{root}/scenes/vibrating-bar.toml")).unwrap();
+    assert!(base.contains("tracked = [[12.5, 1.0]]"));
+    let scene = dir.join("bar.toml");
+    std::fs::write(
+        &scene,
+        base.replace(
+            "tracked = [[12.5, 1.0]]",
+            "tracked = [[12.4, 0.9], [3.0, 0.5]]",
+        ),
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = cli()
+        .args([
+            "run",
+            key(&scene),
+            "--t-end",
+            "0.5",
+            "--diag-every",
+            "1",
+            "--format",
+            "json",
+            "--out",
+            key(&out_dir),
+            "--out-every",
+            "100",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    // stdout stays JSON; the line naming the directory goes to stderr.
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains(&format!("output written to {}", out_dir.display())),
+        "{stderr}"
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let steps = 500;
+    assert_eq!(lines.len(), steps + 1);
+    let (rows, summary) = (&lines[..steps], &lines[steps]);
+
+    let frames: Vec<String> = (0..6).map(|k| format!("particles_{k:05}.vtu")).collect();
+    for file in [
+        "diagnostics.csv",
+        "summary.json",
+        "mesh.vtu",
+        "particles.pvd",
+        "tracked.csv",
+        "tracked.svg",
+        "energy.svg",
+    ]
+    .iter()
+    .copied()
+    .chain(frames.iter().map(String::as_str))
+    {
+        assert!(out_dir.join(file).is_file(), "{file} missing");
+    }
+    assert!(!out_dir.join("particles_00006.vtu").exists());
+
+    // diagnostics.csv: one row per step, the values of --format json, bit for bit.
+    let (header, csv) = read_csv(&out_dir.join("diagnostics.csv"));
+    assert_eq!(
+        header,
+        [
+            "step",
+            "time",
+            "kinetic",
+            "strain",
+            "potential",
+            "work",
+            "total",
+            "mass",
+            "momentum_x",
+            "momentum_y",
+            "max_speed",
+            "active",
+            "lumped_rows",
+            "deactivated",
+            "condition"
+        ]
+    );
+    assert_eq!(csv.len(), steps);
+    for (row, json) in csv.iter().zip(rows) {
+        assert_eq!(row.len(), header.len());
+        let expected = |name: &str| -> Value {
+            match name {
+                "momentum_x" => json["momentum"][0].clone(),
+                "momentum_y" => json["momentum"][1].clone(),
+                other => json[other].clone(),
+            }
+        };
+        for (name, field) in header.iter().zip(row) {
+            let want = expected(name);
+            match name.as_str() {
+                "step" | "active" | "lumped_rows" | "deactivated" => {
+                    assert_eq!(
+                        field.parse::<u64>().unwrap(),
+                        want.as_u64().unwrap(),
+                        "{name}"
+                    )
+                }
+                "condition" => {
+                    assert!(want.is_null() && field.is_empty(), "{name}: {field}")
+                }
+                _ => assert_eq!(
+                    field.parse::<f64>().unwrap().to_bits(),
+                    want.as_f64().unwrap().to_bits(),
+                    "{name} at step {}: csv {field}, json {want}",
+                    json["step"]
+                ),
+            }
+        }
+    }
+
+    // summary.json is the printed summary.
+    let written: Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(&written, summary);
+    assert_eq!(written["steps"], 500);
+    assert_eq!(written["stable"], true);
+
+    // tracked.csv: per step and particle, with the reference.
+    let (header, tracked) = read_csv(&out_dir.join("tracked.csv"));
+    assert_eq!(
+        header,
+        [
+            "time",
+            "particle",
+            "u_x",
+            "u_y",
+            "v_x",
+            "v_y",
+            "u_exact_x",
+            "u_exact_y"
+        ]
+    );
+    assert_eq!(tracked.len(), 2 * steps);
+    let particle_of = |row: &Vec<String>| row[1].parse::<usize>().unwrap();
+    let (p0, p1) = (particle_of(&tracked[0]), particle_of(&tracked[1]));
+    assert_ne!(p0, p1);
+    let value = |row: &Vec<String>, k: usize| row[k].parse::<f64>().unwrap();
+    for pair in tracked.chunks(2) {
+        assert_eq!(pair[0][0], pair[1][0], "both particles at each time");
+        assert_eq!((particle_of(&pair[0]), particle_of(&pair[1])), (p0, p1));
+    }
+    let last = &tracked[2 * steps - 2];
+    assert_eq!(value(last, 0), 0.5);
+    // The reference is close to the computed displacement (E_u ~ 1e-5).
+    assert!((value(last, 2) - value(last, 6)).abs() < 1e-3 * value(last, 6).abs().max(1e-3));
+
+    // The .vtu files and the collection, read back.
+    let files: Vec<PathBuf> = vec![
+        out_dir.join("mesh.vtu"),
+        out_dir.join(&frames[0]),
+        out_dir.join(&frames[5]),
+        out_dir.join("particles.pvd"),
+        out_dir.join("energy.svg"),
+        out_dir.join("tracked.svg"),
+    ];
+    let json = read_back(&files);
+    let mesh = &json["vtu"][key(&files[0])];
+    // 4 x 1 blocks of four triangles: 16 triangles on 10 corners + 4 centres.
+    assert_eq!(mesh["cells"], serde_json::json!([["triangle", 16]]));
+    assert_eq!(array(&mesh["points"]).0, [14, 3]);
+
+    let first = &json["vtu"][key(&files[1])];
+    let last = &json["vtu"][key(&files[2])];
+    let n = 576;
+    let (shape, x0) = array(&first["points"]);
+    assert_eq!(shape, [n, 3]);
+    let (shape, x) = array(&last["points"]);
+    assert_eq!(shape, [n, 3]);
+    assert_eq!(last["cells"], serde_json::json!([["vertex", n]]));
+    let (shape, u) = array(&last["point_data"]["displacement"]);
+    assert_eq!(shape, [n, 3]);
+    assert_eq!(array(&last["point_data"]["velocity"]).0, [n, 3]);
+    assert_eq!(array(&last["point_data"]["stress"]).0, [n, 9]);
+    assert_eq!(array(&last["point_data"]["volume"]).0, [n]);
+    // The first frame is the initial state: at rest positions, zero displacement.
+    assert!(array(&first["point_data"]["displacement"])
+        .1
+        .iter()
+        .all(|&v| v == 0.0));
+    // x = x0 + u, and the bar moves.
+    for i in 0..3 * n {
+        assert!((x[i] - x0[i] - u[i]).abs() < 1e-12, "component {i}");
+    }
+    assert!(u.iter().any(|&v| v.abs() > 1e-3));
+    // The tracked particle is the nearest to its point at the start, and its last
+    // displacement is the frame's.
+    let nearest = |p: [f64; 2]| {
+        (0..n)
+            .min_by(|&a, &b| {
+                let d = |i: usize| (x0[3 * i] - p[0]).powi(2) + (x0[3 * i + 1] - p[1]).powi(2);
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    assert_eq!((p0, p1), (nearest([12.4, 0.9]), nearest([3.0, 0.5])));
+    assert_eq!(value(&tracked[2 * steps - 2], 2), u[3 * p0]);
+
+    let pvd = json["pvd"][key(&files[3])].as_array().unwrap();
+    let entries: Vec<(f64, &str)> = pvd
+        .iter()
+        .map(|e| {
+            (
+                e[0].as_str().unwrap().parse().unwrap(),
+                e[1].as_str().unwrap(),
+            )
+        })
+        .collect();
+    let times: Vec<f64> = entries.iter().map(|e| e.0).collect();
+    let expected: Vec<f64> = (0..6).map(|k| (100 * k) as f64 * 1e-3).collect();
+    assert_eq!(times, expected);
+    for ((_, file), expected) in entries.iter().zip(&frames) {
+        assert_eq!(file, expected);
+    }
+
+    check_plot(
+        &json["svg"][key(&files[4])],
+        &["kinetic", "strain", "potential", "total"],
+        &[true; 4],
+        0,
+    );
+    let names: Vec<String> = [p0, p1]
+        .iter()
+        .flat_map(|p| {
+            [
+                format!("particle {p} u_x (MPM)"),
+                format!("particle {p} u_x (exact)"),
+            ]
+        })
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    check_plot(
+        &json["svg"][key(&files[5])],
+        &names,
+        &[false, true, false, true],
+        100,
+    );
+    let texts = json["svg"][key(&files[5])]["texts"].to_string();
+    assert!(texts.contains("time (s)") && texts.contains("displacement (m)"));
+}
+
+#[test]
+fn a_1d_run_writes_about_50_frames_and_no_mesh() {
+    let dir = TempDir::new("bar1d");
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar-1d",
+            "--t-end",
+            "1",
+            "--diag-every",
+            "0",
+            "--out",
+            key(dir.path()),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains("error E_u = "), "{stdout}");
+    let line = stdout.lines().last().unwrap();
+    assert!(
+        line.starts_with(&format!("output written to {}: ", dir.path().display())),
+        "{line}"
+    );
+    assert!(out.stderr.is_empty());
+    // 1000 steps: a frame every 20 steps and the initial state.
+    for k in 0..=50 {
+        assert!(dir.join(&format!("particles_{k:05}.vtu")).is_file(), "{k}");
+    }
+    assert!(!dir.join("particles_00051.vtu").exists());
+    for file in ["mesh.vtu", "tracked.csv", "tracked.svg"] {
+        assert!(!dir.join(file).exists(), "{file}");
+    }
+    let (_, rows) = read_csv(&dir.join("diagnostics.csv"));
+    assert_eq!(rows.len(), 1000);
+    assert_eq!(rows[999][0], "1000");
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["scene"], "vibrating-bar-1d");
+    assert_eq!(summary["steps"], 1000);
+
+    let (last, pvd, energy) = (
+        dir.join("particles_00050.vtu"),
+        dir.join("particles.pvd"),
+        dir.join("energy.svg"),
+    );
+    let json = read_back(&[last.clone(), pvd.clone(), energy.clone()]);
+    let frame = &json["vtu"][key(&last)];
+    let (shape, x) = array(&frame["points"]);
+    assert_eq!(shape, [32, 3]);
+    assert!((0..32).all(|i| x[3 * i + 1] == 0.0 && x[3 * i + 2] == 0.0));
+    let (shape, u) = array(&frame["point_data"]["displacement"]);
+    assert_eq!(shape, [32, 3]);
+    assert!(u.iter().any(|&v| v != 0.0));
+    let entries = json["pvd"][key(&pvd)].as_array().unwrap();
+    assert_eq!(entries.len(), 51);
+    assert_eq!(entries[50][0], "1.0");
+    check_plot(
+        &json["svg"][key(&energy)],
+        &["kinetic", "strain", "potential", "total"],
+        &[true; 4],
+        0,
+    );
+}
+
+fn input_error(args: &[&str]) -> String {
+    let out = cli().args(args).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+#[test]
+fn an_unwritable_directory_is_an_input_error_naming_it() {
+    let dir = TempDir::new("bad");
+    std::fs::create_dir_all(dir.path()).unwrap();
+    let file = dir.join("plain-file");
+    std::fs::write(&file, "not a directory").unwrap();
+    let target = file.join("out");
+    let stderr = input_error(&[
+        "run",
+        "vibrating-bar-1d",
+        "--t-end",
+        "0.01",
+        "--out",
+        key(&target),
+    ]);
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(stderr.contains(key(&target)), "{stderr}");
+    // --out-every needs --out.
+    input_error(&["run", "vibrating-bar-1d", "--out-every", "5"]);
+}
+
+#[test]
+fn a_failed_run_still_writes_its_files() {
+    let dir = TempDir::new("fail");
+    // A huge time step throws the bar's particles out of the mesh.
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--dt",
+            "100",
+            "--t-end",
+            "1000",
+            "--out",
+            key(dir.path()),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["stable"], false);
+    assert!(summary["failure"].is_string());
+    for file in ["diagnostics.csv", "particles.pvd", "particles_00000.vtu"] {
+        assert!(dir.join(file).is_file(), "{file}");
+    }
+}
+
+#[test]
+fn a_long_run_with_a_captured_stderr_shows_no_progress_bar() {
+    // About 1.2 s in release: past the bar's 1 s delay.
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--dt",
+            "2.5e-4",
+            "--t-end",
+            "2.5",
+            "--diag-every",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.is_empty(), "stderr: {stderr:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for mark in ["\r", "\u{1b}[", "ETA", "=>", "━", "█"] {
+        assert!(!stdout.contains(mark), "{mark:?} in {stdout}");
+    }
+    assert!(stdout.contains("10000 steps"), "{stdout}");
+}
