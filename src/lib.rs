@@ -9,10 +9,29 @@
 //!   (symbolic once, numeric per call);
 //! - [`projection`]: L² projection onto a basis (benchmark B1 of the seeds);
 //! - [`driver`]: the MPM time step, generic over basis, [`mass`] strategy and
-//!   [`material`]; [`particles`], [`effect`]s (gravity);
-//! - [`scene`]: built-in benchmark scenes with their exact solutions.
+//!   [`material`]; [`particles`]; [`effect`]s (gravity, local damping, traction,
+//!   body forces, initial stress) with their work in the energy balance;
+//! - [`scene`]: a run declared as data (TOML), and the built-in scenes;
+//!   [`simulation`]: building and running a scene, its summary and stability verdict;
+//! - [`exact`]: the seeds' exact solutions; [`ulfem`]: the 1D updated-Lagrangian FEM
+//!   reference; [`reproduction`]: the benchmark studies of `docs/results.md`;
+//! - [`output`]: VTK XML, ParaView collections and CSV; [`plot`]: SVG plots.
 //!
-//! # Example
+//! # Examples
+//!
+//! Run a built-in scene, changed in code, with a callback after every step:
+//!
+//! ```
+//! use psmpm::{mass::MassKind, scene::Scene, simulation::run};
+//!
+//! let mut scene = Scene::builtin("column-small").unwrap();
+//! scene.mass = MassKind::parse("partial").unwrap();
+//! scene.time.t_end = 0.01;
+//! let mut energies = Vec::new();
+//! let summary = run(&scene, &mut |r| energies.push(r.total_energy())).unwrap();
+//! assert!(summary.stable && summary.error.unwrap() < 1e-3);
+//! assert_eq!(energies.len(), 100);
+//! ```
 //!
 //! Project `sin(πx) sin(πy)` onto Powell–Sabin splines on a 9 × 9 lattice:
 //!
