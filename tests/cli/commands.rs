@@ -78,6 +78,22 @@ fn scenes_lists_every_builtin_in_every_format() {
 }
 
 #[test]
+fn scene_show_prints_the_scene_file() {
+    insta::assert_snapshot!(
+        "scene_show_column_small",
+        stdout(&["scene", "show", "column-small"])
+    );
+    // A file is shown normalised (comments dropped, defaults written out).
+    let dir = temp_dir("show-file");
+    let path = dir.join("c.toml");
+    std::fs::write(&path, stdout(&["scene", "show", "column-small"])).unwrap();
+    insta::assert_snapshot!(
+        "scene_show_normalised",
+        stdout(&["scene", "show", path.to_str().unwrap()])
+    );
+}
+
+#[test]
 fn scene_show_round_trips_for_every_builtin_scene() {
     let dir = temp_dir("show");
     for (name, _, _) in psmpm::scene::BUILTIN {
