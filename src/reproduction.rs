@@ -106,6 +106,13 @@ fn opt(x: Option<f64>) -> String {
     x.map_or_else(|| "-".into(), sci)
 }
 
+/// A plot with logarithmic axes (errors against sizes or particle counts).
+fn log_log(title: impl Into<String>, x: &str, y: &str) -> LinePlot {
+    LinePlot::new(title, x, y)
+        .x_scale(Scale::Log10)
+        .y_scale(Scale::Log10)
+}
+
 /// The error of a completed run (`None` if it failed).
 fn completed_error(sum: &Summary) -> Option<f64> {
     sum.failure.is_none().then_some(sum.error).flatten()
@@ -208,13 +215,11 @@ fn b2(effort: Effort) -> Result<Report, RunError> {
             theirs,
         ));
     }
-    let mut plot = LinePlot::new(
+    let mut plot = log_log(
         "B2: vibrating bar, E_u at t = 0.02 against block width",
         "block width h (m)",
         "E_u (m²)",
-    )
-    .x_scale(Scale::Log10)
-    .y_scale(Scale::Log10);
+    );
     for s in series {
         plot = plot.with_series(s);
     }
@@ -453,13 +458,11 @@ fn b4(effort: Effort) -> Result<Report, RunError> {
         ],
         rows: Vec::new(),
     };
-    let mut h_plot = LinePlot::new(
+    let mut h_plot = log_log(
         "B4: RMS error against mesh size",
         "target edge length h (m)",
         "RMS position error (m)",
-    )
-    .x_scale(Scale::Log10)
-    .y_scale(Scale::Log10);
+    );
     let mut findings = Vec::new();
     let mut coarsest = Vec::new();
     // PS with the consistent mass, PS with rows of tiny mass lumped (threshold rule:
@@ -548,13 +551,11 @@ fn b4(effort: Effort) -> Result<Report, RunError> {
         ],
         rows: Vec::new(),
     };
-    let mut ppe_plot = LinePlot::new(
+    let mut ppe_plot = log_log(
         format!("B4: RMS error against particles per element (edge {ppe_edge})"),
         "particles per element",
         "RMS position error (m)",
-    )
-    .x_scale(Scale::Log10)
-    .y_scale(Scale::Log10);
+    );
     for basis in [BasisKind::Ps, BasisKind::Pl] {
         let mut points = Vec::new();
         let mut previous: Option<(f64, f64)> = None;
@@ -595,6 +596,11 @@ fn b4(effort: Effort) -> Result<Report, RunError> {
         "B4: velocity of the particle starting near (0.25, 0.47)",
         "time (s)",
         "velocity v_x (m/s)",
+    );
+    let mut field = LinePlot::new(
+        "B4: σ_xx at t = 0.016 of the particle row starting at y ≈ 0.47",
+        "initial position x⁰ (m)",
+        "σ_xx (Pa)",
     );
     let mut cross_table = Table {
         title: "B4: grid crossing, PS and PL at about the same number of functions, 5120 particles"
@@ -639,11 +645,25 @@ fn b4(effort: Effort) -> Result<Report, RunError> {
         let at16 = simulation::run_2d(&s16, &mut |_| {})?;
         let (mut worst, mut scale) = (0.0f64, 0.0f64);
         let p = &at16.particles;
+        // The particle row nearest y⁰ = 0.47 (the tracked particle's row).
+        let row_y = t.x0[1];
+        let mut row = Vec::new();
         for k in 0..p.len() {
             let e = exact.cauchy_stress([p.x0[k][0], p.x0[k][1]], at16.summary.t_end)[0];
             worst = worst.max((p.sigma[k][(0, 0)] - e).abs());
             scale = scale.max(e.abs());
+            if (p.x0[k][1] - row_y).abs() < 1e-9 {
+                row.push((p.x0[k][0], p.sigma[k][(0, 0)], e));
+            }
         }
+        row.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if basis == BasisKind::Ps {
+            field = field.with_series(Series::line("exact", row.iter().map(|r| (r.0, r.2))));
+        }
+        field = field.with_series(Series::markers(
+            basis.name().to_uppercase(),
+            row.iter().map(|r| (r.0, r.1)),
+        ));
         cross_table.rows.push(vec![
             basis.name().into(),
             out.summary.functions.to_string(),
@@ -667,6 +687,10 @@ fn b4(effort: Effort) -> Result<Report, RunError> {
             Figure {
                 file: "b4-crossing.svg".into(),
                 plot: crossing,
+            },
+            Figure {
+                file: "b4-sigma-xx.svg".into(),
+                plot: field,
             },
         ],
         findings,
