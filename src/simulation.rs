@@ -434,6 +434,19 @@ pub fn particle_lattice(scene: &Scene) -> Result<(Vec<[f64; 2]>, Vec<f64>), RunE
     Ok((positions, volumes))
 }
 
+/// Number of particles of each body (in the order of [`particle_lattice`]).
+fn body_sizes(scene: &Scene) -> Result<Vec<usize>, RunError> {
+    scene
+        .bodies
+        .iter()
+        .map(|b| {
+            let mut one = scene.clone();
+            one.bodies = vec![b.clone()];
+            particle_lattice(&one).map(|(p, _)| p.len())
+        })
+        .collect()
+}
+
 fn to_vec<const D: usize>(p: [f64; 2]) -> SVector<f64, D> {
     SVector::<f64, D>::from_fn(|k, _| p[k])
 }
@@ -615,6 +628,7 @@ where
         o
     };
     let (positions, volumes) = particle_lattice(scene)?;
+    let body_sizes = body_sizes(scene)?;
     let mut particles = Particles::<f64, D>::new(
         positions.iter().map(|&p| to_vec::<D>(p)).collect(),
         volumes,
@@ -674,7 +688,25 @@ where
     let steps = (scene.time.t_end / dt).round().max(1.0) as usize;
     let functions = basis.num_functions();
     let mut driver: Driver<f64, D, B, M, AnyMaterial> =
-        Driver::new(basis, particles, material, scene.mass, &fixes, effects, dt)?;
+        Driver::new(basis, particles, material, scene.mass, &fixes, effects, dt).map_err(
+            |e| match e {
+                SetupError::ParticleOutside { particle, position } => {
+                    // Name the body the particle belongs to.
+                    let mut first = 0;
+                    let body = body_sizes
+                        .iter()
+                        .position(|&n| {
+                            first += n;
+                            particle < first
+                        })
+                        .unwrap_or(0);
+                    RunError::Setup(format!(
+                        "body[{body}]: the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"
+                    ))
+                }
+                other => other.into(),
+            },
+        )?;
     driver.estimate_condition = scene.output.condition;
     for (tag, normal) in walls {
         let n = SVector::<f64, D>::from_fn(|k, _| normal[k]);
