@@ -1,1 +1,1340 @@
-//! (being written)
+//! Malformed input reaches the user as one line with exit status 2, never as a panic.
+//!
+//! `mpm-cli run FILE.toml` is fed malformed scenes (syntax errors, unknown fields,
+//! wrong types, out-of-range values, inconsistent scenes, missing fields, unknown
+//! kinds) and malformed Gmsh meshes (`tests/data/bad/*.msh`, read through a scene's
+//! `mesh.file` and through `mpm-cli project --mesh`). Each case checks the whole of
+//! stderr: `error: FILE:LINE:COLUMN: FIELD: what is wrong` for scene-file errors,
+//! the value and the allowed range for out-of-range values, and the mesh file and
+//! line for mesh errors.
+//!
+//! Each malformed scene is one of the small base scenes below with a few edits. In
+//! an edit, `@@` marks where the error is located (`FILE:LINE:COLUMN`); it is
+//! removed before the file is written. A case without `@@` expects no location.
+//!
+//! Cases marked `LIBRARY` get an error that is right in status and form but
+//! short of the issue's requirement (no location, no field name, a location that
+//! is off); the test pins today's message, and `known_library_gaps` (ignored)
+//! states what the message should say. Run it with
+//! `cargo test --release -p mpm-cli --test cli_bad_input -- --ignored`.
+
+use assert_cmd::Command;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+fn cli() -> Command {
+    Command::cargo_bin("mpm-cli").unwrap()
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// A fresh directory for the files of one test.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("psmpm-bad-input-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A 2D elastic bar on blocks with every optional table.
+const BAR: &str = r#"# A small bar: the base of most malformed scenes.
+name = "bar"
+description = "a bar fixed at both ends"
+dim = 2
+basis = "ps"
+split = "incentre"
+mass = "consistent"
+
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 1.0]
+blocks = [4, 1]
+layout = "four-triangles"
+
+[material]
+model = "linear-elastic"
+young = 100.0
+poisson = 0.25
+density = 1.0
+
+[[body]]
+min = [0.0, 0.0]
+max = [4.0, 1.0]
+per_block = [4, 4]
+
+[initial_velocity]
+kind = "exact"
+
+[[boundary]]
+tag = "left"
+fix = ["x", "y"]
+
+[[boundary]]
+tag = "right"
+fix = ["x", "y"]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+
+[reference]
+kind = "vibrating-bar"
+v0 = 0.1
+
+[output]
+tracked = [[2.0, 0.5]]
+diagnostics_every = 5
+
+[[resolution]]
+basis = "pl"
+blocks = [8, 1]
+
+[study]
+refine = ["x"]
+"#;
+
+/// A 2D column under gravity with damping and a Courant number.
+const COLUMN: &str = r#"name = "column"
+dim = 2
+basis = "pl"
+mass = "lumped"
+
+[mesh]
+kind = "blocks"
+x = [0.0, 1.0]
+y = [0.0, 4.0]
+blocks = [1, 4]
+
+[material]
+model = "linear-elastic"
+young = 5e4
+density = 1.0
+
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 4.0]
+per_block = [2, 2]
+
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+
+[[effect]]
+kind = "damping"
+alpha = 0.1
+
+[[effect]]
+kind = "traction"
+min = [0.0, 3.5]
+max = [1.0, 4.0]
+traction = [0.0, -1.0]
+length = 1.0
+ramp = 0.1
+
+[time]
+courant = 0.5
+t_end = 0.01
+
+[reference]
+kind = "column-self-weight"
+"#;
+
+/// A 1D bar.
+const BAR_1D: &str = r#"name = "bar-1d"
+dim = 1
+basis = "bspline"
+mass = "consistent"
+
+[mesh]
+kind = "interval"
+x = [0.0, 4.0]
+elements = 4
+
+[material]
+model = "linear-elastic"
+young = 100.0
+density = 1.0
+
+[[body]]
+min = [0.0]
+max = [4.0]
+per_block = [2]
+
+[[boundary]]
+tag = "left"
+fix = ["x"]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+"#;
+
+/// The neo-Hookean manufactured solution on a polygon mesh.
+const SQUARE: &str = r#"name = "square"
+dim = 2
+basis = "ps"
+mass = "consistent"
+
+[mesh]
+kind = "polygon"
+outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+tags = ["bottom", "right", "top", "left"]
+edge_length = 0.25
+
+[material]
+model = "neo-hookean"
+young = 1e7
+poisson = 0.3
+density = 1e3
+
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+count = [16, 16]
+
+[initial_velocity]
+kind = "exact"
+
+[[boundary]]
+tag = "left"
+fix = ["x"]
+
+[[boundary]]
+tag = "bottom"
+fix = ["y"]
+
+[[effect]]
+kind = "manufactured-body-force"
+
+[time]
+dt = 1e-4
+t_end = 1e-3
+
+[reference]
+kind = "axis-aligned"
+u0 = 0.05
+"#;
+
+/// A Gmsh mesh next to the scene file (in `meshes/`).
+const GMSH: &str = r#"name = "gmsh-square"
+dim = 2
+basis = "pl"
+mass = "lumped"
+
+[mesh]
+kind = "gmsh"
+file = "meshes/square.msh"
+
+[material]
+model = "linear-elastic"
+young = 100.0
+density = 1.0
+
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+count = [8, 8]
+
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+"#;
+
+const BASES: [(&str, &str); 5] = [
+    ("bar", BAR),
+    ("column", COLUMN),
+    ("bar-1d", BAR_1D),
+    ("square", SQUARE),
+    ("gmsh", GMSH),
+];
+
+/// A malformed scene and the message it must give.
+struct Case {
+    name: &'static str,
+    text: String,
+    message: String,
+}
+
+fn case(name: &'static str, base: &str) -> Case {
+    Case {
+        name,
+        text: base.to_string(),
+        message: String::new(),
+    }
+}
+
+impl Case {
+    /// Replaces the one occurrence of `from` by `to`.
+    fn edit(mut self, from: &str, to: &str) -> Case {
+        let n = self.text.matches(from).count();
+        assert_eq!(n, 1, "case {}: `{from}` occurs {n} times", self.name);
+        self.text = self.text.replacen(from, to, 1);
+        self
+    }
+
+    /// Applies `f` to the whole text.
+    fn map(mut self, f: impl Fn(&str) -> String) -> Case {
+        self.text = f(&self.text);
+        self
+    }
+
+    /// The message after `FILE:LINE:COLUMN: ` (`{dir}`: the scene's directory).
+    fn expect(mut self, message: &str) -> Case {
+        self.message = message.to_string();
+        self
+    }
+
+    /// The text to write and the expected stderr for the scene file `path`.
+    fn resolve(&self, path: &Path) -> (String, String) {
+        let dir = path.parent().unwrap().display().to_string();
+        let message = self.message.replace("{dir}", &dir);
+        match self.text.find("@@") {
+            Some(at) => {
+                let before = &self.text[..at];
+                let line = before.matches('\n').count() + 1;
+                let column = at - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                let expected = format!("error: {}:{line}:{column}: {message}\n", path.display());
+                (self.text.replacen("@@", "", 1), expected)
+            }
+            None => (self.text.clone(), format!("error: {message}\n")),
+        }
+    }
+}
+
+/// Runs `args`, checks status 2, one `error: ` line and no panic; returns stderr.
+fn input_error(args: &[&str]) -> Result<String, String> {
+    let out = cli().args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    if stderr.contains("panicked") {
+        return Err(format!("panicked:\n{stderr}"));
+    }
+    if out.status.code() != Some(2) {
+        return Err(format!("exit status {:?}:\n{stderr}", out.status.code()));
+    }
+    if !stderr.starts_with("error: ") || stderr.lines().count() != 1 {
+        return Err(format!("not one `error: ` line:\n{stderr}"));
+    }
+    Ok(stderr)
+}
+
+/// The 1-based line of the first line of `file` that starts with `needle`.
+fn line_of(file: &Path, needle: &str) -> usize {
+    let text = std::fs::read_to_string(file).unwrap();
+    1 + text
+        .lines()
+        .position(|l| l.starts_with(needle))
+        .unwrap_or_else(|| panic!("`{needle}` not in {}", file.display()))
+}
+
+fn syntax_cases() -> Vec<Case> {
+    vec![
+        case("unterminated-string", BAR)
+            .edit("name = \"bar\"", "name = \"bar@@")
+            .expect("invalid basic string, expected `\"`"),
+        case("unterminated-array", BAR)
+            .edit("x = [0.0, 4.0]\n", "x = [0.0, 4.0\n@@")
+            .expect("missing comma between array elements, expected `,`"),
+        case("bad-table-header", BAR)
+            .edit("[material]", "[material@@")
+            .expect("unclosed table, expected `]`"),
+        case("bad-array-of-tables-header", BAR)
+            .edit("[[resolution]]", "[[resolution]@@")
+            .expect("unclosed array table, expected `]`"),
+        // LIBRARY: the message does not name the key (`density`).
+        case("duplicate-key", BAR)
+            .edit("density = 1.0", "density = 1.0\n@@density = 2.0")
+            .expect("duplicate key"),
+        case("key-without-value", BAR)
+            .edit("young = 100.0", "young @@100.0")
+            .expect("key with no value, expected `=`"),
+        case("bad-escape", BAR)
+            .edit("description = \"a bar", "description = \"a \\@@q bar")
+            .expect("missing escaped value, expected `b`, `e`, `f`, `n`, `r`, `\\`, `\"`, `x`, `u`, `U`"),
+        case("trailing-garbage", BAR)
+            .edit("name = \"bar\"", "name = \"bar\" @@x")
+            .expect("unexpected key or value, expected newline, `#`"),
+        // Line endings and a byte-order mark do not shift the location.
+        case("crlf-line-endings", BAR)
+            .edit("dt = 1e-3", "dt = @@-1e-3")
+            .map(|t| t.replace('\n', "\r\n"))
+            .expect("time.dt: must be positive and finite, got -0.001"),
+        case("byte-order-mark", BAR)
+            .edit("dt = 1e-3", "dt = @@-1e-3")
+            .map(|t| format!("\u{feff}{t}"))
+            .expect("time.dt: must be positive and finite, got -0.001"),
+    ]
+}
+
+fn unknown_field_cases() -> Vec<Case> {
+    vec![
+        case("unknown-top-level-field", BAR)
+            .edit("dim = 2\n", "dim = 2\n@@colour = \"red\"\n")
+            .expect("unknown field `colour`, expected one of `name`, `description`, `dim`, `basis`, `split`, `mass`, `mesh`, `material`, `body`, `initial_velocity`, `boundary`, `effect`, `time`, `reference`, `output`, `resolution`, `study`"),
+        case("unknown-top-level-table", BAR)
+            .edit("[study]", "[@@solver]")
+            .expect("unknown field `solver`, expected one of `name`, `description`, `dim`, `basis`, `split`, `mass`, `mesh`, `material`, `body`, `initial_velocity`, `boundary`, `effect`, `time`, `reference`, `output`, `resolution`, `study`"),
+        // LIBRARY: located at `[mesh]`, not at the unknown key (tagged tables).
+        case("unknown-field-in-mesh", BAR)
+            .edit("[mesh]", "@@[mesh]")
+            .edit("blocks = [4, 1]", "blocks = [4, 1]\nblock = [4, 1]")
+            .expect("unknown field `block`, expected one of `x`, `y`, `blocks`, `layout`"),
+        case("unknown-field-in-inline-mesh", BAR)
+            .edit("[mesh]\nkind = \"blocks\"\nx = [0.0, 4.0]\ny = [0.0, 1.0]\nblocks = [4, 1]\nlayout = \"four-triangles\"\n\n", "")
+            .edit("mass = \"consistent\"\n", "mass = \"consistent\"\nmesh = @@{ kind = \"blocks\", x = [0.0, 4.0], y = [0.0, 1.0], blocks = [4, 1], nx = 4 }\n")
+            .expect("unknown field `nx`, expected one of `x`, `y`, `blocks`, `layout`"),
+        case("unknown-field-in-material", BAR)
+            .edit("density = 1.0", "density = 1.0\n@@young_modulus = 3.0")
+            .expect("unknown field `young_modulus`, expected one of `model`, `young`, `poisson`, `density`"),
+        case("unknown-field-in-body", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\n@@speed = 1.0")
+            .expect("unknown field `speed`, expected one of `min`, `max`, `per_block`, `count`"),
+        case("unknown-field-in-boundary", BAR)
+            .edit("tag = \"right\"", "tag = \"right\"\n@@fixed = true")
+            .expect("unknown field `fixed`, expected `tag` or `fix`"),
+        // LIBRARY: located at the first `[[effect]]` header (the gravity), not at
+        // the key in the second.
+        case("unknown-field-in-effect", COLUMN)
+            .edit("[[effect]]\nkind = \"gravity\"", "@@[[effect]]\nkind = \"gravity\"")
+            .edit("alpha = 0.1", "alpha = 0.1\nbeta = 0.2")
+            .expect("unknown field `beta`, expected `alpha`"),
+        case("unknown-field-in-time", BAR)
+            .edit("dt = 1e-3", "dt = 1e-3\n@@steps = 10")
+            .expect("unknown field `steps`, expected one of `dt`, `courant`, `t_end`"),
+        // LIBRARY: located at `[reference]`, not at the key.
+        case("unknown-field-in-reference", BAR)
+            .edit("[reference]", "@@[reference]")
+            .edit("v0 = 0.1", "v0 = 0.1\namplitude = 2.0")
+            .expect("unknown field `amplitude`, expected `v0`"),
+        case("unknown-field-in-output", BAR)
+            .edit("diagnostics_every = 5", "diagnostics_every = 5\n@@every = 3")
+            .expect("unknown field `every`, expected one of `tracked`, `diagnostics_every`, `condition`"),
+        case("unknown-field-in-resolution", BAR)
+            .edit("blocks = [8, 1]", "blocks = [8, 1]\n@@colour = 1")
+            .expect("unknown field `colour`, expected one of `basis`, `blocks`, `edge_length`, `per_block`"),
+        case("unknown-field-in-study", BAR)
+            .edit("refine = [\"x\"]", "refine = [\"x\"]\n@@levels = 3")
+            .expect("unknown field `levels`, expected `refine`"),
+        case("unknown-field-in-initial-velocity", BAR)
+            .edit("[initial_velocity]", "@@[initial_velocity]")
+            .edit("kind = \"exact\"", "kind = \"sine-mode\"\nv0 = 1.0\nv1 = 2.0")
+            .expect("unknown field `v1`, expected `v0`"),
+    ]
+}
+
+fn type_cases() -> Vec<Case> {
+    vec![
+        // LIBRARY: type errors do not name the field (`dim`, `material.young`, ...).
+        case("string-for-integer", BAR)
+            .edit("dim = 2", "dim = @@\"two\"")
+            .expect("invalid type: string \"two\", expected usize"),
+        case("bare-word-for-integer", BAR)
+            .edit("dim = 2", "dim = @@two")
+            .expect("invalid boolean, expected `true`"),
+        case("string-for-number", BAR)
+            .edit("young = 100.0", "young = @@\"stiff\"")
+            .expect("invalid type: string \"stiff\", expected f64"),
+        case("integer-for-string", BAR)
+            .edit("name = \"bar\"", "name = @@3")
+            .expect("invalid type: integer `3`, expected a string"),
+        case("string-for-boolean", BAR)
+            .edit(
+                "diagnostics_every = 5",
+                "diagnostics_every = 5\ncondition = @@\"yes\"",
+            )
+            .expect("invalid type: string \"yes\", expected a boolean"),
+        case("string-for-list", BAR)
+            .edit(
+                "fix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = \"right\"",
+                "fix = @@\"x\"\n\n[[boundary]]\ntag = \"right\"",
+            )
+            .expect("invalid type: string \"x\", expected a sequence"),
+        case("negative-count", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, @@-2]")
+            .expect("invalid value: integer `-2`, expected usize"),
+        case("table-for-array-of-tables", BAR)
+            .edit("[[body]]", "@@[body]")
+            .expect("invalid type: map, expected a sequence"),
+        // LIBRARY: located at `[mesh]`, and no field named.
+        case("float-for-block-count", BAR)
+            .edit("[mesh]", "@@[mesh]")
+            .edit("blocks = [4, 1]", "blocks = [4.5, 1]")
+            .expect("invalid type: floating point `4.5`, expected usize"),
+        case("three-block-counts", BAR)
+            .edit("[mesh]", "@@[mesh]")
+            .edit("blocks = [4, 1]", "blocks = [4, 1, 1]")
+            .expect("invalid length 3, expected 2 elements in sequence"),
+        // LIBRARY: an integer beyond 64 bits gives a confusing message.
+        case("huge-integer", BAR)
+            .edit("blocks = [4, 1]", "blocks = [@@99999999999999999999, 1]")
+            .expect("invalid type: integer `99999999999999999999` as i128, expected any value"),
+    ]
+}
+
+fn unknown_name_cases() -> Vec<Case> {
+    vec![
+        // LIBRARY: these name the value but not the field (`basis`, `mass`, `split`).
+        case("unknown-basis", BAR)
+            .edit("basis = \"ps\"", "basis = @@\"cubic\"")
+            .expect("unknown basis `cubic` (known: ps, pl, bspline, pl1d)"),
+        case("unknown-mass-strategy", BAR)
+            .edit("mass = \"consistent\"", "mass = @@\"heavy\"")
+            .expect("unknown mass strategy `heavy` (known: consistent, lumped, partial, partial:TAU, deactivate, deactivate:THRESHOLD)"),
+        case("negative-partial-threshold", BAR)
+            .edit("mass = \"consistent\"", "mass = @@\"partial:-1\"")
+            .expect("`partial:-1`: the threshold must be a positive number, got `-1`"),
+        case("unknown-split-point", BAR)
+            .edit("split = \"incentre\"", "split = @@\"orthocentre\"")
+            .expect("unknown split point `orthocentre` (known: incentre, centroid)"),
+        case("unknown-resolution-basis", BAR)
+            .edit("basis = \"pl\"", "basis = @@\"quadratic\"")
+            .expect("unknown basis `quadratic` (known: ps, pl, bspline, pl1d)"),
+        case("unknown-mesh-kind", BAR)
+            .edit("kind = \"blocks\"", "kind = @@\"grid\"")
+            .expect("unknown variant `grid`, expected one of `blocks`, `polygon`, `gmsh`, `interval`"),
+        case("unknown-effect-kind", COLUMN)
+            .edit("kind = \"damping\"", "kind = @@\"magnetism\"")
+            .expect("unknown variant `magnetism`, expected one of `gravity`, `damping`, `traction`, `body-force`, `manufactured-body-force`, `geostatic-stress`"),
+        case("unknown-reference-kind", BAR)
+            .edit("kind = \"vibrating-bar\"", "kind = @@\"pendulum\"")
+            .expect("unknown variant `pendulum`, expected one of `vibrating-bar`, `column-self-weight`, `axis-aligned`, `column-equilibrium`"),
+        case("unknown-initial-velocity-kind", BAR)
+            .edit("kind = \"exact\"", "kind = @@\"spinning\"")
+            .expect("unknown variant `spinning`, expected one of `rest`, `uniform`, `sine-mode`, `exact`"),
+        case("unknown-material-model", BAR)
+            .edit("model = \"linear-elastic\"", "model = @@\"plastic\"")
+            .expect("unknown variant `plastic`, expected `linear-elastic` or `neo-hookean`"),
+        // LIBRARY: located at `[mesh]`, not at the value.
+        case("unknown-block-layout", BAR)
+            .edit("[mesh]", "@@[mesh]")
+            .edit("layout = \"four-triangles\"", "layout = \"hexagons\"")
+            .expect("unknown variant `hexagons`, expected `four-triangles` or `delaunay`"),
+        case("unknown-component", BAR)
+            .edit("fix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = \"right\"", "fix = [@@\"z\"]\n\n[[boundary]]\ntag = \"right\"")
+            .expect("unknown variant `z`, expected one of `x`, `y`, `normal`"),
+    ]
+}
+
+fn range_cases() -> Vec<Case> {
+    vec![
+        case("dim-3", BAR)
+            .edit("dim = 2", "dim = @@3")
+            .expect("dim: must be 1 or 2, got 3"),
+        case("negative-young", BAR)
+            .edit("young = 100.0", "young = @@-100.0")
+            .expect("material.young: young = -100 is out of range: E > 0"),
+        case("poisson-one-half", BAR)
+            .edit("poisson = 0.25", "poisson = @@0.5")
+            .expect("material.poisson: poisson = 0.5 is out of range: −1 < ν < 0.5"),
+        case("poisson-minus-one", BAR)
+            .edit("poisson = 0.25", "poisson = @@-1.0")
+            .expect("material.poisson: poisson = -1 is out of range: −1 < ν < 0.5"),
+        case("zero-density", BAR)
+            .edit("density = 1.0", "density = @@0.0")
+            .expect("material.density: density = 0 is out of range: ρ > 0"),
+        case("zero-dt", BAR)
+            .edit("dt = 1e-3", "dt = @@0.0")
+            .expect("time.dt: must be positive and finite, got 0"),
+        case("negative-dt", BAR)
+            .edit("dt = 1e-3", "dt = @@-1e-3")
+            .expect("time.dt: must be positive and finite, got -0.001"),
+        case("nan-dt", BAR)
+            .edit("dt = 1e-3", "dt = @@nan")
+            .expect("time.dt: must be positive and finite, got NaN"),
+        case("negative-courant", COLUMN)
+            .edit("courant = 0.5", "courant = @@-0.5")
+            .expect("time.courant: must be positive and finite, got -0.5"),
+        case("dt-and-courant", COLUMN)
+            .edit("courant = 0.5", "courant = 0.5\ndt = @@1e-3")
+            .expect("time.dt: give exactly one of `dt` and `courant`"),
+        case("neither-dt-nor-courant", BAR)
+            .edit("[time]\ndt = 1e-3\n", "@@[time]\n")
+            .expect("time.dt: give exactly one of `dt` and `courant`"),
+        case("zero-t-end", BAR)
+            .edit("t_end = 0.01", "t_end = @@0.0")
+            .expect("time.t_end: must be positive and finite, got 0"),
+        case("negative-t-end", BAR)
+            .edit("t_end = 0.01", "t_end = @@-1.0")
+            .expect("time.t_end: must be positive and finite, got -1"),
+        case("t-end-below-one-step", BAR)
+            .edit("t_end = 0.01", "t_end = @@1e-5")
+            .expect("time.t_end: is shorter than one time step"),
+        case("zero-blocks", BAR)
+            .edit("blocks = [4, 1]", "blocks = @@[4, 0]")
+            .expect("mesh.blocks: each count must be in 1..=4096, got [4, 0]"),
+        case("too-many-blocks", BAR)
+            .edit("blocks = [4, 1]", "blocks = @@[5000, 1]")
+            .expect("mesh.blocks: each count must be in 1..=4096, got [5000, 1]"),
+        case("zero-per-block", BAR)
+            .edit("per_block = [4, 4]", "per_block = @@[0, 4]")
+            .expect("body[0].per_block: needs 2 counts in 1..=1000, got [0, 4]"),
+        case("too-many-per-block", BAR)
+            .edit("per_block = [4, 4]", "per_block = @@[4, 1001]")
+            .expect("body[0].per_block: needs 2 counts in 1..=1000, got [4, 1001]"),
+        case("zero-count", SQUARE)
+            .edit("count = [16, 16]", "count = @@[0, 8]")
+            .expect("body[0].count: needs 2 counts in 1..=100000, got [0, 8]"),
+        case("damping-alpha-1.5", COLUMN)
+            .edit("alpha = 0.1", "alpha = @@1.5")
+            .expect("effect[1].alpha: must be in [0, 1), got 1.5"),
+        case("negative-damping-alpha", COLUMN)
+            .edit("alpha = 0.1", "alpha = @@-0.1")
+            .expect("effect[1].alpha: must be in [0, 1), got -0.1"),
+        case("negative-traction-ramp", COLUMN)
+            .edit("ramp = 0.1", "ramp = @@-1.0")
+            .expect("effect[2].ramp: must be ≥ 0, got -1"),
+        case("zero-traction-length", COLUMN)
+            .edit("length = 1.0", "length = @@0.0")
+            .expect("effect[2].length: must be positive and finite, got 0"),
+        case("nan-gravity", COLUMN)
+            .edit("g = [0.0, -9.81]", "g = @@[0.0, nan]")
+            .expect("effect[0].g: must be finite, got NaN"),
+        case("reversed-mesh-x", BAR)
+            .edit("x = [0.0, 4.0]", "x = @@[4.0, 0.0]")
+            .expect("mesh.x: needs min < max, got [4, 0]"),
+        case("infinite-mesh-y", BAR)
+            .edit("y = [0.0, 1.0]", "y = @@[0.0, inf]")
+            .expect("mesh.y: must be finite, got inf"),
+        case("zero-elements", BAR_1D)
+            .edit("elements = 4", "elements = @@0")
+            .expect("mesh.elements: must be in 1..=1000000, got 0"),
+        case("zero-edge-length", SQUARE)
+            .edit("edge_length = 0.25", "edge_length = @@0.0")
+            .expect("mesh.edge_length: must be positive and finite, got 0"),
+        case("infinite-reference-v0", BAR)
+            .edit("v0 = 0.1", "v0 = @@inf")
+            .expect("reference.v0: must be finite, got inf"),
+        case("nan-reference-u0", SQUARE)
+            .edit("u0 = 0.05", "u0 = @@nan")
+            .expect("reference.u0: must be finite, got NaN"),
+    ]
+}
+
+fn inconsistent_cases() -> Vec<Case> {
+    vec![
+        case("1d-basis-in-2d", BAR)
+            .edit("basis = \"ps\"", "basis = @@\"bspline\"")
+            .expect("basis: `bspline` is a 1D basis but the scene is 2D (2D: ps, pl; 1D: bspline, pl1d)"),
+        case("2d-basis-in-1d", BAR_1D)
+            .edit("basis = \"bspline\"", "basis = @@\"ps\"")
+            .expect("basis: `ps` is a 2D basis but the scene is 1D (2D: ps, pl; 1D: bspline, pl1d)"),
+        case("blocks-mesh-in-1d", BAR)
+            .edit("dim = 2", "dim = 1")
+            .edit("basis = \"ps\"", "basis = \"bspline\"")
+            .edit("kind = \"blocks\"", "kind = @@\"blocks\"")
+            .expect("mesh.kind: `blocks` is a 2D mesh; use `interval` in 1D"),
+        case("interval-mesh-in-2d", BAR_1D)
+            .edit("dim = 1", "dim = 2")
+            .edit("basis = \"bspline\"", "basis = \"pl\"")
+            .edit("kind = \"interval\"", "kind = @@\"interval\"")
+            .expect("mesh.kind: `interval` is a 1D mesh; use `blocks` in 2D"),
+        case("gmsh-mesh-in-1d", GMSH)
+            .edit("dim = 2", "dim = 1")
+            .edit("basis = \"pl\"", "basis = \"pl1d\"")
+            .edit("kind = \"gmsh\"", "kind = @@\"gmsh\"")
+            .expect("mesh.kind: `gmsh` meshes are 2D"),
+        case("body-with-one-coordinate", BAR)
+            .edit("min = [0.0, 0.0]", "min = @@[0.0]")
+            .expect("body[0].min: needs 2 entries, got 1"),
+        case("body-with-three-coordinates", BAR)
+            .edit("max = [4.0, 1.0]", "max = @@[4.0, 1.0, 1.0]")
+            .expect("body[0].max: needs 2 entries, got 3"),
+        // LIBRARY (minor): the values of min and max are not given.
+        case("body-min-not-below-max", BAR)
+            .edit("max = [4.0, 1.0]", "max = @@[4.0, 0.0]")
+            .expect("body[0].max: needs min < max on every axis"),
+        case("second-body-min-not-below-max", BAR)
+            .edit("[initial_velocity]", "[[body]]\nmin = [1.0, 1.0]\nmax = @@[2.0, 1.0]\ncount = [2, 2]\n\n[initial_velocity]")
+            .expect("body[1].max: needs min < max on every axis"),
+        case("per-block-and-count", BAR)
+            .edit("per_block = [4, 4]", "per_block = @@[4, 4]\ncount = [8, 2]")
+            .expect("body[0].per_block: give exactly one of `per_block` and `count`"),
+        case("neither-per-block-nor-count", BAR)
+            .edit("[[body]]", "@@[[body]]")
+            .edit("per_block = [4, 4]\n", "")
+            .expect("body[0].per_block: give exactly one of `per_block` and `count`"),
+        case("per-block-on-a-polygon-mesh", SQUARE)
+            .edit("count = [16, 16]", "per_block = @@[2, 2]")
+            .expect("body[0].per_block: needs a `blocks` or `interval` mesh; use `count` on other meshes"),
+        // LIBRARY (minor): `1d` should read `1D`.
+        case("component-y-in-1d", BAR_1D)
+            .edit("fix = [\"x\"]", "fix = @@[\"y\"]")
+            .expect("boundary[0].fix: component `y` does not exist in 1d"),
+        case("no-component", BAR)
+            .edit("fix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = \"right\"", "fix = @@[]\n\n[[boundary]]\ntag = \"right\"")
+            .expect("boundary[0].fix: lists no component"),
+        case("normal-with-another-component", BAR)
+            .edit("fix = [\"x\", \"y\"]\n\n[time]", "fix = @@[\"normal\", \"x\"]\n\n[time]")
+            .expect("boundary[1].fix: `normal` fixes the normal component alone; list it on its own"),
+        case("column-reference-without-gravity", COLUMN)
+            .edit("[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n\n", "")
+            .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
+            .expect("reference.kind: a column reference needs a gravity effect"),
+        case("geostatic-stress-without-gravity", BAR)
+            .edit("[time]", "[[effect]]\nkind = @@\"geostatic-stress\"\nsurface = 1.0\n\n[time]")
+            .expect("effect[0].kind: geostatic stress needs a gravity effect"),
+        case("manufactured-force-without-axis-aligned", BAR)
+            .edit("[time]", "[[effect]]\nkind = @@\"manufactured-body-force\"\n\n[time]")
+            .expect("effect[0].kind: `manufactured-body-force` needs reference kind `axis-aligned`"),
+        case("axis-aligned-with-linear-elasticity", SQUARE)
+            .edit("model = \"neo-hookean\"", "model = \"linear-elastic\"")
+            .edit("kind = \"axis-aligned\"", "kind = @@\"axis-aligned\"")
+            .expect("reference.kind: `axis-aligned` is a 2D neo-Hookean solution"),
+        case("exact-velocity-without-reference", BAR)
+            .edit("[reference]\nkind = \"vibrating-bar\"\nv0 = 0.1\n", "")
+            .edit("kind = \"exact\"", "kind = @@\"exact\"")
+            .expect("initial_velocity.kind: `exact` needs a [reference] solution"),
+        case("uniform-velocity-with-one-entry", BAR)
+            .edit("kind = \"exact\"", "kind = \"uniform\"\nvalue = @@[1.0]")
+            .expect("initial_velocity.value: needs 2 entries, got 1"),
+        case("polygon-with-two-corners", SQUARE)
+            .edit("outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]", "outline = @@[[0.0, 0.0], [1.0, 0.0]]")
+            .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]\n", "")
+            .expect("mesh.outline: needs at least 3 corners"),
+        case("polygon-with-two-tags", SQUARE)
+            .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]", "tags = @@[\"bottom\", \"right\"]")
+            .expect("mesh.tags: needs one tag per outline segment (4), got 2"),
+        case("refine-normal", BAR)
+            .edit("refine = [\"x\"]", "refine = @@[\"normal\"]")
+            .expect("study.refine: lists axes, `x` or `y`"),
+        // LIBRARY (minor): located at `[output]`, not at `tracked`.
+        case("tracked-point-with-one-coordinate", BAR)
+            .edit("[output]", "@@[output]")
+            .edit("tracked = [[2.0, 0.5]]", "tracked = [[2.0]]")
+            .expect("output.tracked[0]: needs 2 entries, got 1"),
+        case("empty-gmsh-file-name", GMSH)
+            .edit("file = \"meshes/square.msh\"", "file = @@\"\"")
+            .expect("mesh.file: is empty"),
+        // LIBRARY: the errors below are found when the scene is built, after the
+        // file was read: no file, line and column, and some name no field.
+        case("unknown-boundary-tag", BAR)
+            .edit("tag = \"right\"", "tag = \"west\"")
+            .expect("unknown boundary tag `west`; the mesh has tags [\"bottom\", \"top\", \"left\", \"right\"]"),
+        case("unknown-boundary-tag-on-a-gmsh-mesh", GMSH)
+            .edit("tag = \"bottom\"", "tag = \"wall\"")
+            .expect("unknown boundary tag `wall`; the mesh has tags [\"bottom\", \"right\", \"top\", \"left\"]"),
+        case("body-outside-the-mesh", BAR)
+            .edit("max = [4.0, 1.0]", "max = [4.0, 2.0]")
+            .expect("body[0]: the particle at [0.125, 1.125] lies outside the mesh; the body's box must lie inside the meshed domain"),
+        case("body-not-a-whole-number-of-cells", BAR)
+            .edit("max = [4.0, 1.0]", "max = [4.0, 0.9]")
+            .expect("body[0].max: the body's extent 0.9 along axis 1 is not a whole number of lattice cells of size 0.25"),
+        case("traction-box-selects-nothing", COLUMN)
+            .edit("min = [0.0, 3.5]\nmax = [1.0, 4.0]", "min = [5.0, 5.0]\nmax = [6.0, 6.0]")
+            .expect("effect[2].min: the traction box selects no particle"),
+        case("self-intersecting-polygon", SQUARE)
+            .edit("outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]", "outline = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]")
+            .expect("mesh: invalid mesh parameter: the boundary intersects itself: segment (0, 0)–(1, 1) of the outer polygon meets segment (1, 0)–(0, 1) of the outer polygon"),
+        case("edge-length-below-the-mesher-limit", SQUARE)
+            .edit("edge_length = 0.25", "edge_length = 1e-5")
+            .expect("mesh: invalid mesh parameter: target_edge_length must be at least 1e-4 of the domain size 1.4142135623730951, got 0.00001"),
+        case("block-grid-beyond-the-generator-limit", BAR)
+            .edit("blocks = [4, 1]", "blocks = [4096, 4096]")
+            .edit("per_block = [4, 4]", "per_block = [1, 1]")
+            .expect("mesh: invalid mesh parameter: nx × ny = 16777216 exceeds the limit of 10000000"),
+    ]
+}
+
+fn missing_cases() -> Vec<Case> {
+    vec![
+        case("missing-name", BAR)
+            .edit("# A small", "@@# A small")
+            .edit("name = \"bar\"\n", "")
+            .expect("missing field `name`"),
+        case("missing-material", BAR)
+            .edit("# A small", "@@# A small")
+            .edit("[material]\nmodel = \"linear-elastic\"\nyoung = 100.0\npoisson = 0.25\ndensity = 1.0\n", "")
+            .expect("missing field `material`"),
+        case("missing-body", BAR)
+            .edit("# A small", "@@# A small")
+            .edit("[[body]]\nmin = [0.0, 0.0]\nmax = [4.0, 1.0]\nper_block = [4, 4]\n", "")
+            .expect("missing field `body`"),
+        case("missing-time", BAR)
+            .edit("# A small", "@@# A small")
+            .edit("[time]\ndt = 1e-3\nt_end = 0.01\n", "")
+            .expect("missing field `time`"),
+        case("missing-young", BAR)
+            .edit("[material]", "@@[material]")
+            .edit("young = 100.0\n", "")
+            .expect("missing field `young`"),
+        case("missing-t-end", BAR)
+            .edit("[time]", "@@[time]")
+            .edit("t_end = 0.01\n", "")
+            .expect("missing field `t_end`"),
+        case("missing-boundary-fix", BAR)
+            .edit("[[boundary]]\ntag = \"right\"", "@@[[boundary]]\ntag = \"right\"")
+            .edit("fix = [\"x\", \"y\"]\n\n[time]", "\n[time]")
+            .expect("missing field `fix`"),
+        case("missing-mesh-kind", BAR)
+            .edit("[mesh]", "@@[mesh]")
+            .edit("kind = \"blocks\"\n", "")
+            .expect("missing field `kind`"),
+        case("missing-gmsh-file", GMSH)
+            .edit("[mesh]", "@@[mesh]")
+            .edit("file = \"meshes/square.msh\"\n", "")
+            .expect("missing field `file`"),
+        case("missing-gravity-g", COLUMN)
+            .edit("[[effect]]\nkind = \"gravity\"", "@@[[effect]]\nkind = \"gravity\"")
+            .edit("g = [0.0, -9.81]\n", "")
+            .expect("missing field `g`"),
+        case("empty-file", "")
+            .map(|_| "@@".into())
+            .expect("missing field `name`"),
+    ]
+}
+
+/// Scenes reading a malformed mesh from `meshes/` next to the scene file.
+fn mesh_cases() -> Vec<Case> {
+    let bad = |name: &'static str, msh: &str, message: &str| {
+        case(name, GMSH)
+            .edit("meshes/square.msh", &format!("meshes/{msh}"))
+            .expect(&format!("mesh.file: {{dir}}/meshes/{msh}{message}"))
+    };
+    let data = repo().join("tests/data");
+    let at = |file: &str, needle: &str| format!(":{}", line_of(&data.join(file), needle));
+    vec![
+        bad(
+            "gmsh-missing",
+            "nothere.msh",
+            ": cannot read: No such file or directory (os error 2)",
+        ),
+        bad(
+            "gmsh-binary",
+            "square_binary.msh",
+            ":2: binary .msh is not supported: save as ASCII (Mesh.Binary = 0)",
+        ),
+        bad(
+            "gmsh-quadrilaterals",
+            "quads.msh",
+            &format!(
+                "{}: quadrilateral elements (type 3) are not supported: psmpm reads first-order triangle meshes",
+                at("quads.msh", "2 1 3 78")
+            ),
+        ),
+        bad(
+            "gmsh-second-order",
+            "second_order.msh",
+            &format!(
+                "{}: second-order triangle elements (type 9) are not supported: psmpm reads first-order triangle meshes",
+                at("bad/second_order.msh", "33 9 ")
+            ),
+        ),
+        bad(
+            "gmsh-undefined-node",
+            "undefined_node.msh",
+            &format!(
+                "{}: element refers to undefined node 999",
+                at("bad/undefined_node.msh", "33 37 68 999")
+            ),
+        ),
+        bad(
+            "gmsh-truncated-4.1",
+            "truncated.msh",
+            ":101: unexpected end of file, expected a node tag",
+        ),
+        bad(
+            "gmsh-truncated-2.2",
+            "truncated_v22.msh",
+            ":201: unexpected end of file, expected an element (tag type numTags tags… nodes…)",
+        ),
+        bad(
+            "gmsh-version-3",
+            "version3.msh",
+            ":2: unsupported .msh format version 3.0 (supported: 4.1 and 2.2 ASCII)",
+        ),
+        bad(
+            "gmsh-no-triangles",
+            "no_triangles.msh",
+            ": no triangles (element type 2) in the file",
+        ),
+        bad(
+            "gmsh-not-planar",
+            "nonplanar.msh",
+            ": node 50 has z = 0.5 but others have z = 0: only planar meshes in a z = const plane are supported",
+        ),
+        bad(
+            "gmsh-duplicate-node",
+            "duplicate_node.msh",
+            &format!(
+                "{}: node 5 is defined twice",
+                at("bad/duplicate_node.msh", "5 0.374999999999046")
+            ),
+        ),
+        bad(
+            "gmsh-decimal-comma",
+            "bad_number.msh",
+            &format!(
+                "{}: expected a finite number for x, found `0,1249999999997731`",
+                at("bad/bad_number.msh", "5 0,12")
+            ),
+        ),
+        // LIBRARY (minor): no line for the inverted element (it is line 146).
+        bad(
+            "gmsh-inverted-triangle",
+            "inverted.msh",
+            ": invalid mesh: triangle 0 is clockwise (inverted); triangles must be counter-clockwise",
+        ),
+        bad(
+            "gmsh-misspelt-end",
+            "misspelt_end.msh",
+            &format!(
+                "{}: expected $EndNodes, found `$EndNode`",
+                at("bad/misspelt_end.msh", "$EndNode")
+            ),
+        ),
+        bad(
+            "gmsh-not-a-mesh",
+            "not_a_mesh.msh",
+            ":1: expected $MeshFormat at the start of the file, found `name = \"vibrating-bar\"`",
+        ),
+        bad(
+            "gmsh-empty",
+            "empty.msh",
+            ":1: unexpected end of file, expected a section",
+        ),
+        bad(
+            "gmsh-parametric",
+            "parametric.msh",
+            &format!(
+                "{}: parametric nodes are not supported",
+                at("bad/parametric.msh", "1 1 1 7")
+            ),
+        ),
+        bad(
+            "gmsh-too-few-tags",
+            "too_few_tags.msh",
+            &format!(
+                "{}: element lists fewer tags than it announces",
+                at("bad/too_few_tags.msh", "194 2 9")
+            ),
+        ),
+        bad(
+            "gmsh-huge-node-count",
+            "huge_count.msh",
+            &format!(
+                "{}: expected 4 values in a node (tag x y z), found 1: `$EndNodes`",
+                at("bad/huge_count.msh", "$EndNodes")
+            ),
+        ),
+        bad(
+            "gmsh-negative-element-count",
+            "negative_count.msh",
+            &format!(
+                "{}: the number of elements must be non-negative, found -194",
+                at("bad/negative_count.msh", "-194")
+            ),
+        ),
+        // A slip wall on a curved boundary.  LIBRARY: no file, line and column.
+        case("gmsh-slip-wall-on-a-curve", GMSH)
+            .edit("meshes/square.msh", "meshes/square_hole.msh")
+            .edit("tag = \"bottom\"\nfix = [\"x\", \"y\"]", "tag = \"hole\"\nfix = [\"normal\"]")
+            .edit("min = [0.0, 0.0]\nmax = [1.0, 1.0]", "min = [0.0, 0.0]\nmax = [1.0, 0.25]")
+            .expect("boundary[0].fix: `normal` needs a straight wall, but `hole` bends"),
+    ]
+}
+
+/// Writes the bases and the meshes into `dir`.
+fn setup(dir: &Path) {
+    let meshes = dir.join("meshes");
+    std::fs::create_dir_all(&meshes).unwrap();
+    let data = repo().join("tests/data");
+    for sub in [data.clone(), data.join("bad")] {
+        for entry in std::fs::read_dir(&sub).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "msh") {
+                std::fs::copy(&path, meshes.join(path.file_name().unwrap())).unwrap();
+            }
+        }
+    }
+}
+
+#[test]
+fn the_base_scenes_are_valid() {
+    // Every malformed scene is a base with a few edits: the bases themselves run.
+    let dir = temp_dir("bases");
+    setup(&dir);
+    for (name, text) in BASES {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let out = cli()
+            .args(["run", path.to_str().unwrap(), "--diag-every", "0"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn malformed_scenes_name_file_line_column_and_field() {
+    let dir = temp_dir("scenes");
+    setup(&dir);
+    let cases: Vec<Case> = [
+        syntax_cases(),
+        unknown_field_cases(),
+        type_cases(),
+        unknown_name_cases(),
+        range_cases(),
+        inconsistent_cases(),
+        missing_cases(),
+        mesh_cases(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    assert!(cases.len() >= 140, "{} cases", cases.len());
+    let mut names = std::collections::HashSet::new();
+    let mut failures = String::new();
+    for c in &cases {
+        assert!(names.insert(c.name), "two cases named {}", c.name);
+        let path = dir.join(format!("{}.toml", c.name));
+        let (text, expected) = c.resolve(&path);
+        std::fs::write(&path, text).unwrap();
+        match input_error(&["run", path.to_str().unwrap()]) {
+            Ok(stderr) if stderr == expected => {}
+            Ok(stderr) => {
+                let _ = write!(
+                    failures,
+                    "\n{}:\n  expected {expected}  got      {stderr}",
+                    c.name
+                );
+            }
+            Err(e) => {
+                let _ = write!(failures, "\n{}: {e}", c.name);
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_absolute_gmsh_path_is_used_as_is() {
+    let dir = temp_dir("absolute");
+    let mesh = repo().join("tests/data/bad/empty.msh");
+    let mesh = mesh.canonicalize().unwrap();
+    let scene = GMSH.replace("meshes/square.msh", mesh.to_str().unwrap());
+    let path = dir.join("absolute.toml");
+    std::fs::write(&path, scene).unwrap();
+    let stderr = input_error(&["run", path.to_str().unwrap()]).unwrap();
+    assert_eq!(
+        stderr,
+        format!(
+            "error: mesh.file: {}:1: unexpected end of file, expected a section\n",
+            mesh.display()
+        )
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unreadable_scene_files_are_named() {
+    let dir = temp_dir("unreadable");
+    let missing = dir.join("missing.toml");
+    let missing = missing.to_str().unwrap();
+    assert_eq!(
+        input_error(&["run", missing]).unwrap(),
+        format!("error: {missing}: cannot read: No such file or directory (os error 2)\n")
+    );
+    let binary = dir.join("binary.toml");
+    std::fs::write(&binary, b"name = \"\xff\xfe\"\n").unwrap();
+    let binary = binary.to_str().unwrap();
+    assert_eq!(
+        input_error(&["run", binary]).unwrap(),
+        format!("error: {binary}: cannot read: stream did not contain valid UTF-8\n")
+    );
+    let folder = dir.join("folder.toml");
+    std::fs::create_dir_all(&folder).unwrap();
+    let folder = folder.to_str().unwrap();
+    assert_eq!(
+        input_error(&["run", folder]).unwrap(),
+        format!("error: {folder}: cannot read: Is a directory (os error 21)\n")
+    );
+    // `scene show` reads files the same way.
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, BAR.replace("dt = 1e-3", "dt = -1e-3")).unwrap();
+    let bad = bad.to_str().unwrap();
+    let line = 1 + BAR.lines().position(|l| l == "dt = 1e-3").unwrap();
+    assert_eq!(
+        input_error(&["scene", "show", bad]).unwrap(),
+        format!("error: {bad}:{line}:6: time.dt: must be positive and finite, got -0.001\n")
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn project_names_the_bad_mesh_and_its_line() {
+    let data = repo().join("tests/data");
+    let cases = [
+        (
+            "bad/undefined_node.msh",
+            format!(
+                ":{}: element refers to undefined node 999",
+                line_of(&data.join("bad/undefined_node.msh"), "33 37 68 999")
+            ),
+        ),
+        (
+            "square_binary.msh",
+            ":2: binary .msh is not supported: save as ASCII (Mesh.Binary = 0)".into(),
+        ),
+        (
+            "quads.msh",
+            format!(
+                ":{}: quadrilateral elements (type 3) are not supported: psmpm reads first-order triangle meshes",
+                line_of(&data.join("quads.msh"), "2 1 3 78")
+            ),
+        ),
+        (
+            "bad/truncated_v22.msh",
+            ":201: unexpected end of file, expected an element (tag type numTags tags… nodes…)"
+                .into(),
+        ),
+        (
+            "bad/nonplanar.msh",
+            ": node 50 has z = 0.5 but others have z = 0: only planar meshes in a z = const plane are supported".into(),
+        ),
+        (
+            "bad/missing.msh",
+            ": cannot read: No such file or directory (os error 2)".into(),
+        ),
+    ];
+    let mut failures = String::new();
+    for (file, message) in cases {
+        let path = data.join(file);
+        let path = path.to_str().unwrap();
+        let expected = format!("error: {path}{message}\n");
+        match input_error(&["project", "--mesh", path, "--levels", "1"]) {
+            Ok(stderr) if stderr == expected => {}
+            Ok(stderr) => {
+                let _ = write!(
+                    failures,
+                    "\n{file}:\n  expected {expected}  got      {stderr}"
+                );
+            }
+            Err(e) => {
+                let _ = write!(failures, "\n{file}: {e}");
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures}");
+}
+
+#[test]
+fn an_unknown_scene_lists_the_known_ones() {
+    let stderr = input_error(&["run", "pendulum"]).unwrap();
+    let known: Vec<&str> = psmpm::scene::BUILTIN.iter().map(|(n, _, _)| *n).collect();
+    assert_eq!(
+        stderr,
+        format!(
+            "error: unknown scene `pendulum` (known: {})\n",
+            known.join(", ")
+        )
+    );
+    // A file name must end in `.toml` to be read as a file.
+    let stderr = input_error(&["run", "scene.TOML"]).unwrap();
+    assert!(
+        stderr.starts_with("error: unknown scene `scene.TOML` (known: vibrating-bar, "),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn unknown_flags_follow_clap_conventions() {
+    let out = cli()
+        .args(["run", "vibrating-bar", "--frobnicate"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.starts_with("error: unexpected argument '--frobnicate' found\n"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("\nUsage: mpm-cli run "), "{stderr}");
+    assert!(stderr.contains("For more information, try '--help'."));
+    assert!(!stderr.contains("panicked"));
+
+    for (args, first) in [
+        (
+            &["frobnicate"][..],
+            "error: unrecognized subcommand 'frobnicate'",
+        ),
+        (
+            &["run"][..],
+            "error: the following required arguments were not provided:",
+        ),
+        (
+            &["run", "vibrating-bar", "--dt", "small"][..],
+            "error: invalid value 'small' for '--dt <DT>': invalid float literal",
+        ),
+        (
+            &["run", "vibrating-bar", "--format", "xml"][..],
+            "error: invalid value 'xml' for '--format <FORMAT>'",
+        ),
+    ] {
+        let out = cli().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(stderr.lines().next(), Some(first), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"));
+    }
+}
+
+#[test]
+fn a_run_that_fails_numerically_exits_with_1_and_names_the_step() {
+    let out = cli()
+        .args(["run", "vibrating-bar", "--dt", "100", "--t-end", "1000"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.starts_with("error: step 1: "), "{stderr}");
+    assert!(stderr.contains("try a smaller time step"), "{stderr}");
+    // The summary on stdout says where the run stopped.
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains("stopped: step 1: "), "{stdout}");
+}
+
+/// What the cases marked `LIBRARY` should give once the library is fixed: each
+/// entry is a malformed scene and the strings its error must contain (`{file}`:
+/// the scene file).
+#[test]
+#[ignore = "library gaps reported to the lead; run with --ignored to check the fixes"]
+fn known_library_gaps() {
+    let dir = temp_dir("gaps");
+    setup(&dir);
+    let bar_line = |needle: &str| 1 + BAR.lines().position(|l| l.starts_with(needle)).unwrap();
+    let gaps: Vec<(&str, String, Vec<String>)> = vec![
+        (
+            "duplicate key names the key",
+            BAR.replace("density = 1.0", "density = 1.0\ndensity = 2.0"),
+            vec!["density".into()],
+        ),
+        (
+            "unknown field in [mesh] located at the key",
+            BAR.replace("blocks = [4, 1]", "blocks = [4, 1]\nblock = [4, 1]"),
+            vec![format!("{{file}}:{}:1: ", bar_line("blocks") + 1)],
+        ),
+        (
+            "unknown field in [reference] located at the key",
+            BAR.replace("v0 = 0.1", "v0 = 0.1\namplitude = 2.0"),
+            vec![format!("{{file}}:{}:1: ", bar_line("v0 = 0.1") + 1)],
+        ),
+        (
+            "unknown field in the second [[effect]] located at its key",
+            COLUMN.replace("alpha = 0.1", "alpha = 0.1\nbeta = 0.2"),
+            vec![format!(
+                "{{file}}:{}:1: ",
+                1 + COLUMN.lines().position(|l| l == "alpha = 0.1").unwrap() + 1
+            )],
+        ),
+        (
+            "type errors name the field",
+            BAR.replace("dim = 2", "dim = \"two\""),
+            vec!["dim".into(), "{file}:4:7: ".into()],
+        ),
+        (
+            "type errors in [mesh] name the field and its line",
+            BAR.replace("blocks = [4, 1]", "blocks = [4.5, 1]"),
+            vec![
+                "mesh.blocks".into(),
+                format!("{{file}}:{}:", bar_line("blocks")),
+            ],
+        ),
+        (
+            "unknown basis names the field",
+            BAR.replace("basis = \"ps\"", "basis = \"cubic\""),
+            vec!["basis: unknown basis `cubic`".into()],
+        ),
+        (
+            "unknown mass strategy names the field",
+            BAR.replace("mass = \"consistent\"", "mass = \"heavy\""),
+            vec!["mass: unknown mass strategy `heavy`".into()],
+        ),
+        (
+            "unknown boundary tag is located and names the field",
+            BAR.replace("tag = \"right\"", "tag = \"west\""),
+            vec![
+                format!("{{file}}:{}:", bar_line("tag = \"right\"")),
+                "boundary[1].tag".into(),
+            ],
+        ),
+        (
+            "a body outside the mesh is located",
+            BAR.replace("max = [4.0, 1.0]", "max = [4.0, 2.0]"),
+            vec![format!("{{file}}:{}:", bar_line("max = [4.0, 1.0]"))],
+        ),
+        (
+            "mesher errors are located and name the field",
+            SQUARE.replace("edge_length = 0.25", "edge_length = 1e-5"),
+            vec!["mesh.edge_length".into(), "{file}:".into()],
+        ),
+        (
+            "columns count characters, not bytes",
+            BAR.replace("name = \"bar\"", "name = \"bär\" x"),
+            vec!["{file}:2:14: ".into()],
+        ),
+        (
+            "1D is spelt 1D",
+            BAR_1D.replace("fix = [\"x\"]", "fix = [\"y\"]"),
+            vec!["in 1D".into()],
+        ),
+        (
+            "unknown fields of a unit reference kind are rejected",
+            COLUMN.replace(
+                "kind = \"column-self-weight\"",
+                "kind = \"column-self-weight\"\nv0 = 0.1",
+            ),
+            vec!["unknown field `v0`".into()],
+        ),
+        (
+            "unknown fields of the manufactured body force are rejected",
+            SQUARE.replace(
+                "kind = \"manufactured-body-force\"",
+                "kind = \"manufactured-body-force\"\nvalue = [1.0, 0.0]",
+            ),
+            vec!["unknown field `value`".into()],
+        ),
+        (
+            "unknown fields of a unit initial velocity are rejected",
+            BAR.replace("kind = \"exact\"", "kind = \"rest\"\nvalue = [1.0, 0.0]"),
+            vec!["unknown field `value`".into()],
+        ),
+    ];
+    let mut failures = String::new();
+    for (k, (what, text, wanted)) in gaps.iter().enumerate() {
+        let path = dir.join(format!("gap{k}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let file = path.to_str().unwrap();
+        match input_error(&["run", file]) {
+            Ok(stderr) => {
+                for w in wanted {
+                    let w = w.replace("{file}", file);
+                    if !stderr.contains(&w) {
+                        let _ = write!(failures, "\n{what}: `{w}` not in {stderr}");
+                    }
+                }
+            }
+            Err(e) => {
+                let _ = write!(failures, "\n{what}: {e}");
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures}");
+}
