@@ -252,12 +252,14 @@ pub struct Body {
 }
 
 /// Initial velocity.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+///
+/// (Variants without parameters are written `Rest {}` so that a stray key next to
+/// their `kind` is rejected as an unknown field.)
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum InitialVelocity {
     /// At rest.
-    #[default]
-    Rest,
+    Rest {},
     /// The same velocity everywhere.
     Uniform {
         /// Velocity (`dim` entries).
@@ -269,7 +271,13 @@ pub enum InitialVelocity {
         v0: f64,
     },
     /// The velocity of the scene's reference solution at `t = 0`.
-    Exact,
+    Exact {},
+}
+
+impl Default for InitialVelocity {
+    fn default() -> Self {
+        InitialVelocity::Rest {}
+    }
 }
 
 /// A homogeneous Dirichlet condition on the boundary with tag `tag`.
@@ -349,7 +357,7 @@ pub enum EffectSpec {
     },
     /// The body force that makes the reference solution exact (paper eqs. (42)–(46)
     /// for `axis-aligned`).
-    ManufacturedBodyForce,
+    ManufacturedBodyForce {},
     /// Geostatic initial stress: `σ_yy = ρ g (surface − y)`, `σ_xx = k0 σ_yy`, with
     /// the density of the material and `g` of the gravity effect.
     GeostaticStress {
@@ -389,7 +397,7 @@ pub enum Reference {
     },
     /// B5a: column settling under self-weight from rest (thesis eq. (4.6),
     /// corrected), height of the first body, `g` of the gravity effect; error `E_u`.
-    ColumnSelfWeight,
+    ColumnSelfWeight {},
     /// B4: the neo-Hookean manufactured solution (paper §4.2); error: the
     /// time-averaged RMS position error of paper eq. (47).
     AxisAligned {
@@ -401,16 +409,16 @@ pub enum Reference {
     /// exact profile is that of the project's linear law `σ = E (F − 1)`
     /// ([`crate::exact::column_equilibrium_stress_linear`]); paper eq. (48) belongs
     /// to a slightly different law and differs by about `κ² |σ_yy(0)|`.
-    ColumnEquilibrium,
+    ColumnEquilibrium {},
 }
 
 impl Reference {
     /// Name of the error measure.
     pub fn error_measure(&self) -> &'static str {
         match self {
-            Reference::VibratingBar { .. } | Reference::ColumnSelfWeight => "E_u",
+            Reference::VibratingBar { .. } | Reference::ColumnSelfWeight {} => "E_u",
             Reference::AxisAligned { .. } => "rms-position",
-            Reference::ColumnEquilibrium => "max-relative-sigma-yy",
+            Reference::ColumnEquilibrium {} => "max-relative-sigma-yy",
         }
     }
 }
@@ -484,6 +492,11 @@ pub fn parse_split(name: &str) -> Result<SplitPoint, String> {
         )),
     }
 }
+
+/// Most blocks a `blocks` mesh may have.
+pub const MAX_BLOCKS: usize = 1_000_000;
+/// Most particles a scene may have.
+pub const MAX_PARTICLES: usize = 10_000_000;
 
 /// The built-in scenes: name, one line, TOML text.
 pub const BUILTIN: [(&str, &str, &str); 10] = [
@@ -572,18 +585,118 @@ fn bad(field: impl Into<String>, message: impl Into<String>) -> SceneError {
 
 /// 1-based line and column of byte offset `at` in `text`.
 fn line_column(text: &str, at: usize) -> (usize, usize) {
-    let before = &text[..at.min(text.len())];
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
     let line = before.matches('\n').count() + 1;
-    let column = before
-        .rfind('\n')
-        .map_or(before.len(), |i| before.len() - i - 1)
+    // Columns count characters, not bytes.
+    let column = before[before.rfind('\n').map_or(0, |i| i + 1)..]
+        .chars()
+        .count()
         + 1;
     (line, column)
+}
+
+/// Byte offset of the first line at or after `from` that sets `key`.
+fn key_line_after(text: &str, from: usize, key: &str) -> Option<usize> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        if offset + line.len() > from
+            && line
+                .split_once('=')
+                .is_some_and(|(k, _)| k.trim() == key && !line.trim_start().starts_with('#'))
+        {
+            return Some(offset + line.len() - line.trim_start().len());
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// Byte offset of the first value at or after `from` (in a `key = value` line, before
+/// the next table header but one) that contains `value`.
+fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
+    let mut offset = 0;
+    let mut headers = 0;
+    for line in text.split_inclusive('\n') {
+        if offset >= from {
+            if line.trim_start().starts_with('[') {
+                headers += 1;
+                if headers > 1 {
+                    return None;
+                }
+            } else if let Some(eq) = line.find('=') {
+                if let Some(i) = line[eq..].find(value) {
+                    return Some(offset + eq + i);
+                }
+            }
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// The dotted field (`mesh.blocks`, `effect[1].kind`, `basis`) set on the line of
+/// byte offset `at`, if that line is a `key = value` line.
+fn field_at(text: &str, at: usize) -> Option<String> {
+    let mut table: Option<String> = None;
+    let mut counts = std::collections::HashMap::<String, usize>::new();
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim();
+        if let Some(name) = trimmed.strip_prefix("[[").and_then(|r| r.split_once("]]")) {
+            let name = name.0.trim().to_string();
+            let count = counts.entry(name.clone()).or_insert(0);
+            table = Some(format!("{name}[{count}]"));
+            *count += 1;
+        } else if let Some(name) = trimmed.strip_prefix('[').and_then(|r| r.split_once(']')) {
+            table = Some(name.0.trim().to_string());
+        }
+        if at < offset + line.len() {
+            let (key, _) = line.split_once('=')?;
+            let key = key.trim();
+            if key.is_empty()
+                || key.starts_with('#')
+                || !key
+                    .chars()
+                    .all(|c| c.is_alphanumeric() || c == '_' || c == '-')
+            {
+                return None;
+            }
+            return Some(match table {
+                Some(t) => format!("{t}.{key}"),
+                None => key.to_string(),
+            });
+        }
+        offset += line.len();
+    }
+    None
 }
 
 /// Byte offset of the value of field `path` (`time.dt`, `body[1].count`, `mesh`) in
 /// the TOML `text`, found by walking its tables; the start of the file if not found.
 fn field_offset(text: &str, path: &str) -> usize {
+    // A whole array-of-tables entry (`body[1]`) or table (`body`): its header.
+    if !path.contains('.') {
+        let (name, index) = match path.split_once('[') {
+            Some((n, i)) => (n, i.trim_end_matches(']').parse::<usize>().unwrap_or(0)),
+            None => (path, 0),
+        };
+        let mut offset = 0;
+        let mut seen = 0;
+        for line in text.split_inclusive('\n') {
+            let t = line.trim();
+            if t == format!("[[{name}]]") || t == format!("[{name}]") {
+                if seen == index {
+                    return offset;
+                }
+                seen += 1;
+            }
+            offset += line.len();
+        }
+    }
     // Split `body[1].count` into table `body`, index 1, key `count`.
     let (table, index, key) = match path.split_once('.') {
         Some((head, key)) => {
@@ -658,6 +771,24 @@ fn field_offset(text: &str, path: &str) -> usize {
     table_start.unwrap_or(0)
 }
 
+/// `message` located in the scene file `text` (named `file`) when it starts with a
+/// field path (`body[0].max: ...`, `boundary[1].tag: ...`): `file:line:column: message`.
+/// For errors found while a run is built, after the file parsed.
+pub fn locate_message(text: &str, file: &str, message: &str) -> String {
+    let Some((field, _)) = message.split_once(':') else {
+        return message.to_string();
+    };
+    let is_path = !field.is_empty()
+        && field
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_[].".contains(c));
+    if !is_path {
+        return message.to_string();
+    }
+    let (line, column) = line_column(text, field_offset(text, field));
+    format!("{file}:{line}:{column}: {message}")
+}
+
 impl Scene {
     /// The built-in scene `name`. The error lists the known scenes.
     pub fn builtin(name: &str) -> Result<Self, String> {
@@ -680,8 +811,50 @@ impl Scene {
             }
         };
         let scene: Scene = toml::from_str(text).map_err(|e| {
-            let at = e.span().map_or(0, |s| s.start);
-            locate(at, e.message().trim().to_string())
+            let mut at = e.span().map_or(0, |s| s.start);
+            let message = e.message().trim().to_string();
+            // An unknown field is reported at its table's header: find its line.
+            if let Some(name) = message
+                .strip_prefix("unknown field `")
+                .and_then(|r| r.split_once('`'))
+                .map(|(n, _)| n)
+            {
+                if let Some(offset) = key_line_after(text, at, name) {
+                    at = offset;
+                }
+            } else if text[at.min(text.len())..].starts_with('[')
+                && [
+                    "invalid type",
+                    "invalid value",
+                    "unknown variant",
+                    "invalid length",
+                ]
+                .iter()
+                .any(|m| message.starts_with(m))
+            {
+                // A value error inside a tagged table is reported at its header: find
+                // the value the message quotes.
+                if let Some(value) = message.split('`').nth(1) {
+                    if let Some(offset) = value_after(text, at, value) {
+                        at = offset;
+                    }
+                }
+            }
+            // Name the field when the error is about a key or a value (not about the
+            // syntax between them).
+            let about_value = {
+                let line_start = text[..at.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
+                text[line_start..at.min(text.len())].contains('=')
+            };
+            let about_key =
+                message.starts_with("unknown field") || message.starts_with("duplicate key");
+            let message = match field_at(text, at) {
+                Some(field) if (about_value || about_key) && !message.starts_with(&field) => {
+                    format!("{field}: {message}")
+                }
+                _ => message,
+            };
+            locate(at, message)
         })?;
         scene
             .validate()
@@ -758,6 +931,15 @@ impl Scene {
                         format!("each count must be in 1..=4096, got {blocks:?}"),
                     ));
                 }
+                if blocks[0] * blocks[1] > MAX_BLOCKS {
+                    return Err(bad(
+                        "mesh.blocks",
+                        format!(
+                            "{} blocks in all is above the limit of {MAX_BLOCKS}",
+                            blocks[0] * blocks[1]
+                        ),
+                    ));
+                }
             }
             MeshSpec::Polygon {
                 outline,
@@ -829,7 +1011,13 @@ impl Scene {
             vector(&field("max"), &body.max)?;
             for k in 0..d {
                 if body.min[k] >= body.max[k] {
-                    return Err(bad(field("max"), "needs min < max on every axis"));
+                    return Err(bad(
+                        field("max"),
+                        format!(
+                            "needs min < max on every axis, got min = {:?}, max = {:?}",
+                            body.min, body.max
+                        ),
+                    ));
                 }
             }
             match (&body.per_block, &body.count) {
@@ -866,10 +1054,23 @@ impl Scene {
                 }
             }
         }
+        let particles: f64 = self
+            .bodies
+            .iter()
+            .map(|b| self.estimated_particles(b))
+            .sum();
+        if particles > MAX_PARTICLES as f64 {
+            return Err(bad(
+                "body[0]",
+                format!(
+                    "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
+                ),
+            ));
+        }
         match &self.initial_velocity {
             InitialVelocity::Uniform { value } => vector("initial_velocity.value", value)?,
             InitialVelocity::SineMode { v0 } => finite("initial_velocity.v0", *v0)?,
-            InitialVelocity::Exact if self.reference.is_none() => {
+            InitialVelocity::Exact {} if self.reference.is_none() => {
                 return Err(bad(
                     "initial_velocity.kind",
                     "`exact` needs a [reference] solution",
@@ -890,7 +1091,10 @@ impl Scene {
             if let Some(c) = bc.fix.iter().find(|c| c.axis().is_some_and(|a| a >= d)) {
                 return Err(bad(
                     format!("boundary[{i}].fix"),
-                    format!("component `{c:?}` does not exist in {d}D").to_lowercase(),
+                    format!(
+                        "component `{}` does not exist in {d}D",
+                        format!("{c:?}").to_lowercase()
+                    ),
                 ));
             }
         }
@@ -923,7 +1127,7 @@ impl Scene {
                     }
                 }
                 EffectSpec::BodyForce { value } => vector(&field("value"), value)?,
-                EffectSpec::ManufacturedBodyForce => {
+                EffectSpec::ManufacturedBodyForce {} => {
                     if !matches!(self.reference, Some(Reference::AxisAligned { .. })) {
                         return Err(bad(
                             field("kind"),
@@ -957,7 +1161,7 @@ impl Scene {
         }
         match self.reference {
             Some(Reference::VibratingBar { v0 }) => finite("reference.v0", v0)?,
-            Some(Reference::ColumnSelfWeight) | Some(Reference::ColumnEquilibrium)
+            Some(Reference::ColumnSelfWeight {}) | Some(Reference::ColumnEquilibrium {})
                 if gravity.is_none() =>
             {
                 return Err(bad(
@@ -980,6 +1184,29 @@ impl Scene {
             return Err(bad("time.t_end", "is shorter than one time step"));
         }
         Ok(())
+    }
+
+    /// About how many particles `body` gets (exact for aligned boxes).
+    fn estimated_particles(&self, body: &Body) -> f64 {
+        let mut n = 1.0;
+        for k in 0..self.dim.min(body.min.len()).min(body.max.len()) {
+            let extent = body.max[k] - body.min[k];
+            n *= match (&body.count, &body.per_block, self.blocks()) {
+                (Some(c), _, _) => c.get(k).copied().unwrap_or(1) as f64,
+                (None, Some(p), Some(blocks)) => {
+                    let (lo, hi) = match (&self.mesh, k) {
+                        (MeshSpec::Blocks { x, .. }, 0) | (MeshSpec::Interval { x, .. }, 0) => {
+                            (x[0], x[1])
+                        }
+                        (MeshSpec::Blocks { y, .. }, _) => (y[0], y[1]),
+                        _ => (0.0, 1.0),
+                    };
+                    extent / ((hi - lo) / blocks[k] as f64 / p.get(k).copied().unwrap_or(1) as f64)
+                }
+                _ => 1.0,
+            };
+        }
+        n
     }
 
     /// The gravity vector of the scene's gravity effect, if it has one.

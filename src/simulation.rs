@@ -233,8 +233,15 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
                     .map(|h| (points(&h.outline), h.tag.clone()))
                     .collect(),
             };
-            generators::polygon_mesh(&domain, *edge_length)
-                .map_err(|e| RunError::Setup(format!("mesh: {e}")))?
+            generators::polygon_mesh(&domain, *edge_length).map_err(|e| {
+                let e = e.to_string();
+                let field = if e.contains("edge_length") {
+                    "mesh.edge_length"
+                } else {
+                    "mesh.outline"
+                };
+                RunError::Setup(format!("{field}: {e}"))
+            })?
         }
         MeshSpec::Gmsh { file } => psmpm_basis::mesh::gmsh::read_msh(std::path::Path::new(file))
             .map_err(|e| RunError::Setup(format!("mesh.file: {e}")))?,
@@ -243,6 +250,19 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
         }
     };
     Ok(mesh)
+}
+
+/// Every boundary condition names a tag of the mesh.
+fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
+    for (b, bc) in scene.boundaries.iter().enumerate() {
+        if !tags.contains(&bc.tag) {
+            return Err(RunError::Setup(format!(
+                "boundary[{b}].tag: unknown boundary tag `{}`; the mesh has tags {tags:?}",
+                bc.tag
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The unit normal of every slip wall (`fix = ["normal"]`): the boundary edges with
@@ -314,6 +334,7 @@ fn run_2d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<2>, 
     }
     let mesh = triangulation(scene)?;
     let h = smallest_edge(&mesh);
+    check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
     match scene.basis {
         BasisKind::Ps => {
@@ -336,6 +357,7 @@ fn run_1d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<1>, 
         Mesh1d::uniform(x[0], x[1], elements).map_err(|e| RunError::Setup(format!("mesh: {e}")))?;
     let h = (x[1] - x[0]) / elements as f64;
     // In 1D the normal of a wall is the axis.
+    check_tags(scene, &mesh.tags().map(String::from))?;
     let walls: Vec<(String, [f64; 2])> = scene
         .boundaries
         .iter()
@@ -486,7 +508,7 @@ impl Solution {
                 density: m.density,
                 v0,
             }),
-            Reference::ColumnSelfWeight => Solution::Column(exact::ColumnSelfWeight {
+            Reference::ColumnSelfWeight {} => Solution::Column(exact::ColumnSelfWeight {
                 height: body.max[d - 1] - body.min[d - 1],
                 young: m.young,
                 density: m.density,
@@ -498,7 +520,7 @@ impl Solution {
                 poisson: m.poisson,
                 density: m.density,
             }),
-            Reference::ColumnEquilibrium => Solution::Equilibrium {
+            Reference::ColumnEquilibrium {} => Solution::Equilibrium {
                 height: body.max[d - 1] - body.min[d - 1],
                 density: m.density,
                 gravity,
@@ -585,7 +607,7 @@ pub fn build_effects<const D: usize>(
                     field: Box::new(move |_, _| b),
                 }));
             }
-            EffectSpec::ManufacturedBodyForce => {
+            EffectSpec::ManufacturedBodyForce {} => {
                 let Some(Solution::AxisAligned(a)) = solution else {
                     return Err(RunError::Setup(format!(
                         "effect[{i}].kind: `manufactured-body-force` needs reference kind `axis-aligned`"
@@ -636,7 +658,7 @@ where
     );
     for (p, &x0) in positions.iter().enumerate() {
         let v = match &scene.initial_velocity {
-            InitialVelocity::Rest => [0.0; 2],
+            InitialVelocity::Rest {} => [0.0; 2],
             InitialVelocity::Uniform { value } => {
                 let mut v = [0.0; 2];
                 v[..D].copy_from_slice(&value[..D]);
@@ -647,7 +669,9 @@ where
                 let length = body.max[0] - body.min[0];
                 [v0 * (PI * (x0[0] - body.min[0]) / length).sin(), 0.0]
             }
-            InitialVelocity::Exact => solution.map_or([0.0; 2], |s| s.velocity(x0, origin, D, 0.0)),
+            InitialVelocity::Exact {} => {
+                solution.map_or([0.0; 2], |s| s.velocity(x0, origin, D, 0.0))
+            }
         };
         particles.v[p] = to_vec::<D>(v);
     }
@@ -701,7 +725,7 @@ where
                         })
                         .unwrap_or(0);
                     RunError::Setup(format!(
-                        "body[{body}]: the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"
+                        "body[{body}].max: the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"
                     ))
                 }
                 other => other.into(),

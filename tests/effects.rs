@@ -29,7 +29,7 @@ fn bar_1d(effects: Vec<EffectSpec>, t_end: f64) -> Scene {
         per_block: Some(vec![4]),
         count: None,
     }];
-    s.initial_velocity = InitialVelocity::Rest;
+    s.initial_velocity = InitialVelocity::Rest {};
     s.boundaries = vec![BoundaryCondition {
         tag: "left".into(),
         fix: vec![Component::X],
@@ -151,7 +151,7 @@ fn a_geostatic_initial_stress_holds_the_column_at_rest() {
 fn damping_brings_the_column_to_rest_with_its_work_in_the_balance() {
     let mut s = Scene::builtin("column-damped").unwrap();
     s.time.t_end = 3.0;
-    assert!(matches!(s.reference, Some(Reference::ColumnEquilibrium)));
+    assert!(matches!(s.reference, Some(Reference::ColumnEquilibrium {})));
     let mut history = Vec::new();
     let summary = run(&s, &mut |r| history.push((r.kinetic, r.work))).unwrap();
     assert!(summary.stable, "{summary:?}");

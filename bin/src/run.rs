@@ -123,6 +123,17 @@ pub fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
     Ok((a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?))
 }
 
+/// A set-up error of a scene file, located in the file when it names a field.
+pub fn locate(scene: &str, message: &str) -> String {
+    if !scene.ends_with(".toml") {
+        return message.to_string();
+    }
+    match std::fs::read_to_string(scene) {
+        Ok(text) => psmpm::scene::locate_message(&text, scene, message),
+        Err(_) => message.to_string(),
+    }
+}
+
 /// Reads a scene: a built-in name or a `.toml` file (a relative Gmsh path in it is
 /// taken relative to the file).
 pub fn read_scene(name: &str) -> Result<Scene, CliError> {
@@ -264,7 +275,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         }
     };
     let setup = |e: RunError| match e {
-        RunError::Setup(m) => CliError::Input(m),
+        RunError::Setup(m) => CliError::Input(locate(&args.scene, &m)),
     };
     let (summary, tracked, last) = match s.dim {
         2 => {

@@ -169,7 +169,7 @@ fn scene_files_run_and_bad_ones_name_file_line_and_column() {
     let cases: Vec<(String, String)> = vec![
         (
             base.replace("dim = 2", "dim = 2\ncolour = \"red\""),
-            format!(":{}:1: unknown field `colour`", line_of("dim") + 1),
+            format!(":{}:1: colour: unknown field `colour`", line_of("dim") + 1),
         ),
         (
             base.replace("dim = 2", "dim = 3"),
@@ -177,7 +177,7 @@ fn scene_files_run_and_bad_ones_name_file_line_and_column() {
         ),
         (
             base.replace("dt = 1e-3", "dt = \"small\""),
-            format!(":{}:6: invalid type", line_of("dt")),
+            format!(":{}:6: time.dt: invalid type", line_of("dt")),
         ),
         (
             base.replace("dt = 1e-3", "dt = -1.0"),
@@ -193,7 +193,7 @@ fn scene_files_run_and_bad_ones_name_file_line_and_column() {
         ),
         (
             base.replace("mass = \"consistent\"", "mass = \"heavy\""),
-            format!(":{}:8: unknown mass strategy", line_of("mass")),
+            format!(":{}:8: mass: unknown mass strategy", line_of("mass")),
         ),
         (
             base.replace("blocks = [4, 1]", "blocks = [4, 1"),
