@@ -1186,27 +1186,36 @@ impl Scene {
         Ok(())
     }
 
+    /// The lattice spacing of `body` along axis `k`: the box extent over `count`, or
+    /// the mesh's block size over `per_block` (`None` when `per_block` is given on a
+    /// mesh without blocks).
+    pub fn lattice_spacing(&self, body: &Body, k: usize) -> Option<f64> {
+        let extent = body.max[k] - body.min[k];
+        match (&body.count, &body.per_block) {
+            (Some(c), _) => Some(extent / c[k] as f64),
+            (None, Some(per)) => {
+                let blocks = self.blocks()?;
+                let (lo, hi) = match (&self.mesh, k) {
+                    (MeshSpec::Blocks { x, .. }, 0) | (MeshSpec::Interval { x, .. }, 0) => {
+                        (x[0], x[1])
+                    }
+                    (MeshSpec::Blocks { y, .. }, _) => (y[0], y[1]),
+                    _ => return None,
+                };
+                Some((hi - lo) / blocks[k] as f64 / per[k] as f64)
+            }
+            (None, None) => None,
+        }
+    }
+
     /// About how many particles `body` gets (exact for aligned boxes).
     fn estimated_particles(&self, body: &Body) -> f64 {
-        let mut n = 1.0;
-        for k in 0..self.dim.min(body.min.len()).min(body.max.len()) {
-            let extent = body.max[k] - body.min[k];
-            n *= match (&body.count, &body.per_block, self.blocks()) {
-                (Some(c), _, _) => c.get(k).copied().unwrap_or(1) as f64,
-                (None, Some(p), Some(blocks)) => {
-                    let (lo, hi) = match (&self.mesh, k) {
-                        (MeshSpec::Blocks { x, .. }, 0) | (MeshSpec::Interval { x, .. }, 0) => {
-                            (x[0], x[1])
-                        }
-                        (MeshSpec::Blocks { y, .. }, _) => (y[0], y[1]),
-                        _ => (0.0, 1.0),
-                    };
-                    extent / ((hi - lo) / blocks[k] as f64 / p.get(k).copied().unwrap_or(1) as f64)
-                }
-                _ => 1.0,
-            };
-        }
-        n
+        (0..self.dim)
+            .map(|k| {
+                self.lattice_spacing(body, k)
+                    .map_or(1.0, |h| (body.max[k] - body.min[k]) / h)
+            })
+            .product()
     }
 
     /// The gravity vector of the scene's gravity effect, if it has one.

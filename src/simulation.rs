@@ -394,27 +394,20 @@ where
 
 /// Particle positions and volumes of the scene's bodies, block by block for
 /// `per_block` layouts (the order of the seeds' codes), row by row otherwise.
-pub fn particle_lattice(scene: &Scene) -> Result<(Vec<[f64; 2]>, Vec<f64>), RunError> {
+pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
     let d = scene.dim;
-    let (mut positions, mut volumes) = (Vec::new(), Vec::new());
+    let mut lattice = Lattice::default();
     for (b, body) in scene.bodies.iter().enumerate() {
+        let first = lattice.positions.len();
         let mut spacing = [1.0; 2];
         let mut cells = [1usize; 2];
         let mut group = [1usize; 2];
         for k in 0..d {
             let extent = body.max[k] - body.min[k];
-            let (h, n) = if let Some(per) = &body.per_block {
-                let blocks = scene.blocks().ok_or_else(|| {
-                    RunError::Setup(format!("body[{b}].per_block: the mesh has no blocks"))
-                })?;
-                let (lo, hi) = match (&scene.mesh, k) {
-                    (MeshSpec::Blocks { x, .. }, 0) | (MeshSpec::Interval { x, .. }, 0) => {
-                        (x[0], x[1])
-                    }
-                    (MeshSpec::Blocks { y, .. }, _) => (y[0], y[1]),
-                    _ => (0.0, 1.0),
-                };
-                let h = (hi - lo) / blocks[k] as f64 / per[k] as f64;
+            let h = scene.lattice_spacing(body, k).ok_or_else(|| {
+                RunError::Setup(format!("body[{b}].per_block: the mesh has no blocks"))
+            })?;
+            let n = if let Some(per) = &body.per_block {
                 let n = extent / h;
                 if (n - n.round()).abs() > 1e-6 * n.max(1.0) || n.round() < 1.0 {
                     return Err(RunError::Setup(format!(
@@ -422,11 +415,11 @@ pub fn particle_lattice(scene: &Scene) -> Result<(Vec<[f64; 2]>, Vec<f64>), RunE
                     )));
                 }
                 group[k] = per[k];
-                (h, n.round() as usize)
+                n.round() as usize
             } else {
                 let c = body.count.as_ref().map_or(1, |c| c[k]);
                 group[k] = c;
-                (extent / c as f64, c)
+                c
             };
             spacing[k] = h;
             cells[k] = n;
@@ -446,27 +439,27 @@ pub fn particle_lattice(scene: &Scene) -> Result<(Vec<[f64; 2]>, Vec<f64>), RunE
                         if d == 2 {
                             p[1] = body.min[1] + (cj as f64 + 0.5) * spacing[1];
                         }
-                        positions.push(p);
-                        volumes.push(volume);
+                        lattice.positions.push(p);
+                        lattice.volumes.push(volume);
                     }
                 }
             }
         }
+        lattice.body_sizes.push(lattice.positions.len() - first);
     }
-    Ok((positions, volumes))
+    Ok(lattice)
 }
 
-/// Number of particles of each body (in the order of [`particle_lattice`]).
-fn body_sizes(scene: &Scene) -> Result<Vec<usize>, RunError> {
-    scene
-        .bodies
-        .iter()
-        .map(|b| {
-            let mut one = scene.clone();
-            one.bodies = vec![b.clone()];
-            particle_lattice(&one).map(|(p, _)| p.len())
-        })
-        .collect()
+/// The particles of a scene's bodies before the run: positions, volumes, and how
+/// many belong to each body (bodies in order).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Lattice {
+    /// Positions (the second entry is 0 in 1D).
+    pub positions: Vec<[f64; 2]>,
+    /// Volumes.
+    pub volumes: Vec<f64>,
+    /// Particles per body.
+    pub body_sizes: Vec<usize>,
 }
 
 fn to_vec<const D: usize>(p: [f64; 2]) -> SVector<f64, D> {
@@ -649,8 +642,11 @@ where
         o[..D].copy_from_slice(&scene.bodies[0].min[..D]);
         o
     };
-    let (positions, volumes) = particle_lattice(scene)?;
-    let body_sizes = body_sizes(scene)?;
+    let Lattice {
+        positions,
+        volumes,
+        body_sizes,
+    } = particle_lattice(scene)?;
     let mut particles = Particles::<f64, D>::new(
         positions.iter().map(|&p| to_vec::<D>(p)).collect(),
         volumes,
