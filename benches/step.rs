@@ -13,7 +13,7 @@ use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::{Basis, TriMesh};
 use psmpm::driver::{Driver, Fix};
 use psmpm::effect::{Effect, Gravity};
-use psmpm::mass::{Lumped, MassKind, MassStrategy, SparseMass};
+use psmpm::mass::{Consistent, Lumped, MassStrategy};
 use psmpm::material::{Elastic, LinearElastic};
 use psmpm::particles::Particles;
 
@@ -41,7 +41,7 @@ fn particles() -> Particles<f64, 2> {
 
 fn driver<B: Basis<f64, 2>, M: MassStrategy<f64>>(
     basis: B,
-    kind: MassKind,
+    mass: M,
 ) -> Driver<f64, 2, B, M, LinearElastic> {
     let fixes = [
         Fix {
@@ -65,19 +65,19 @@ fn driver<B: Basis<f64, 2>, M: MassStrategy<f64>>(
         g: Vector2::new(0.0, -9.81),
     })];
     let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
-    Driver::new(basis, particles(), material, kind, &fixes, effects, 1e-5).unwrap()
+    Driver::new(basis, particles(), material, mass, &fixes, effects, 1e-5).unwrap()
 }
 
 #[divan::bench(sample_count = 20)]
 fn pl_lumped_step(bencher: divan::Bencher) {
-    let mut d = driver::<_, Lumped<f64>>(Linear::<f64>::new(mesh()), MassKind::Lumped);
+    let mut d = driver(Linear::<f64>::new(mesh()), Lumped::default());
     bencher.bench_local(|| d.step().unwrap());
 }
 
 #[divan::bench(sample_count = 20)]
 fn ps_consistent_step(bencher: divan::Bencher) {
     let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
-    let mut d = driver::<_, SparseMass<f64>>(ps, MassKind::Consistent);
+    let mut d = driver(ps, Consistent::default());
     bencher.bench_local(|| d.step().unwrap());
 }
 

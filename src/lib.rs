@@ -53,6 +53,7 @@
 pub use psmpm_basis as basis;
 
 pub mod bases;
+pub mod diagnostics;
 pub mod driver;
 pub mod effect;
 pub mod exact;

@@ -18,7 +18,7 @@ use crate::bases::BasisKind;
 use crate::driver::{Driver, Fix, PhaseTimes, SetupError, StepError, StepReport};
 use crate::effect::{BodyForce, Effect, Geostatic, Gravity, InitialStress, LocalDamping, Traction};
 use crate::exact;
-use crate::mass::{Lumped, MassKind, MassStrategy, SparseMass};
+use crate::mass::MassStrategy;
 use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
 use crate::particles::Particles;
 use crate::scene::{
@@ -386,10 +386,7 @@ fn dispatch_mass<const D: usize, B: Basis<f64, D>>(
 where
     Particles<f64, D>: AsParticlesRef,
 {
-    match scene.mass {
-        MassKind::Lumped => run_with::<D, B, Lumped<f64>>(scene, basis, h, walls, on_step),
-        _ => run_with::<D, B, SparseMass<f64>>(scene, basis, h, walls, on_step),
-    }
+    run_with::<D, B>(scene, basis, h, walls, on_step)
 }
 
 /// Particle positions and volumes of the scene's bodies, block by block for
@@ -619,7 +616,7 @@ pub fn build_effects<const D: usize>(
     Ok(effects)
 }
 
-fn run_with<const D: usize, B: Basis<f64, D>, M: MassStrategy<f64>>(
+fn run_with<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     basis: B,
     h: f64,
@@ -707,8 +704,16 @@ where
     }
     let steps = (scene.time.t_end / dt).round().max(1.0) as usize;
     let functions = basis.num_functions();
-    let mut driver: Driver<f64, D, B, M, AnyMaterial> =
-        Driver::new(basis, particles, material, scene.mass, &fixes, effects, dt).map_err(
+    let mut driver: Driver<f64, D, B, Box<dyn MassStrategy<f64>>, AnyMaterial> =
+        Driver::new(
+            basis,
+            particles,
+            material,
+            scene.mass.build::<f64>(),
+            &fixes,
+            effects,
+            dt,
+        ).map_err(
             |e| match e {
                 SetupError::ParticleOutside { particle, position } => {
                     // Name the body the particle belongs to.

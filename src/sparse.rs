@@ -121,18 +121,7 @@ impl SymmetricPattern {
 
     /// `y = A x` for the symmetric matrix whose upper triangle has `values`.
     pub fn mul_vec<T: Real>(&self, values: &[T], x: &[T], y: &mut [T]) {
-        y.iter_mut().for_each(|v| *v = T::zero());
-        let (ptr, rows) = (self.col_ptr(), self.row_idx());
-        for c in 0..self.dim() {
-            for k in ptr[c]..ptr[c + 1] {
-                let r = rows[k];
-                let a = values[k];
-                y[r] += a * x[c];
-                if r != c {
-                    y[c] += a * x[r];
-                }
-            }
-        }
+        mul_upper(self.col_ptr(), self.row_idx(), values, x, y);
     }
 
     /// Row sums `Σ_j A_ij` of the symmetric matrix (the lumped mass).
@@ -146,6 +135,28 @@ impl SymmetricPattern {
                 if r != c {
                     out[c] += values[k];
                 }
+            }
+        }
+    }
+}
+
+/// `y = A x` for the symmetric matrix whose upper triangle is stored in compressed
+/// sparse columns (`col_ptr`, `row_idx`, `values`).
+pub fn mul_upper<T: Real>(
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    values: &[T],
+    x: &[T],
+    y: &mut [T],
+) {
+    y.iter_mut().for_each(|v| *v = T::zero());
+    for c in 0..col_ptr.len() - 1 {
+        for k in col_ptr[c]..col_ptr[c + 1] {
+            let r = row_idx[k];
+            let a = values[k];
+            y[r] += a * x[c];
+            if r != c {
+                y[c] += a * x[r];
             }
         }
     }

@@ -1,6 +1,6 @@
 //! The time step allocates nothing: a counting global allocator watches
-//! `Driver::step` after set-up, for PS with the consistent mass (sparse Cholesky)
-//! and PL with the lumped mass.
+//! `Driver::step` after set-up, for every mass strategy (PS and PL), with the
+//! condition estimate on, and with slip walls, damping and body forces.
 
 use nalgebra::Vector2;
 use psmpm::basis::basis::linear::Linear;
@@ -8,8 +8,8 @@ use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
 use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::Basis;
 use psmpm::driver::{Driver, Fix};
-use psmpm::effect::{Effect, Gravity};
-use psmpm::mass::{Lumped, MassKind, MassStrategy, SparseMass};
+use psmpm::effect::{BodyForce, Effect, ForceField, Gravity, LocalDamping};
+use psmpm::mass::MassKind;
 use psmpm::material::{Elastic, LinearElastic};
 use psmpm::particles::Particles;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -40,20 +40,23 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn column_particles() -> Particles<f64, 2> {
+/// A column of 6 × `rows` particles in the 2 × 25 mesh (40 rows fill it).
+fn column_particles(rows: usize) -> Particles<f64, 2> {
     let mut x = Vec::new();
-    for j in 0..40 {
+    for j in 0..rows {
         for i in 0..6 {
             x.push(Vector2::new((i as f64 + 0.5) / 3.0, (j as f64 + 0.5) / 1.6));
         }
     }
     let n = x.len();
-    Particles::new(x, vec![2.0 * 25.0 / n as f64; n], 1.0)
+    Particles::new(x, vec![2.0 * 25.0 / 240.0; n], 1.0)
 }
 
-fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B, kind: MassKind) -> usize {
+/// Allocations during 20 steps after a warm-up step; `rows` particle rows, and
+/// with `extra` a slip wall on the right, local damping and a body force.
+fn steps_allocate<B: Basis<f64, 2>>(basis: B, kind: MassKind, rows: usize, extra: bool) -> usize {
     let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
-    let fixes = [
+    let mut fixes = vec![
         Fix {
             tag: "bottom".into(),
             component: 0,
@@ -66,24 +69,39 @@ fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B, kind: MassKi
             tag: "left".into(),
             component: 0,
         },
-        Fix {
+    ];
+    if !extra {
+        fixes.push(Fix {
             tag: "right".into(),
             component: 0,
-        },
-    ];
-    let effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity {
+        });
+    }
+    let mut effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity {
         g: Vector2::new(0.0, -9.81),
     })];
-    let mut driver: Driver<f64, 2, B, M, LinearElastic> = Driver::new(
+    if extra {
+        let field: ForceField<f64, 2> = Box::new(|_, t| Vector2::new(0.1 * t, 0.0));
+        effects.push(Box::new(BodyForce {
+            label: "body-force",
+            field,
+        }));
+        effects.push(Box::new(LocalDamping { alpha: 0.05 }));
+    }
+    let mut driver = Driver::new(
         basis,
-        column_particles(),
+        column_particles(rows),
         material,
-        kind,
+        kind.build(),
         &fixes,
         effects,
         1e-4,
     )
     .unwrap();
+    if extra {
+        driver
+            .add_slip_wall("right", &Vector2::new(1.0, 0.0))
+            .unwrap();
+    }
     driver.estimate_condition = true;
     driver.step().unwrap(); // warm-up outside the count
     ALLOCATIONS.store(0, Ordering::SeqCst);
@@ -98,23 +116,39 @@ fn steps_allocate<B: Basis<f64, 2>, M: MassStrategy<f64>>(basis: B, kind: MassKi
 #[test]
 fn a_step_allocates_nothing() {
     let mesh = || block_grid(0.0, 2.0, 0.0, 25.0, 1, 8).unwrap();
-    let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
-    assert_eq!(
-        steps_allocate::<_, SparseMass<f64>>(ps, MassKind::Consistent),
-        0,
-        "PS consistent"
-    );
-    let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
-    let partial = MassKind::Partial(psmpm::mass::LumpRule::EmptyElement);
-    assert_eq!(
-        steps_allocate::<_, SparseMass<f64>>(ps, partial),
-        0,
-        "PS partially lumped"
-    );
+    let ps = || PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
+    for (kind, rows) in [
+        ("consistent", 40),
+        ("partial", 40),
+        ("partial-coverage:0.3", 24),
+        ("deactivate", 24),
+        ("extended", 24),
+        ("fmpm:3", 24),
+        ("lumped", 40),
+    ] {
+        let mass = MassKind::parse(kind).unwrap();
+        assert_eq!(steps_allocate(ps(), mass, rows, false), 0, "PS {kind}");
+    }
     let pl = Linear::<f64>::new(mesh());
     assert_eq!(
-        steps_allocate::<_, Lumped<f64>>(pl, MassKind::Lumped),
+        steps_allocate(pl, MassKind::Lumped, 40, false),
         0,
         "PL lumped"
     );
+    let pl = Linear::<f64>::new(mesh());
+    assert_eq!(
+        steps_allocate(pl, MassKind::default(), 24, false),
+        0,
+        "PL extended"
+    );
+    // Slip wall (general constraints), damping and a body force (work booked).
+    for kind in ["extended", "consistent", "lumped"] {
+        let mass = MassKind::parse(kind).unwrap();
+        let rows = if kind == "consistent" { 40 } else { 24 };
+        assert_eq!(
+            steps_allocate(ps(), mass, rows, true),
+            0,
+            "PS {kind} with effects"
+        );
+    }
 }

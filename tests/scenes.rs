@@ -94,7 +94,7 @@ fn only_declared_effects_are_evaluated() {
     use psmpm::basis::basis::linear1d::Linear1d;
     use psmpm::basis::Mesh1d;
     use psmpm::driver::Driver;
-    use psmpm::mass::{Lumped, MassKind};
+    use psmpm::mass::Lumped;
     use psmpm::material::{Elastic, LinearElastic};
     let particles = Particles::new(
         (0..8)
@@ -109,7 +109,7 @@ fn only_declared_effects_are_evaluated() {
         basis,
         particles,
         material,
-        MassKind::Lumped,
+        Lumped::default(),
         &[],
         vec![Box::new(Counting)],
         1e-3,

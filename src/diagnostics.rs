@@ -1,0 +1,193 @@
+//! What a step and a run report: energies, momentum, what the mass strategy did,
+//! the condition of the solved system, phase timings, and the stability verdict
+//! of `shared/docs/benchmarks.md`.
+
+use crate::effect::Effect;
+use crate::mass::MassReport;
+use crate::material::Material;
+use crate::particles::Particles;
+use crate::sparse::Scalar;
+use nalgebra::SMatrix;
+
+/// Largest growth of the total energy (relative to the energy scale of the run)
+/// for a run to count as stable.
+pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
+/// Largest condition estimate of the solved mass system for a stable run.
+pub const STABLE_CONDITION: f64 = 1e8;
+
+/// Energies, momentum and what the mass strategy did, after a step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepReport {
+    /// Step number (1-based after the first step).
+    pub step: usize,
+    /// Time after the step.
+    pub time: f64,
+    /// Kinetic energy `Σ ½ m_p |v_p|²`.
+    pub kinetic: f64,
+    /// Strain energy `Σ V_p⁰ W(F_p)`.
+    pub strain: f64,
+    /// Potential energy of the effects (gravity).
+    pub potential: f64,
+    /// Work done on the body by the non-conservative effects (body forces,
+    /// traction, damping) since the start, `Σ_n Δt F^n · v̂^n`.
+    pub work: f64,
+    /// Total mass.
+    pub mass: f64,
+    /// Total momentum (x, and y in 2D; unused components are zero).
+    pub momentum: [f64; 2],
+    /// Largest particle speed.
+    pub max_speed: f64,
+    /// What the mass strategy did.
+    pub mass_report: MassReport,
+    /// Condition-number estimate of the solved mass system, when requested.
+    pub condition: Option<f64>,
+    /// Wall time of the phases of the step.
+    pub phases: PhaseTimes,
+}
+
+/// Wall time (seconds) of the phases of one step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PhaseTimes {
+    /// Locate particles and evaluate the basis.
+    pub evaluate: f64,
+    /// Assemble the mass matrix and forces.
+    pub assemble: f64,
+    /// Factorise and solve both mass systems (and the condition estimate, if on).
+    pub solve: f64,
+    /// Update particle velocities, momentum, deformation, stress and positions.
+    pub update: f64,
+}
+
+impl PhaseTimes {
+    /// Adds `other` phase by phase.
+    pub fn accumulate(&mut self, other: &PhaseTimes) {
+        self.evaluate += other.evaluate;
+        self.assemble += other.assemble;
+        self.solve += other.solve;
+        self.update += other.update;
+    }
+}
+
+impl StepReport {
+    /// Kinetic + strain + potential energy minus the work of the non-conservative
+    /// effects: constant up to the time-integration error.
+    pub fn total_energy(&self) -> f64 {
+        self.kinetic + self.strain + self.potential - self.work
+    }
+}
+
+/// Energies and momentum of the particles.
+pub struct Energies {
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Strain energy (with the first-order work of an initial stress).
+    pub strain: f64,
+    /// Potential energy of the effects.
+    pub potential: f64,
+    /// Total mass.
+    pub mass: f64,
+    /// Total momentum, per component.
+    pub momentum: [f64; 2],
+    /// Largest particle speed.
+    pub max_speed: f64,
+}
+
+/// The energies and momentum of `parts` under `material` and `effects`.
+pub fn energies<T: Scalar, const D: usize, Mat: Material<T, D>>(
+    parts: &Particles<T, D>,
+    material: &Mat,
+    effects: &[Box<dyn Effect<T, D>>],
+) -> Energies {
+    let (mut kinetic, mut strain, mut mass, mut max_speed) = (0.0, 0.0, 0.0, 0.0f64);
+    let mut momentum = [0.0; 2];
+    for p in 0..parts.len() {
+        let m = parts.mass[p].to_f64();
+        let speed2 = parts.v[p].norm_squared().to_f64();
+        kinetic += 0.5 * m * speed2;
+        max_speed = max_speed.max(speed2.sqrt());
+        strain += parts.volume0[p].to_f64() * material.energy_density(&parts.f[p]).to_f64();
+        if parts.sigma0[p] != SMatrix::<T, D, D>::zeros() {
+            // First-order work of the initial stress: V⁰ σ⁰ : (sym F − I).
+            let f = &parts.f[p];
+            let e = (f + f.transpose()) * T::of(0.5) - SMatrix::<T, D, D>::identity();
+            strain += parts.volume0[p].to_f64() * parts.sigma0[p].dot(&e).to_f64();
+        }
+        mass += m;
+        for k in 0..D {
+            momentum[k] += m * parts.v[p][k].to_f64();
+        }
+    }
+    Energies {
+        kinetic,
+        strain,
+        potential: effects
+            .iter()
+            .map(|e| e.potential_energy(parts))
+            .fold(0.0, |a, b| a + b),
+        mass,
+        momentum,
+        max_speed,
+    }
+}
+
+/// Tracks the energy balance and the condition of a run, and gives the verdict.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Verdict {
+    e0: f64,
+    scale: f64,
+    drift: f64,
+    growth: f64,
+    /// Largest condition estimate seen.
+    pub max_condition: Option<f64>,
+}
+
+impl Verdict {
+    /// Starts from the initial state.
+    pub fn new(start: &StepReport) -> Self {
+        let e0 = start.total_energy();
+        Verdict {
+            e0,
+            scale: e0
+                .abs()
+                .max(start.kinetic)
+                .max(start.strain)
+                .max(start.potential.abs()),
+            drift: 0.0,
+            growth: 0.0,
+            max_condition: None,
+        }
+    }
+
+    /// Takes the report of a step.
+    pub fn observe(&mut self, r: &StepReport) {
+        self.scale = self
+            .scale
+            .max(r.kinetic)
+            .max(r.strain)
+            .max(r.potential.abs());
+        self.drift = self.drift.max((r.total_energy() - self.e0).abs());
+        self.growth = self.growth.max(r.total_energy() - self.e0);
+        if let Some(c) = r.condition {
+            self.max_condition = Some(self.max_condition.map_or(c, |m: f64| m.max(c)));
+        }
+    }
+
+    /// Initial total energy.
+    pub fn initial_energy(&self) -> f64 {
+        self.e0
+    }
+
+    /// `(drift, growth)` of the total energy relative to the energy scale.
+    pub fn energy_drift_and_growth(&self) -> (f64, f64) {
+        let scale = self.scale.max(f64::MIN_POSITIVE);
+        (self.drift / scale, self.growth / scale)
+    }
+
+    /// Stable: no failure, energy growth below [`STABLE_ENERGY_GROWTH`], every
+    /// condition estimate below [`STABLE_CONDITION`].
+    pub fn stable(&self, failed: bool) -> bool {
+        !failed
+            && self.energy_drift_and_growth().1 < STABLE_ENERGY_GROWTH
+            && self.max_condition.is_none_or(|c| c < STABLE_CONDITION)
+    }
+}

@@ -1,0 +1,640 @@
+//! The MPM time step (paper eqs. (13)–(31), thesis Fig. 2.5), generic over the
+//! basis, the mass strategy and the material. Nothing here knows which basis it has.
+//!
+//! [`Driver::step`] is the ordered list of the [`phases`]:
+//! 1. locate every particle (walking from its previous element) and evaluate the basis;
+//! 2. assemble `M` (eq. (13)), `F^int` (eq. (15)) and the effects' forces (eqs. (14), (16));
+//! 3. solve `M a = F` (eq. (17)) with the walls (strategy solve, then the general
+//!    constraints);
+//! 4. update particle velocities `v_p += Δt Σ a_i phi_i(x_p)` (eq. (18)) and scatter
+//!    their momentum `P` (eq. (21));
+//! 5. project velocities `M v̂ = P` (eq. (20));
+//! 6. update `F_p ← (I + Δt ∇v_p) F_p` with the full velocity gradient, `σ_p`,
+//!    `V_p = J_p V_p⁰` (eqs. (22)–(29)), and move particles
+//!    `x_p += Δt Σ v̂_i phi_i(x_p)`, `u_p` likewise (eqs. (30)–(31)).
+//!
+//! The paper (eq. (24)) updates `F` with the symmetric part of the velocity gradient,
+//! which ignores rotation: a rigidly rotating body would accumulate spurious strain.
+//! We use the full gradient `∇v` (see [`phases::update_deformation_gradient`]).
+//!
+//! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
+
+pub mod phases;
+
+pub use crate::diagnostics::{PhaseTimes, StepReport};
+pub use phases::update_deformation_gradient;
+
+use crate::diagnostics::energies;
+use crate::effect::{Effect, ParticleBasis, StepState};
+use crate::mass::{
+    Constraints, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
+};
+use crate::material::Material;
+use crate::particles::Particles;
+use crate::sparse::{Scalar, SymmetricPattern};
+use nalgebra::SVector;
+use phases::{Evaluations, UpdateFailure};
+use psmpm_basis::{Basis, BasisError, BasisEval};
+use std::time::Instant;
+
+/// Coverage below which a function counts as under-supported in failure messages
+/// (the threshold of the default strategy).
+pub const UNDER_SUPPORTED_COVERAGE: f64 = crate::mass::DEFAULT_COVERAGE;
+
+/// Why a step failed. Each names the step, the cause the driver can see, and a
+/// fix that fits that cause.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    #[error("step {step}: particle {particle} at {position:?} left the mesh; {hint}")]
+    ParticleLeftMesh {
+        step: usize,
+        particle: usize,
+        position: Vec<f64>,
+        /// What to change.
+        hint: String,
+    },
+    #[error("step {step}: the mass system could not be solved ({source}); {hint}")]
+    MassNotPositiveDefinite {
+        step: usize,
+        source: MassError,
+        /// What the driver sees (the worst-covered function) and what to change.
+        hint: String,
+    },
+    #[error("step {step}: {quantity} of particle {particle} at {position:?} is not valid; {hint}")]
+    NotFinite {
+        step: usize,
+        quantity: &'static str,
+        particle: usize,
+        position: Vec<f64>,
+        /// What the driver sees near the particle and what to change.
+        hint: String,
+    },
+}
+
+/// Errors setting up a driver.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetupError {
+    #[error(transparent)]
+    Basis(#[from] BasisError),
+    #[error("boundary condition on `{tag}`: {message}")]
+    Boundary { tag: String, message: String },
+    #[error("particle {particle} at {position:?} lies outside the mesh")]
+    ParticleOutside { particle: usize, position: Vec<f64> },
+}
+
+/// A homogeneous Dirichlet condition: velocity component `component` vanishes on `tag`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Fix {
+    /// Boundary tag.
+    pub tag: String,
+    /// Velocity component (0 = x, 1 = y).
+    pub component: usize,
+}
+
+/// The per-step facts a mass strategy asked for.
+struct StrategyInputs {
+    needs: Needs,
+    occupied: Vec<bool>,
+    touches_empty: Vec<bool>,
+    particle_volume: Vec<f64>,
+    support: Option<SupportFacts>,
+}
+
+/// The MPM driver.
+pub struct Driver<T, const D: usize, B, M, Mat>
+where
+    T: Scalar,
+    B: Basis<T, D>,
+    M: MassStrategy<T>,
+    Mat: Material<T, D>,
+{
+    /// The basis.
+    pub basis: B,
+    /// The particles.
+    pub particles: Particles<T, D>,
+    material: Mat,
+    mass: M,
+    constraints: Constraints<T, D>,
+    effects: Vec<Box<dyn Effect<T, D>>>,
+    pattern: SymmetricPattern,
+    dt: T,
+    step: usize,
+    time: f64,
+    // Buffers, sized once.
+    evals: Evaluations<T, D>,
+    eval: BasisEval<T, D>,
+    values: Vec<T>,
+    /// `F`, then the acceleration coefficients `a`.
+    rhs: Vec<Vec<T>>,
+    /// `P`, then the projected velocity coefficients `v̂`.
+    velocity: Vec<Vec<T>>,
+    /// `v̂ⁿ` is known (after the first step, or after projecting the initial state).
+    velocity_known: bool,
+    /// Forces of the non-conservative effects (for their work); empty without any.
+    work_force: Vec<Vec<T>>,
+    /// Scratch for [`Effect::adjust_forces`]; empty without effects.
+    adjust: Vec<Vec<T>>,
+    work: f64,
+    inputs: StrategyInputs,
+    last_report: MassReport,
+    last_condition: Option<f64>,
+    phases: PhaseTimes,
+    /// Estimate the condition number every step.
+    pub estimate_condition: bool,
+}
+
+impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
+where
+    T: Scalar,
+    B: Basis<T, D>,
+    M: MassStrategy<T>,
+    Mat: Material<T, D>,
+{
+    /// Sets up a run: the mass strategy's symbolic work and the basis facts it
+    /// asks for, Dirichlet sets, particle location, initial stress from the
+    /// initial deformation gradients.
+    pub fn new(
+        basis: B,
+        mut particles: Particles<T, D>,
+        material: Mat,
+        mut mass: M,
+        fixes: &[Fix],
+        effects: Vec<Box<dyn Effect<T, D>>>,
+        dt: f64,
+    ) -> Result<Self, SetupError> {
+        let n = basis.num_functions();
+        let mut fixed = vec![vec![false; n]; D];
+        let mut general: Vec<Vec<(usize, usize, T)>> = Vec::new();
+        for fix in fixes {
+            if fix.component >= D {
+                return Err(SetupError::Boundary {
+                    tag: fix.tag.clone(),
+                    message: format!("component {} does not exist in {D}D", fix.component),
+                });
+            }
+            let mut direction = SVector::<T, D>::zeros();
+            direction[fix.component] = T::one();
+            for c in basis.dirichlet(&fix.tag, &direction)? {
+                if c.is_single() {
+                    fixed[fix.component][c.terms[0].0] = true;
+                } else {
+                    general.push(
+                        c.terms
+                            .iter()
+                            .map(|&(i, w)| (fix.component, i, w))
+                            .collect(),
+                    );
+                }
+            }
+        }
+        for p in 0..particles.len() {
+            match basis.locate(&particles.x[p], None) {
+                Some(e) => particles.element[p] = e,
+                None => {
+                    return Err(SetupError::ParticleOutside {
+                        particle: p,
+                        position: to_f64(&particles.x[p]),
+                    })
+                }
+            }
+            particles.sigma[p] = particles.sigma0[p] + material.stress(&particles.f[p]);
+        }
+        let scratch = |needed: bool| {
+            if needed {
+                vec![vec![T::zero(); n]; D]
+            } else {
+                Vec::new()
+            }
+        };
+        let pattern = SymmetricPattern::new(&basis);
+        let needs = mass.needs();
+        let support = (needs.coverage || needs.polynomials)
+            .then(|| SupportFacts::new(&basis, &pattern, needs.polynomials));
+        mass.prepare(&MassSetup {
+            pattern: &pattern,
+            fixed: &fixed,
+            support: support.as_ref(),
+        });
+        let inputs = StrategyInputs {
+            needs,
+            occupied: if needs.empty_elements {
+                vec![false; basis.num_elements()]
+            } else {
+                Vec::new()
+            },
+            touches_empty: vec![false; if needs.empty_elements { n } else { 0 }],
+            particle_volume: vec![0.0; if needs.coverage { n } else { 0 }],
+            support,
+        };
+        let np = particles.len();
+        Ok(Driver {
+            eval: BasisEval::for_basis(&basis),
+            evals: Evaluations::new(np, basis.max_functions_per_element()),
+            values: vec![T::zero(); pattern.nnz()],
+            rhs: vec![vec![T::zero(); n]; D],
+            velocity: vec![vec![T::zero(); n]; D],
+            velocity_known: false,
+            work_force: scratch(effects.iter().any(|e| e.does_work())),
+            adjust: scratch(!effects.is_empty()),
+            work: 0.0,
+            constraints: Constraints::new(general, n),
+            inputs,
+            last_condition: None,
+            phases: PhaseTimes::default(),
+            estimate_condition: false,
+            basis,
+            particles,
+            material,
+            mass,
+            effects,
+            pattern,
+            dt: T::of(dt),
+            step: 0,
+            time: 0.0,
+            last_report: MassReport::default(),
+        })
+    }
+
+    /// Adds a slip wall: the velocity component along the unit vector `normal`
+    /// vanishes on the boundary tagged `tag` (for an oblique straight wall, its
+    /// normal). The constraints couple the components of each coefficient and are
+    /// imposed exactly by projection in the mass-matrix norm (see [`Constraints`]).
+    pub fn add_slip_wall(&mut self, tag: &str, normal: &SVector<T, D>) -> Result<(), SetupError> {
+        let constraints = self.basis.dirichlet(tag, normal)?;
+        let mut general = std::mem::take(&mut self.constraints.rows);
+        for c in constraints {
+            let mut row = Vec::new();
+            for &(i, w) in &c.terms {
+                for k in 0..D {
+                    if normal[k] != T::zero() {
+                        row.push((k, i, w * normal[k]));
+                    }
+                }
+            }
+            general.push(row);
+        }
+        self.constraints = Constraints::new(general, self.basis.num_functions());
+        Ok(())
+    }
+
+    /// Current time.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> usize {
+        self.step
+    }
+    /// The time step.
+    pub fn dt(&self) -> f64 {
+        self.dt.to_f64()
+    }
+    /// The material.
+    pub fn material(&self) -> &Mat {
+        &self.material
+    }
+    /// The mass strategy.
+    pub fn mass_strategy(&self) -> &M {
+        &self.mass
+    }
+    /// Projected velocity coefficients `v̂` of the last step, per component.
+    pub fn velocity_coefficients(&self) -> &[Vec<T>] {
+        &self.velocity
+    }
+
+    /// Advances one time step: the phases in order, each timed.
+    pub fn step(&mut self) -> Result<StepReport, StepError> {
+        let clock = Instant::now();
+        self.locate_and_evaluate()?;
+        let t_evaluate = clock.elapsed().as_secs_f64();
+        self.assemble();
+        let t_assemble = clock.elapsed().as_secs_f64();
+        self.factorize()?;
+        let power_start = self.power_at_start()?;
+        self.solve_acceleration()?;
+        let t_solve = clock.elapsed().as_secs_f64() - t_assemble;
+        phases::update_velocities_and_momentum(
+            &self.evals,
+            &self.rhs,
+            self.dt,
+            &self.particles.mass,
+            &mut self.particles.v,
+            &mut self.velocity,
+        );
+        let before_projection = clock.elapsed().as_secs_f64();
+        self.solve_projection()?;
+        let t_projection = clock.elapsed().as_secs_f64() - before_projection;
+        self.book_work(power_start);
+        self.update_particles()?;
+        self.phases = PhaseTimes {
+            evaluate: t_evaluate,
+            assemble: t_assemble - t_evaluate,
+            solve: t_solve + t_projection,
+            update: clock.elapsed().as_secs_f64() - t_assemble - t_solve - t_projection,
+        };
+        self.step += 1;
+        // Time from the step count, so that it does not accumulate round-off.
+        self.time = self.step as f64 * self.dt.to_f64();
+        Ok(self.report())
+    }
+
+    /// Phase 1.
+    fn locate_and_evaluate(&mut self) -> Result<(), StepError> {
+        phases::locate_and_evaluate(
+            &self.basis,
+            &self.particles.x,
+            &mut self.particles.element,
+            &mut self.eval,
+            &mut self.evals,
+        )
+        .map_err(|o| {
+            let p = o.particle;
+            let speed = self.particles.v[p].norm().to_f64();
+            let moved = speed * self.dt.to_f64();
+            StepError::ParticleLeftMesh {
+                step: self.step + 1,
+                particle: p,
+                position: to_f64(&self.particles.x[p]),
+                hint: format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                ),
+            }
+        })
+    }
+
+    /// Phase 2: `M`, `F = −F^int + effects` into `rhs`, and the facts the mass
+    /// strategy asked for.
+    fn assemble(&mut self) {
+        phases::assemble_mass_and_internal_force(
+            &self.pattern,
+            &self.particles,
+            &self.evals,
+            &mut self.values,
+            &mut self.rhs,
+        );
+        if self.inputs.needs.empty_elements {
+            phases::mark_empty_elements(
+                &self.basis,
+                &self.particles.element,
+                &mut self.inputs.occupied,
+                &mut self.inputs.touches_empty,
+            );
+        }
+        if self.inputs.needs.coverage {
+            phases::particle_volume(
+                &self.evals,
+                &self.particles.volume,
+                &mut self.inputs.particle_volume,
+            );
+        }
+        if self.effects.is_empty() {
+            return;
+        }
+        let state = StepState {
+            time: self.time,
+            dt: self.dt.to_f64(),
+            basis: ParticleBasis {
+                stride: self.evals.stride,
+                len: &self.evals.len,
+                index: &self.evals.index,
+                phi: &self.evals.phi,
+            },
+        };
+        let tracks_work = !self.work_force.is_empty();
+        if tracks_work {
+            phases::zero(&mut self.work_force);
+        }
+        for effect in &self.effects {
+            if effect.does_work() {
+                effect.add_forces(&self.particles, &state, &mut self.work_force);
+            } else {
+                effect.add_forces(&self.particles, &state, &mut self.rhs);
+            }
+        }
+        if tracks_work {
+            phases::add_into(&mut self.rhs, &self.work_force);
+        }
+        // Corrections from the total force (damping, eq. (49)), all from the same total.
+        phases::zero(&mut self.adjust);
+        for effect in &self.effects {
+            if effect.does_work() {
+                effect.adjust_forces(&self.rhs, &self.velocity, &mut self.work_force);
+            }
+            effect.adjust_forces(&self.rhs, &self.velocity, &mut self.adjust);
+        }
+        phases::add_into(&mut self.rhs, &self.adjust);
+    }
+
+    /// Phase 3a: the strategy's numeric work on `M`, the condition estimate when
+    /// requested, and the constraint projection for the step.
+    fn factorize(&mut self) -> Result<(), StepError> {
+        let context = StepContext {
+            touches_empty: &self.inputs.touches_empty,
+            particle_volume: &self.inputs.particle_volume,
+        };
+        match self.mass.factorize(&self.pattern, &self.values, context) {
+            Ok(report) => self.last_report = report,
+            Err(source) => return Err(self.mass_failure(source)),
+        }
+        self.last_condition = self
+            .estimate_condition
+            .then(|| self.mass.condition_estimate(&self.pattern));
+        self.constraints
+            .prepare(&mut self.mass)
+            .map_err(|source| self.mass_failure(source))
+    }
+
+    /// Solves component by component and projects onto the general constraints.
+    fn solve_projected(&mut self, which: Which) -> Result<(), StepError> {
+        let target = match which {
+            Which::Acceleration => &mut self.rhs,
+            Which::Velocity => &mut self.velocity,
+        };
+        for k in 0..D {
+            if let Err(source) = self.mass.solve(k, &mut target[k]) {
+                return Err(self.mass_failure(source));
+            }
+        }
+        let target = match which {
+            Which::Acceleration => &mut self.rhs,
+            Which::Velocity => &mut self.velocity,
+        };
+        self.constraints.project(target);
+        Ok(())
+    }
+
+    /// Phase 3b: `M a = F` (eq. (17)).
+    fn solve_acceleration(&mut self) -> Result<(), StepError> {
+        self.solve_projected(Which::Acceleration)
+    }
+
+    /// Phase 5: `M v̂ = P` (eq. (20)).
+    fn solve_projection(&mut self) -> Result<(), StepError> {
+        self.solve_projected(Which::Velocity)
+    }
+
+    /// Power of the non-conservative forces with the velocity at the start of the
+    /// step, `v̂ⁿ`; before the first step `v̂⁰` is the projection of the initial
+    /// particle velocities with this step's mass matrix.
+    fn power_at_start(&mut self) -> Result<f64, StepError> {
+        if self.work_force.is_empty() {
+            return Ok(0.0);
+        }
+        if !self.velocity_known {
+            phases::zero(&mut self.velocity);
+            phases::scatter_to_functions(
+                &self.evals,
+                &self.particles.mass,
+                &self.particles.v,
+                &mut self.velocity,
+            );
+            self.solve_projection()?;
+            self.velocity_known = true;
+        }
+        Ok(phases::power(&self.work_force, &self.velocity))
+    }
+
+    /// Work of the non-conservative effects over the step with the mean of the
+    /// start and end velocities, the rule under which the kinetic energy of the
+    /// symplectic Euler update changes: `W += Δt F · (v̂ⁿ + v̂ⁿ⁺¹) / 2`.
+    fn book_work(&mut self, power_start: f64) {
+        self.velocity_known = true;
+        if !self.work_force.is_empty() {
+            self.work += 0.5
+                * (power_start + phases::power(&self.work_force, &self.velocity))
+                * self.dt.to_f64();
+        }
+    }
+
+    /// Phase 6: deformation, stress, volume and positions (eqs. (22)–(31)).
+    fn update_particles(&mut self) -> Result<(), StepError> {
+        phases::update_particles(
+            &self.evals,
+            &self.velocity,
+            self.dt,
+            &self.material,
+            &mut self.particles,
+        )
+        .map_err(|failure| {
+            let (particle, quantity) = match failure {
+                UpdateFailure::Jacobian { particle, .. } => {
+                    (particle, "the Jacobian det F (non-positive or NaN)")
+                }
+                UpdateFailure::NotFinite { particle } => (particle, "position or velocity"),
+            };
+            StepError::NotFinite {
+                step: self.step + 1,
+                quantity,
+                particle,
+                position: to_f64(&self.particles.x[particle]),
+                hint: self.diagnose_particle(particle),
+            }
+        })
+    }
+
+    /// What the driver can see around a failing particle, and the fix that fits.
+    fn diagnose_particle(&self, particle: usize) -> String {
+        // The worst-covered function among those the particle sees (the coverage
+        // is measured here if the strategy did not need it).
+        let computed;
+        let (support, particle_volume) = match &self.inputs.support {
+            Some(s) if self.inputs.needs.coverage => (s, &self.inputs.particle_volume),
+            _ => {
+                let mut volume = vec![0.0; self.basis.num_functions()];
+                phases::particle_volume(&self.evals, &self.particles.volume, &mut volume);
+                computed = (SupportFacts::new(&self.basis, &self.pattern, false), volume);
+                (&computed.0, &computed.1)
+            }
+        };
+        let worst = self
+            .evals
+            .range(particle)
+            .map(|s| self.evals.index[s])
+            .map(|i| {
+                (
+                    i,
+                    SupportFacts::coverage_of(particle_volume[i], support.volume[i]),
+                )
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((i, c)) =
+            worst.filter(|&(_, c)| c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0)
+        {
+            return format!(
+                "the particle sits in the support of function {i} at {:?}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                to_f64_point(&self.basis.function_point(i)),
+                c,
+                self.mass.spec()
+            );
+        }
+        if let Some((i, c)) = self.last_report.worst_coverage {
+            if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 {
+                return format!(
+                    "function {i} at {:?} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended`)",
+                    to_f64_point(&self.basis.function_point(i)),
+                    self.mass.spec()
+                );
+            }
+        }
+        let speed = self.particles.v[particle].norm().to_f64();
+        format!(
+            "the element around it inverted (speed {speed:.3e}, Δt = {:.3e}): the time step is likely above the critical one for this material and mesh, lower `time.dt` or `time.courant`; if the body rotates, a law that is not objective (`linear-elastic`) also builds spurious stress",
+            self.dt.to_f64()
+        )
+    }
+
+    /// The error of a failed mass solve, with what the strategy reported.
+    fn mass_failure(&self, source: MassError) -> StepError {
+        let hint = match (self.last_report.worst_coverage, &self.inputs.support) {
+            (Some((i, c)), _) => format!(
+                "the worst-covered function {i} at {:?} is covered to {c:.1e} of its support: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                to_f64_point(&self.basis.function_point(i))
+            ),
+            _ => format!(
+                "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended`), or `partial` / `lumped`",
+                self.mass.spec()
+            ),
+        };
+        StepError::MassNotPositiveDefinite {
+            step: self.step + 1,
+            source,
+            hint,
+        }
+    }
+
+    /// Energies and momentum of the current state.
+    pub fn report(&self) -> StepReport {
+        let e = energies(&self.particles, &self.material, &self.effects);
+        StepReport {
+            step: self.step,
+            time: self.time,
+            kinetic: e.kinetic,
+            strain: e.strain,
+            potential: e.potential,
+            work: self.work,
+            mass: e.mass,
+            momentum: e.momentum,
+            max_speed: e.max_speed,
+            mass_report: self.last_report,
+            condition: self.last_condition,
+            phases: self.phases,
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Which {
+    Acceleration,
+    Velocity,
+}
+
+fn to_f64<T: Scalar, const D: usize>(x: &SVector<T, D>) -> Vec<f64> {
+    x.iter().map(|v| v.to_f64()).collect()
+}
+
+fn to_f64_point<const D: usize>(x: &SVector<f64, D>) -> Vec<f64> {
+    x.iter().copied().collect()
+}
+
+#[cfg(test)]
+mod tests;

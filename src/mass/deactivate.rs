@@ -1,0 +1,55 @@
+//! Deactivation (thesis §5.2): functions with a small diagonal mass are removed
+//! from the system.
+
+use super::masked::MaskedCholesky;
+use super::{MassError, MassReport, MassSetup, MassStrategy, StepContext};
+use crate::sparse::{Scalar, SymmetricPattern};
+
+/// `M` without the functions whose `M_ii` is below an absolute threshold.
+pub struct Deactivate<T: Scalar> {
+    threshold: f64,
+    solver: MaskedCholesky<T>,
+}
+
+impl<T: Scalar> Deactivate<T> {
+    /// Removes functions with `0 < M_ii < threshold` (the thesis uses 1e-2).
+    pub fn new(threshold: f64) -> Self {
+        Deactivate {
+            threshold,
+            solver: MaskedCholesky::default(),
+        }
+    }
+}
+
+impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
+    fn spec(&self) -> String {
+        format!("deactivate:{}", self.threshold)
+    }
+    fn prepare(&mut self, setup: &MassSetup) {
+        self.solver.prepare(setup);
+    }
+    fn factorize(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        _context: StepContext,
+    ) -> Result<MassReport, MassError> {
+        let mut report = MassReport::default();
+        for i in 0..pattern.dim() {
+            let d = values[pattern.diagonal_position(i)];
+            let empty = d <= T::zero();
+            let deactivated = !empty && d.to_f64() < self.threshold;
+            self.solver.inactive[i] = empty || deactivated;
+            report.deactivated += deactivated as usize;
+            report.active += !self.solver.inactive[i] as usize;
+        }
+        self.solver.factorize(pattern, values)?;
+        Ok(report)
+    }
+    fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
+        self.solver.solve(k, rhs)
+    }
+    fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
+        self.solver.condition_estimate(pattern)
+    }
+}

@@ -1,0 +1,322 @@
+//! Mass strategies: how the system `M a = F` (paper eq. (17)) and the velocity
+//! projection `M v̂ = P` (eq. (20)) are solved, with
+//! `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)` (eq. (13)).
+//!
+//! Each strategy is its own type, configured by value and chosen once at set-up
+//! ([`MassKind::build`]); the driver asks it ([`MassStrategy::needs`]) which
+//! per-step facts it uses and computes only those.
+//!
+//! | [`MassKind`] | type | what is solved |
+//! |---|---|---|
+//! | `consistent` | [`Consistent`] | `M` itself, sparse Cholesky |
+//! | `lumped` | [`Lumped`] | row sums `M_ii^L = Σ_j M_ij` |
+//! | `partial`, `partial:TAU`, `partial-coverage:C` | [`Partial`] | `M` with some rows lumped (thesis §5.3; by `M_ii`; by particle coverage) |
+//! | `deactivate[:THRESHOLD]` | [`Deactivate`] | `M` without the functions with `M_ii < threshold` (thesis §5.2) |
+//! | `extended[:C]` (the default) | [`Extended`] | `Eᵀ M E`: functions covered below `C` expressed through well-covered neighbours |
+//! | `fmpm:K` | [`Fmpm`] | no solve: the series `Σ_{j≤K} (I − M_L⁻¹ M)^j M_L⁻¹` |
+//!
+//! Homogeneous Dirichlet conditions come as a set of fixed coefficients per
+//! component; functions with no particle in their support are inactive. Both are
+//! held at zero. General (multi-term) constraints are imposed on top of any
+//! strategy by [`Constraints`], so that "solve" always means solve and project.
+//! What a strategy did is returned as a [`MassReport`], never printed.
+
+mod condition;
+mod consistent;
+mod constraints;
+mod deactivate;
+mod extended;
+mod fmpm;
+mod lumped;
+mod masked;
+mod partial;
+pub mod support;
+
+pub use condition::CONDITION_ITERATIONS;
+pub use consistent::Consistent;
+pub use constraints::Constraints;
+pub use deactivate::Deactivate;
+pub use extended::{Extended, DEFAULT_COVERAGE};
+pub use fmpm::Fmpm;
+pub use lumped::Lumped;
+pub use partial::{LumpRule, Partial};
+pub use support::SupportFacts;
+
+use crate::sparse::{NotPositiveDefinite, Scalar, SymmetricPattern};
+
+/// Why a strategy could not solve the step's system.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MassError {
+    /// The factorisation met a non-positive pivot.
+    #[error("non-positive pivot at row {} of the reordered matrix", .0.row)]
+    NotPositiveDefinite(#[from] NotPositiveDefinite),
+    /// An iterative solve did not reach its tolerance.
+    #[error("the iterative solve stalled at relative residual {residual:.1e} after {iterations} iterations")]
+    NotConverged {
+        /// Iterations taken.
+        iterations: usize,
+        /// Relative residual reached.
+        residual: f64,
+    },
+}
+
+/// The mass strategy a scene or the command line asks for: the typed choice made
+/// at the edge, turned into a strategy once by [`MassKind::build`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MassKind {
+    /// Consistent mass matrix, sparse Cholesky.
+    Consistent,
+    /// Row-sum lumped mass.
+    Lumped,
+    /// Consistent with some rows lumped.
+    Partial(LumpRule),
+    /// Consistent without the functions whose `M_ii` is below `threshold`.
+    Deactivate {
+        /// Absolute threshold on `M_ii` (the thesis uses 1e-2).
+        threshold: f64,
+    },
+    /// Extension: functions whose support is covered by particles below
+    /// `coverage` are expressed through well-covered neighbours.
+    Extended {
+        /// Coverage threshold (fraction of the support's integral).
+        coverage: f64,
+    },
+    /// Truncated series for `M⁻¹` preconditioned by the lumped mass.
+    Fmpm {
+        /// Number of correction terms `K` (`0` is the lumped mass).
+        order: usize,
+    },
+}
+
+impl Default for MassKind {
+    /// The default strategy of every basis: extension at the default coverage.
+    fn default() -> Self {
+        MassKind::Extended {
+            coverage: DEFAULT_COVERAGE,
+        }
+    }
+}
+
+/// Names [`MassKind::parse`] knows, for messages.
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, fmpm:K";
+
+impl MassKind {
+    /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
+    /// (threshold rule), `partial-coverage:C`, `deactivate` (threshold 1e-2),
+    /// `deactivate:THRESHOLD`, `extended` (default coverage), `extended:C`, `fmpm:K`.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        let (head, arg) = match name.split_once(':') {
+            Some((h, a)) => (h, Some(a)),
+            None => (name, None),
+        };
+        let number = |a: &str| -> Result<f64, String> {
+            a.parse::<f64>()
+                .ok()
+                .filter(|v| *v > 0.0 && v.is_finite())
+                .ok_or_else(|| {
+                    format!("`{name}`: the threshold must be a positive number, got `{a}`")
+                })
+        };
+        let fraction = |a: &str| -> Result<f64, String> {
+            a.parse::<f64>()
+                .ok()
+                .filter(|v| *v > 0.0 && *v < 1.0)
+                .ok_or_else(|| {
+                    format!("`{name}`: the coverage must be a number in (0, 1), got `{a}`")
+                })
+        };
+        match (head, arg) {
+            ("default", None) => Ok(MassKind::default()),
+            ("consistent", None) => Ok(MassKind::Consistent),
+            ("lumped", None) => Ok(MassKind::Lumped),
+            ("partial", None) => Ok(MassKind::Partial(LumpRule::EmptyElement)),
+            ("partial", Some(a)) => Ok(MassKind::Partial(LumpRule::Threshold(number(a)?))),
+            ("partial-coverage", Some(a)) => {
+                Ok(MassKind::Partial(LumpRule::Coverage(fraction(a)?)))
+            }
+            ("deactivate", None) => Ok(MassKind::Deactivate { threshold: 1e-2 }),
+            ("deactivate", Some(a)) => Ok(MassKind::Deactivate {
+                threshold: number(a)?,
+            }),
+            ("extended", None) => Ok(MassKind::default()),
+            ("extended", Some(a)) => Ok(MassKind::Extended {
+                coverage: fraction(a)?,
+            }),
+            ("fmpm", Some(a)) => a
+                .parse::<usize>()
+                .ok()
+                .filter(|k| *k <= 64)
+                .map(|order| MassKind::Fmpm { order })
+                .ok_or_else(|| {
+                    format!("`{name}`: the order must be an integer in 0..=64, got `{a}`")
+                }),
+            _ => Err(format!(
+                "unknown mass strategy `{name}` (known: {MASS_NAMES})"
+            )),
+        }
+    }
+
+    /// The form [`MassKind::parse`] reads back (`partial:0.1`, `extended:0.3`).
+    pub fn spec(self) -> String {
+        match self {
+            MassKind::Partial(LumpRule::Threshold(tau)) => format!("partial:{tau}"),
+            MassKind::Partial(LumpRule::Coverage(c)) => format!("partial-coverage:{c}"),
+            MassKind::Deactivate { threshold } => format!("deactivate:{threshold}"),
+            MassKind::Extended { coverage } if coverage != DEFAULT_COVERAGE => {
+                format!("extended:{coverage}")
+            }
+            MassKind::Fmpm { order } => format!("fmpm:{order}"),
+            other => other.name().to_string(),
+        }
+    }
+
+    /// Name for output.
+    pub fn name(self) -> &'static str {
+        match self {
+            MassKind::Consistent => "consistent",
+            MassKind::Lumped => "lumped",
+            MassKind::Partial(_) => "partial",
+            MassKind::Deactivate { .. } => "deactivate",
+            MassKind::Extended { .. } => "extended",
+            MassKind::Fmpm { .. } => "fmpm",
+        }
+    }
+
+    /// The strategy this choice names, ready for [`MassStrategy::prepare`].
+    pub fn build<T: Scalar>(self) -> Box<dyn MassStrategy<T>> {
+        match self {
+            MassKind::Consistent => Box::new(Consistent::default()),
+            MassKind::Lumped => Box::new(Lumped::default()),
+            MassKind::Partial(rule) => Box::new(Partial::new(rule)),
+            MassKind::Deactivate { threshold } => Box::new(Deactivate::new(threshold)),
+            MassKind::Extended { coverage } => Box::new(Extended::new(coverage)),
+            MassKind::Fmpm { order } => Box::new(Fmpm::new(order)),
+        }
+    }
+}
+
+/// What a strategy did in one step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MassReport {
+    /// Functions with particles in their support that take part in the solve.
+    pub active: usize,
+    /// Rows replaced by their lumped value.
+    pub lumped_rows: usize,
+    /// Functions removed by deactivation.
+    pub deactivated: usize,
+    /// Functions expressed through their neighbours (extension).
+    pub extended: usize,
+    /// The worst-covered active function and its coverage (fraction of its
+    /// support's integral covered by particle volume), when the strategy measures it.
+    pub worst_coverage: Option<(usize, f64)>,
+}
+
+impl MassReport {
+    /// Functions the strategy treated (lumped, deactivated or extended).
+    pub fn treated(&self) -> usize {
+        self.lumped_rows + self.deactivated + self.extended
+    }
+}
+
+/// Which per-step facts a strategy uses; the driver computes only these.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Needs {
+    /// `touches_empty[i]`: the support of `i` has an element without particles.
+    pub empty_elements: bool,
+    /// `particle_volume[i] = Σ_p V_p phi_i(x_p)`, and the [`SupportFacts`] of the basis.
+    pub coverage: bool,
+    /// The polynomial coefficients of the basis in [`SupportFacts`].
+    pub polynomials: bool,
+}
+
+/// Per-step facts a strategy may use (empty slices for facts it did not ask for).
+#[derive(Debug, Clone, Copy)]
+pub struct StepContext<'a> {
+    /// `touches_empty[i]`: the support of function `i` contains an element without particles.
+    pub touches_empty: &'a [bool],
+    /// `Σ_p V_p phi_i(x_p)`: the particle volume seen by function `i`.
+    pub particle_volume: &'a [f64],
+}
+
+/// What a strategy is prepared with once per mesh.
+pub struct MassSetup<'a> {
+    /// The sparsity pattern of `M`.
+    pub pattern: &'a SymmetricPattern,
+    /// `fixed[k][i]`: component `k` of coefficient `i` is held at zero (Dirichlet).
+    pub fixed: &'a [Vec<bool>],
+    /// Facts of the basis, when the strategy asked for them.
+    pub support: Option<&'a SupportFacts>,
+}
+
+/// How to solve the mass systems of a step.
+pub trait MassStrategy<T: Scalar> {
+    /// The form [`MassKind::parse`] reads back.
+    fn spec(&self) -> String;
+    /// The per-step facts this strategy uses.
+    fn needs(&self) -> Needs {
+        Needs::default()
+    }
+    /// Set-up once per mesh (symbolic work, buffers).
+    fn prepare(&mut self, setup: &MassSetup);
+    /// Numeric work for the matrix whose upper triangle has `values`
+    /// (`M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)`, eq. (13)), reused by every solve of the step.
+    fn factorize(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        context: StepContext,
+    ) -> Result<MassReport, MassError>;
+    /// Solves component `k` in place: `rhs` becomes the coefficients, zero at fixed
+    /// and inactive functions.
+    fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError>;
+    /// An estimate of the spectral condition number of the systems last factorised
+    /// (the largest over components). Costs about `2 ×` [`CONDITION_ITERATIONS`]
+    /// solves; call on request.
+    fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64;
+}
+
+impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
+    fn spec(&self) -> String {
+        (**self).spec()
+    }
+    fn needs(&self) -> Needs {
+        (**self).needs()
+    }
+    fn prepare(&mut self, setup: &MassSetup) {
+        (**self).prepare(setup)
+    }
+    fn factorize(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        context: StepContext,
+    ) -> Result<MassReport, MassError> {
+        (**self).factorize(pattern, values, context)
+    }
+    fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
+        (**self).solve(k, rhs)
+    }
+    fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
+        (**self).condition_estimate(pattern)
+    }
+}
+
+/// Groups the components by their set of fixed coefficients: returns the
+/// distinct sets and, per component, the index of its set (one factorisation per set).
+fn distinct_fixed_sets(fixed: &[Vec<bool>]) -> (Vec<Vec<bool>>, Vec<usize>) {
+    let mut distinct: Vec<Vec<bool>> = Vec::new();
+    let of = fixed
+        .iter()
+        .map(|f| match distinct.iter().position(|d| d == f) {
+            Some(i) => i,
+            None => {
+                distinct.push(f.clone());
+                distinct.len() - 1
+            }
+        })
+        .collect();
+    (distinct, of)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,255 @@
+use super::*;
+use nalgebra::Vector2;
+use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+use psmpm_basis::mesh::generators::{block_grid, SplitMix64};
+use psmpm_basis::{Basis, BasisEval};
+
+/// A PS mass matrix from random particles filling the lower 60 % of a 2 × 4 block
+/// grid (the top elements are empty), the empty-element marks and the particle
+/// volume each function sees.
+struct Column {
+    ps: PowellSabin<f64>,
+    pattern: SymmetricPattern,
+    values: Vec<f64>,
+    touches_empty: Vec<bool>,
+    particle_volume: Vec<f64>,
+}
+
+fn column_mass() -> Column {
+    filled_to(1.2)
+}
+
+/// Particles filling the grid up to `height` (of 2).
+fn filled_to(height: f64) -> Column {
+    let ps = PowellSabin::<f64>::new(
+        block_grid(0.0, 1.0, 0.0, 2.0, 2, 4).unwrap(),
+        SplitPoint::Incentre,
+    )
+    .unwrap();
+    let pattern = SymmetricPattern::new(&ps);
+    let mut values = vec![0.0; pattern.nnz()];
+    let mut particle_volume = vec![0.0; ps.num_functions()];
+    let mut eval = BasisEval::for_basis(&ps);
+    let mut rng = SplitMix64(3);
+    let mut occupied = vec![false; ps.num_elements()];
+    for _ in 0..(400.0 * height / 1.2) as usize {
+        let x = Vector2::new(rng.next_f64(), height * rng.next_f64());
+        let e = ps.locate(&x, None).unwrap();
+        occupied[e] = true;
+        ps.eval(e, &x, &mut eval);
+        let scatter = pattern.element_scatter(e);
+        for a in 0..9 {
+            particle_volume[eval.index[a]] += 0.003 * eval.phi[a];
+            for b in a..9 {
+                values[scatter[a * 9 + b]] += 0.01 * eval.phi[a] * eval.phi[b];
+            }
+        }
+    }
+    let mut touches_empty = vec![false; ps.num_functions()];
+    for e in (0..ps.num_elements()).filter(|&e| !occupied[e]) {
+        for &i in ps.element_functions(e) {
+            touches_empty[i] = true;
+        }
+    }
+    Column {
+        ps,
+        pattern,
+        values,
+        touches_empty,
+        particle_volume,
+    }
+}
+
+fn prepared(c: &Column, kind: MassKind) -> Box<dyn MassStrategy<f64>> {
+    let n = c.ps.num_functions();
+    let fixed = vec![vec![false; n]; 2];
+    let mut m = kind.build::<f64>();
+    let needs = m.needs();
+    let support = (needs.coverage || needs.polynomials)
+        .then(|| SupportFacts::new(&c.ps, &c.pattern, needs.polynomials));
+    m.prepare(&MassSetup {
+        pattern: &c.pattern,
+        fixed: &fixed,
+        support: support.as_ref(),
+    });
+    m
+}
+
+fn context(c: &Column) -> StepContext<'_> {
+    StepContext {
+        touches_empty: &c.touches_empty,
+        particle_volume: &c.particle_volume,
+    }
+}
+
+/// Solving `M' y = M 1` returns `y = 1` on the active functions: the strategy keeps
+/// the row sums of `M` (mass and momentum are conserved).
+fn assert_keeps_row_sums(c: &Column, m: &mut Box<dyn MassStrategy<f64>>, label: &str) {
+    let n = c.ps.num_functions();
+    let mut rhs = vec![0.0; n];
+    c.pattern.row_sums(&c.values, &mut rhs);
+    let active: Vec<bool> = rhs.iter().map(|&r| r > 0.0).collect();
+    m.solve(0, &mut rhs).unwrap();
+    for i in 0..n {
+        let expected = if active[i] { 1.0 } else { 0.0 };
+        assert!(
+            (rhs[i] - expected).abs() < 1e-9,
+            "{label}: y[{i}] = {}",
+            rhs[i]
+        );
+    }
+}
+
+/// The consistent matrix of this near-empty configuration is singular (three PS
+/// functions of a top vertex see too few particles): reported, not a panic.
+/// Partial lumping keeps every row sum and stays SPD.
+#[test]
+fn partial_lumping_keeps_row_sums_and_stays_spd() {
+    let c = column_mass();
+    let mut consistent = prepared(&c, MassKind::Consistent);
+    assert!(consistent
+        .factorize(&c.pattern, &c.values, context(&c))
+        .is_err());
+    for kind in [
+        MassKind::Partial(LumpRule::EmptyElement),
+        MassKind::Partial(LumpRule::Threshold(0.3)),
+        MassKind::Partial(LumpRule::Coverage(0.5)),
+    ] {
+        let mut m = prepared(&c, kind);
+        let report = m.factorize(&c.pattern, &c.values, context(&c)).unwrap();
+        assert!(report.lumped_rows > 0, "{kind:?} lumped nothing");
+        assert_keeps_row_sums(&c, &mut m, &kind.spec());
+        assert!(m.condition_estimate(&c.pattern) >= 1.0);
+    }
+}
+
+/// Extension solves where the consistent mass fails, keeps the row sums, and its
+/// solved system is well conditioned.
+#[test]
+fn extension_keeps_row_sums_where_consistent_fails() {
+    let c = column_mass();
+    let mut m = prepared(&c, MassKind::default());
+    let report = m.factorize(&c.pattern, &c.values, context(&c)).unwrap();
+    assert!(report.extended > 0, "nothing extended: {report:?}");
+    let (_, worst) = report.worst_coverage.unwrap();
+    assert!(worst < DEFAULT_COVERAGE);
+    assert_keeps_row_sums(&c, &mut m, "extended");
+    let condition = m.condition_estimate(&c.pattern);
+    assert!((1.0..1e4).contains(&condition), "condition {condition}");
+}
+
+/// With every function well covered the extension does nothing and solves the
+/// consistent system.
+#[test]
+fn extension_is_the_consistent_mass_where_everything_is_covered() {
+    let c = filled_to(2.0);
+    let mut consistent = prepared(&c, MassKind::Consistent);
+    let mut extended = prepared(&c, MassKind::default());
+    consistent
+        .factorize(&c.pattern, &c.values, context(&c))
+        .unwrap();
+    let report = extended
+        .factorize(&c.pattern, &c.values, context(&c))
+        .unwrap();
+    assert_eq!(report.extended, 0, "{report:?}");
+    let n = c.ps.num_functions();
+    let rhs: Vec<f64> = (0..n).map(|i| ((i * 7) % 5) as f64 * 1e-3 - 1e-3).collect();
+    let (mut a, mut b) = (rhs.clone(), rhs);
+    consistent.solve(1, &mut a).unwrap();
+    extended.solve(1, &mut b).unwrap();
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        assert!(
+            (a[i] - b[i]).abs() < 1e-9 * scale,
+            "{i}: {} against {}",
+            a[i],
+            b[i]
+        );
+    }
+}
+
+/// FMPM(K) keeps row sums for every K and approaches the consistent solve as K grows.
+#[test]
+fn fmpm_keeps_row_sums_and_converges_to_the_consistent_solve() {
+    let c = column_mass();
+    let n = c.ps.num_functions();
+    let mut reference = prepared(&c, MassKind::Deactivate { threshold: 1e-4 });
+    reference
+        .factorize(&c.pattern, &c.values, context(&c))
+        .unwrap();
+    let rhs: Vec<f64> = (0..n).map(|i| ((i * 7) % 5) as f64 * 1e-3).collect();
+    let mut exact = rhs.clone();
+    reference.solve(0, &mut exact).unwrap();
+    let mut errors = Vec::new();
+    for order in [0, 2, 8] {
+        let mut m = prepared(&c, MassKind::Fmpm { order });
+        m.factorize(&c.pattern, &c.values, context(&c)).unwrap();
+        assert_keeps_row_sums(&c, &mut m, &format!("fmpm:{order}"));
+        let mut a = rhs.clone();
+        m.solve(0, &mut a).unwrap();
+        // Compare on well-supported functions only (the series converges slowest
+        // on nearly empty ones, where the reference deactivated a few).
+        let err: f64 = (0..n)
+            .filter(|&i| c.values[c.pattern.diagonal_position(i)] > 1e-3)
+            .map(|i| (a[i] - exact[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        errors.push(err);
+    }
+    assert!(errors[1] < errors[0] && errors[2] < errors[1], "{errors:?}");
+}
+
+#[test]
+fn deactivation_removes_small_rows_and_lumped_matches_row_sums() {
+    let c = column_mass();
+    let n = c.ps.num_functions();
+    let active = (0..n)
+        .filter(|&i| c.values[c.pattern.diagonal_position(i)] > 0.0)
+        .count();
+    // Particle masses 0.01: a threshold of 1e-4 on M_ii removes the nearly empty rows.
+    let mut deact = prepared(&c, MassKind::Deactivate { threshold: 1e-4 });
+    let r = deact.factorize(&c.pattern, &c.values, context(&c)).unwrap();
+    assert!(r.deactivated > 0);
+    assert_eq!(r.active + r.deactivated, active);
+    let mut lumped = prepared(&c, MassKind::Lumped);
+    lumped
+        .factorize(&c.pattern, &c.values, context(&c))
+        .unwrap();
+    let mut rhs = vec![0.0; n];
+    c.pattern.row_sums(&c.values, &mut rhs);
+    lumped.solve(1, &mut rhs).unwrap();
+    assert!(rhs.iter().all(|&y| y == 0.0 || (y - 1.0).abs() < 1e-14));
+}
+
+#[test]
+fn mass_kinds_parse() {
+    assert_eq!(
+        MassKind::parse("partial").unwrap(),
+        MassKind::Partial(LumpRule::EmptyElement)
+    );
+    assert_eq!(
+        MassKind::parse("partial:0.1").unwrap(),
+        MassKind::Partial(LumpRule::Threshold(0.1))
+    );
+    assert_eq!(
+        MassKind::parse("deactivate").unwrap(),
+        MassKind::Deactivate { threshold: 1e-2 }
+    );
+    assert_eq!(MassKind::parse("default").unwrap(), MassKind::default());
+    assert_eq!(
+        MassKind::parse("extended:0.4").unwrap().spec(),
+        "extended:0.4"
+    );
+    assert_eq!(
+        MassKind::parse("fmpm:3").unwrap(),
+        MassKind::Fmpm { order: 3 }
+    );
+    for kind in ["partial-coverage:0.2", "fmpm:2", "extended", "lumped"] {
+        assert_eq!(MassKind::parse(kind).unwrap().spec(), kind);
+        assert_eq!(MassKind::parse(kind).unwrap().build::<f64>().spec(), kind);
+    }
+    assert!(MassKind::parse("partial:-1").is_err());
+    assert!(MassKind::parse("extended:1.5").is_err());
+    assert!(MassKind::parse("fmpm").is_err());
+    assert!(MassKind::parse("heavy").unwrap_err().contains("known:"));
+}
