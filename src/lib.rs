@@ -15,7 +15,8 @@
 //!   [`simulation`]: building and running a scene, its summary and stability verdict;
 //! - [`exact`]: the seeds' exact solutions; [`ulfem`]: the 1D updated-Lagrangian FEM
 //!   reference; [`reproduction`]: the benchmark studies of `docs/results.md`;
-//! - [`output`]: VTK XML, ParaView collections and CSV; [`plot`]: SVG plots.
+//! - [`output`]: VTK XML, ParaView collections, CSV and SVG figures (line plots, mesh
+//!   and basis function pictures), apart from the method.
 //!
 //! # Examples
 //!
