@@ -61,7 +61,12 @@ pub mod mass;
 pub mod material;
 pub mod output;
 pub mod particles;
-pub mod plot;
+/// Temporary: the old path of the chart items `reproduction` uses, until it moves
+/// to `output::chart` (remove at merge).
+#[doc(hidden)]
+pub(crate) mod plot {
+    pub(crate) use crate::output::chart::{LinePlot, Scale, Series};
+}
 pub mod projection;
 pub mod reproduction;
 pub mod scene;

@@ -24,8 +24,13 @@
 //! written. `f32` simulations are widened to `f64` (exactly) before they are written.
 //! The SVG figures have integer pixel coordinates (see [`chart`]).
 
+/// The axis coordinate of every chart, its ticks and tick labels.
+mod axis;
+pub mod basis_picture;
+pub mod chart;
 pub mod csv;
 pub mod dir;
+pub mod mesh_picture;
 pub mod vtk;
 
 use std::io::{self, Write};
