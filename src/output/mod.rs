@@ -7,8 +7,9 @@
 //! - [`dir`]: the output directory the command line's `--out DIR` writes through
 //!   ([`OutputDir`](dir::OutputDir)), and [`write_file`](dir::write_file) with its
 //!   error [`OutputError`](dir::OutputError);
-//! - [`chart`]: SVG line plots (time series, convergence), their [`PlotError`](chart::PlotError)
-//!   and colours;
+//! - [`chart`]: SVG line plots (time series, convergence), the plotting error
+//!   [`PlotError`](chart::PlotError), colours and legend shared by all figures (their
+//!   axes, linear or log10 with nice ticks, are the private `axis` module);
 //! - [`mesh_picture`]: the SVG picture of a Powell–Sabin mesh with its refinement and
 //!   control triangles;
 //! - [`basis_picture`]: the SVG picture of one basis function, shaded by value.
@@ -35,6 +36,7 @@ pub mod vtk;
 
 use std::io::{self, Write};
 
+/// An `InvalidInput` io error: inconsistent data handed to a writer.
 fn invalid(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
 }
