@@ -15,7 +15,8 @@
 //!   [`simulation`]: building and running a scene, its summary and stability verdict;
 //! - [`exact`]: the seeds' exact solutions; [`ulfem`]: the 1D updated-Lagrangian FEM
 //!   reference; [`reproduction`]: the benchmark studies of `docs/results.md`;
-//! - [`output`]: VTK XML, ParaView collections and CSV; [`plot`]: SVG plots.
+//! - [`output`]: VTK XML, ParaView collections, CSV and SVG figures (line plots, mesh
+//!   and basis function pictures), apart from the method.
 //!
 //! # Examples
 //!
@@ -61,7 +62,12 @@ pub mod mass;
 pub mod material;
 pub mod output;
 pub mod particles;
-pub mod plot;
+/// Temporary: the old path of the chart items `reproduction` uses, until it moves
+/// to `output::chart` (remove at merge).
+#[doc(hidden)]
+pub(crate) mod plot {
+    pub(crate) use crate::output::chart::{LinePlot, Scale, Series};
+}
 pub mod projection;
 pub mod reproduction;
 pub mod scene;

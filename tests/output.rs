@@ -4,7 +4,7 @@
 //! These tests need `python3` with `meshio`; they fail (never skip) without them.
 
 use nalgebra::{Matrix1, Matrix2, Vector1, Vector2};
-use psmpm::output::{OutputDir, OutputError};
+use psmpm::output::dir::{OutputDir, OutputError};
 use psmpm::particles::Particles;
 use psmpm_basis::mesh::generators::block_grid;
 use serde_json::Value;

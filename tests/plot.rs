@@ -1,4 +1,4 @@
-//! SVG plots (`psmpm::plot`): well-formed files, legends, one drawn curve per line
+//! SVG plots (`psmpm::output::{chart, mesh_picture, basis_picture}`): well-formed files, legends, one drawn curve per line
 //! series, one control-triangle polygon per vertex, errors instead of panics.
 //!
 //! The SVGs go to a fresh directory under the system's temp dir, removed at the end;
@@ -10,10 +10,9 @@ use std::path::{Path, PathBuf};
 use psmpm::bases;
 use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::Basis;
-use psmpm::plot::{
-    basis_function_plot, line_plot, mesh_plot, series_colour, BasisPlotOptions, LinePlot,
-    MeshPlotOptions, PlotError, Scale, Series, VertexSelection, MESH_EDGE,
-};
+use psmpm::output::basis_picture::{basis_function_plot, BasisPlotOptions, MESH_EDGE};
+use psmpm::output::chart::{line_plot, series_colour, LinePlot, PlotError, Scale, Series};
+use psmpm::output::mesh_picture::{mesh_plot, MeshPlotOptions, VertexSelection};
 
 /// A fresh directory for one test's files, removed on drop.
 struct TempDir(PathBuf);

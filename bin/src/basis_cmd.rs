@@ -9,7 +9,8 @@ use psmpm::basis::basis::linear::Linear;
 use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
 use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::{Basis, TriMesh};
-use psmpm::plot::{basis_function_plot, mesh_plot, BasisPlotOptions, MeshPlotOptions};
+use psmpm::output::basis_picture::{basis_function_plot, BasisPlotOptions};
+use psmpm::output::mesh_picture::{mesh_plot, MeshPlotOptions};
 use psmpm::scene::parse_split;
 use std::path::PathBuf;
 
@@ -82,8 +83,9 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
     let kind =
         BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
     let mesh = mesh(&args)?;
-    let plot_error =
-        |e: psmpm::plot::PlotError| CliError::Input(format!("{}: {e}", args.out.display()));
+    let plot_error = |e: psmpm::output::chart::PlotError| {
+        CliError::Input(format!("{}: {e}", args.out.display()))
+    };
     let functions = match (args.function, kind) {
         (None, BasisKind::Ps) => {
             let ps = PowellSabin::<f64>::new(mesh, split).map_err(|e| CliError::Input(e.to_string()))?;

@@ -10,7 +10,7 @@ use crate::error::CliError;
 use crate::run::{read_scene, Overrides};
 use crate::table::{fixed2, sci, Table};
 use crate::Format;
-use psmpm::plot::{line_plot, Axis, LinePlot, Scale, Series, SeriesStyle};
+use psmpm::output::chart::{line_plot, Axis, LinePlot, Scale, Series, SeriesStyle};
 use psmpm::simulation::{self, RunError};
 use serde::Serialize;
 use std::path::PathBuf;

@@ -7,7 +7,7 @@
 //!   integers, `condition` empty unless `--condition`).
 //! - `summary.json`: the summary of `--format json`, pretty-printed.
 //! - `particles_NNNNN.vtu` and `particles.pvd`: particle frames (position,
-//!   velocity, displacement, stress, volume, mass; see `psmpm::output`) of the
+//!   velocity, displacement, stress, volume, mass; see `psmpm::output::vtk`) of the
 //!   initial state, every `--out-every` steps and the last step (on a numerical
 //!   failure, the particles as the failed step left them, at the time of the last
 //!   completed step); the `.pvd` collection plays them back in ParaView.
@@ -21,8 +21,8 @@
 
 use crate::error::CliError;
 use psmpm::driver::StepReport;
-use psmpm::output::{write_file, OutputDir, OutputError};
-use psmpm::plot::{line_plot, LinePlot, Series};
+use psmpm::output::chart::{line_plot, LinePlot, Series};
+use psmpm::output::dir::{write_file, OutputDir, OutputError};
 use psmpm::scene::Scene;
 use psmpm::simulation::{self, ParticlesRef, Summary, Tracked};
 use std::fs::File;
@@ -387,7 +387,7 @@ impl Recorder {
         }
         let path = self.dir.file(file);
         line_plot(&path, &plot).map_err(|e| match e {
-            psmpm::plot::PlotError::Io { .. } => CliError::Input(e.to_string()),
+            psmpm::output::chart::PlotError::Io { .. } => CliError::Input(e.to_string()),
             other => CliError::Input(format!("{}: {other}", path.display())),
         })?;
         Ok(true)

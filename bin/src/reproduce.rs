@@ -3,7 +3,7 @@
 
 use crate::error::CliError;
 use crate::Format;
-use psmpm::plot::line_plot;
+use psmpm::output::chart::line_plot;
 use psmpm::reproduction::{reproduce, Effort, STUDIES};
 use psmpm::simulation::RunError;
 use std::path::PathBuf;

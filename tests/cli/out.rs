@@ -143,9 +143,9 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     (header, rows)
 }
 
-/// The colour `psmpm::plot` gives series `k`, as it appears in the SVG.
+/// The colour `psmpm::output::chart` gives series `k`, as it appears in the SVG.
 fn series_stroke(k: usize) -> String {
-    let (r, g, b) = psmpm::plot::series_colour(k);
+    let (r, g, b) = psmpm::output::chart::series_colour(k);
     format!("#{r:02X}{g:02X}{b:02X}")
 }
 
