@@ -3,9 +3,9 @@
 //! `docs/results.md` that hold at this size checked.
 
 use psmpm::mass::MassKind;
-use psmpm::reproduction::{reproduce, Effort, STUDIES};
 use psmpm::scene::Scene;
 use psmpm::simulation::run;
+use psmpm::studies::reproduction::{reproduce, Effort, STUDIES};
 
 #[test]
 fn quick_reproductions_are_pinned() {

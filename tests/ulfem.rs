@@ -1,10 +1,10 @@
-//! The 1D updated-Lagrangian FEM reference solver (`psmpm::ulfem`): convergence to
+//! The 1D updated-Lagrangian FEM reference solver (`psmpm::studies::ulfem`): convergence to
 //! the exact solutions of B2, B3 (large amplitude, still exact in 1D) and B5a/B5b
 //! under grid refinement, the time error, the disk cache, and allocation-free steps.
 //!
 //! `cargo test --release -p psmpm --test ulfem -- --nocapture` prints the tables.
 
-use psmpm::ulfem::{
+use psmpm::studies::ulfem::{
     cache_file_name, cached_reference_history_in, history_key, reference_history, End,
     InitialVelocity, UlFem, UlFemConfig, UlMass,
 };
@@ -386,7 +386,7 @@ fn history_records_and_cache_round_trip() {
     )
     .unwrap();
     assert_eq!(read, history);
-    let stored: psmpm::ulfem::History =
+    let stored: psmpm::studies::ulfem::History =
         serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
     assert_eq!(stored, history);
     // No temporary files left behind.

@@ -4,8 +4,8 @@
 use crate::error::CliError;
 use crate::Format;
 use psmpm::plot::line_plot;
-use psmpm::reproduction::{reproduce, Effort, STUDIES};
 use psmpm::simulation::RunError;
+use psmpm::studies::reproduction::{reproduce, Effort, STUDIES};
 use std::path::PathBuf;
 
 /// Arguments of `mpm-cli reproduce`.

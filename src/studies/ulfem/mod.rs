@@ -116,7 +116,7 @@
 //! # Example
 //!
 //! ```
-//! use psmpm::ulfem::{End, InitialVelocity, UlFem, UlFemConfig, UlMass};
+//! use psmpm::studies::ulfem::{End, InitialVelocity, UlFem, UlFemConfig, UlMass};
 //!
 //! let config = UlFemConfig {
 //!     length: 25.0,

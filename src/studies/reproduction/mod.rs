@@ -20,7 +20,7 @@ use crate::mass::MassKind;
 use crate::plot::{LinePlot, Scale, Series};
 use crate::scene::{MeshSpec, Reference, Scene};
 use crate::simulation::{self, Outcome, RunError, Summary};
-use crate::ulfem::{self, End, InitialVelocity, UlFemConfig, UlMass};
+use crate::studies::ulfem::{self, End, InitialVelocity, UlFemConfig, UlMass};
 
 /// How much to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -621,7 +621,7 @@ fn b4(effort: Effort) -> Result<Report, RunError> {
         let out = simulation::run_2d(&s, &mut |_| {})?;
         let t = &out.tracked[0];
         let vx: Vec<f64> = t.velocity.iter().map(|v| v[0]).collect();
-        let exact = crate::exact::AxisAligned {
+        let exact = crate::studies::exact::AxisAligned {
             u0: 0.05,
             young: s.material.young,
             poisson: s.material.poisson,
@@ -889,7 +889,9 @@ fn b5c(effort: Effort) -> Result<Report, RunError> {
             let y = height * (1.0 - 0.5 * density * g * height / young) * k as f64 / 100.0;
             (
                 y,
-                crate::exact::column_equilibrium_stress_linear(y, height, density, g, young),
+                crate::studies::exact::column_equilibrium_stress_linear(
+                    y, height, density, g, young,
+                ),
             )
         })
         .collect();
@@ -909,9 +911,11 @@ fn b5c(effort: Effort) -> Result<Report, RunError> {
         for k in 0..p.len() {
             let y = p.x[k][1];
             let s_yy = p.sigma[k][(1, 1)];
-            let e_lin =
-                crate::exact::column_equilibrium_stress_linear(y, height, density, g, young);
-            let e_paper = crate::exact::column_equilibrium_stress(y, height, density, g, young);
+            let e_lin = crate::studies::exact::column_equilibrium_stress_linear(
+                y, height, density, g, young,
+            );
+            let e_paper =
+                crate::studies::exact::column_equilibrium_stress(y, height, density, g, young);
             linear = linear.max((s_yy - e_lin).abs() / sigma0);
             paper = paper.max((s_yy - e_paper).abs() / sigma0);
             points.push((y, s_yy));
