@@ -1,6 +1,7 @@
-//! The 1D updated-Lagrangian FEM reference solver (`psmpm::studies::ulfem`): convergence to
-//! the exact solutions of B2, B3 (large amplitude, still exact in 1D) and B5a/B5b
-//! under grid refinement, the time error, the disk cache, and allocation-free steps.
+//! The 1D updated-Lagrangian FEM reference solver (`psmpm::studies::ulfem`):
+//! convergence to the exact solutions of B2, B3 (large amplitude, still exact in 1D)
+//! and B5a/B5b under grid refinement, the time error, the disk cache, and
+//! allocation-free steps.
 //!
 //! `cargo test --release -p psmpm --test ulfem -- --nocapture` prints the tables.
 
