@@ -21,6 +21,7 @@ use crate::plot::{LinePlot, Scale, Series};
 use crate::scene::{MeshSpec, Reference, Scene};
 use crate::simulation::{self, Outcome, RunError, Summary};
 use crate::studies::ulfem::{self, End, InitialVelocity, UlFemConfig, UlMass};
+use std::path::Path;
 
 /// How much to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -78,13 +79,15 @@ pub struct Report {
 /// The studies, in order.
 pub const STUDIES: [&str; 5] = ["b2", "b3", "b4", "b5b", "b5c"];
 
-/// Runs study `name` (one of [`STUDIES`]).
-pub fn reproduce(name: &str, effort: Effort) -> Result<Report, RunError> {
+/// Runs study `name` (one of [`STUDIES`]). The UL-FEM references of `b3` and `b5b`
+/// are read from or stored in the cache directory `cache`
+/// ([`ulfem::cached_reference_history`]; `None`: no cache, they are computed).
+pub fn reproduce(name: &str, effort: Effort, cache: Option<&Path>) -> Result<Report, RunError> {
     match name {
         "b2" => b2(effort),
-        "b3" => b3(effort),
+        "b3" => b3(effort, cache),
         "b4" => b4(effort),
-        "b5b" => b5b(effort),
+        "b5b" => b5b(effort, cache),
         "b5c" => b5c(effort),
         other => Err(RunError::Setup(format!(
             "unknown study `{other}` (known: {})",
@@ -236,7 +239,7 @@ fn b2(effort: Effort) -> Result<Report, RunError> {
 
 /// B3 (paper §4.1): energies of the large-deformation bar against the UL-FEM
 /// reference.
-fn b3(effort: Effort) -> Result<Report, RunError> {
+fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunError> {
     let t_end = if effort == Effort::Quick { 2.0 } else { 20.0 };
     let base = builtin("bar-large")?;
     let (length, width) = (1.0, 0.05);
@@ -256,6 +259,7 @@ fn b3(effort: Effort) -> Result<Report, RunError> {
         mass: UlMass::Lumped,
     };
     let reference = ulfem::cached_reference_history(
+        cache,
         &reference_config,
         InitialVelocity::SineMode { v0: 0.1 },
         &[0.5],
@@ -719,7 +723,7 @@ pub fn sigma_yy_roughness(particles: &crate::particles::Particles<f64, 2>, sigma
 }
 
 /// B5b (paper §4.3, thesis §4.4 and 5): mass strategies on three grids.
-fn b5b(effort: Effort) -> Result<Report, RunError> {
+fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunError> {
     let base = builtin("column-large")?;
     let t_end = if effort == Effort::Quick { 0.5 } else { 2.5 };
     // (label, blocks of the mesh: the column's blocks plus the empty band above).
@@ -746,6 +750,7 @@ fn b5b(effort: Effort) -> Result<Report, RunError> {
         mass: UlMass::Lumped,
     };
     let reference = ulfem::cached_reference_history(
+        cache,
         &reference_config,
         InitialVelocity::Rest,
         &[0.5],

@@ -3,7 +3,7 @@
 
 use super::config::{InitialVelocity, UlFemConfig, UlFemError};
 use super::history::{reference_history, validate_run, History};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Version of the cache format and of the solver; part of every key.
 pub const CACHE_VERSION: u32 = 1;
@@ -51,39 +51,13 @@ pub fn cache_file_name(key: &str) -> String {
     format!("ulfem-{:016x}.json", fnv1a64(key.as_bytes()))
 }
 
-/// The cache directory: `$PSMPM_CACHE_DIR` if set (and non-empty), else
-/// `$XDG_CACHE_HOME/psmpm`, else `$HOME/.cache/psmpm`; `None` if none is set.
-pub fn cache_dir() -> Option<PathBuf> {
-    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
-    var("PSMPM_CACHE_DIR")
-        .map(PathBuf::from)
-        .or_else(|| var("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("psmpm")))
-        .or_else(|| var("HOME").map(|d| PathBuf::from(d).join(".cache").join("psmpm")))
-}
-
-/// [`reference_history`], read from or stored in [`cache_dir`] (see the module
-/// documentation). Cache failures are silent: the history is then computed.
-pub fn cached_reference_history(
-    config: &UlFemConfig,
-    initial_velocity: InitialVelocity,
-    sample_points: &[f64],
-    output_every: usize,
-    t_end: f64,
-) -> Result<History, UlFemError> {
-    cached_reference_history_in(
-        cache_dir().as_deref(),
-        config,
-        initial_velocity,
-        sample_points,
-        output_every,
-        t_end,
-    )
-}
-
-/// [`cached_reference_history`] with an explicit cache directory (`None`: no cache).
+/// [`reference_history`], read from or stored in the cache directory `dir` (`None`:
+/// no cache, the history is computed). The library never chooses the directory:
+/// `mpm-cli` resolves it from the environment (see the module documentation).
 /// The directory is created if needed; the file is written to a temporary name and
-/// renamed, so concurrent runs never read a partial file.
-pub fn cached_reference_history_in(
+/// renamed, so concurrent runs never read a partial file. Cache failures are silent:
+/// the history is then computed.
+pub fn cached_reference_history(
     dir: Option<&Path>,
     config: &UlFemConfig,
     initial_velocity: InitialVelocity,

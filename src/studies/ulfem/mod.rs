@@ -106,12 +106,16 @@
 //! [`reference_history`] runs a configuration to `t_end` and records the time,
 //! displacement, velocity and stress at sample reference points, and the energies,
 //! every `output_every` steps ([`History`]). [`cached_reference_history`] stores the
-//! history as JSON in [`cache_dir`]: `$PSMPM_CACHE_DIR` if set, else
-//! `$XDG_CACHE_HOME/psmpm`, else `$HOME/.cache/psmpm` (never the source tree), under
+//! history as JSON in the directory it is given (`None`: no cache), under
 //! `ulfem-<16 hex digits>.json`, the 64-bit FNV-1a hash ([`fnv1a64`]) of a key string
 //! ([`history_key`]) listing every input. The key is stored in the file and checked
 //! on reading; if the cache cannot be read or written the history is simply
 //! computed.
+//!
+//! The library reads no environment: the caller chooses the directory. `mpm-cli`
+//! (`reproduce`, through [`reproduction::reproduce`](crate::studies::reproduction::reproduce))
+//! uses `$PSMPM_CACHE_DIR` if set (and non-empty), else `$XDG_CACHE_HOME/psmpm`, else
+//! `$HOME/.cache/psmpm` (never the source tree), and no cache if none is set.
 //!
 //! # Example
 //!
@@ -144,10 +148,7 @@ mod config;
 mod history;
 mod solver;
 
-pub use cache::{
-    cache_dir, cache_file_name, cached_reference_history, cached_reference_history_in, fnv1a64,
-    history_key, CACHE_VERSION,
-};
+pub use cache::{cache_file_name, cached_reference_history, fnv1a64, history_key, CACHE_VERSION};
 pub use config::{End, InitialVelocity, UlFemConfig, UlFemError, UlMass, MAX_ELEMENTS};
 pub use history::{reference_history, History, Record};
 pub use solver::{UlEnergies, UlFem};
