@@ -7,14 +7,15 @@
 //! - [`bases`]: the typed choice of basis made at the edge (command line, scene);
 //! - [`sparse`]: symmetric sparsity patterns on a basis and the sparse Cholesky solver
 //!   (symbolic once, numeric per call);
-//! - [`projection`]: L² projection onto a basis (benchmark B1 of the seeds);
 //! - [`driver`]: the MPM time step, generic over basis, [`mass`] strategy and
 //!   [`material`]; [`particles`]; [`effect`]s (gravity, local damping, traction,
 //!   body forces, initial stress) with their work in the energy balance;
 //! - [`scene`]: a run declared as data (TOML), and the built-in scenes;
 //!   [`simulation`]: building and running a scene, its summary and stability verdict;
-//! - [`exact`]: the seeds' exact solutions; [`ulfem`]: the 1D updated-Lagrangian FEM
-//!   reference; [`reproduction`]: the benchmark studies of `docs/results.md`;
+//! - [`studies`]: the checks of the method, apart from it: the seeds' exact solutions
+//!   ([`studies::exact`]), the 1D updated-Lagrangian FEM reference ([`studies::ulfem`]),
+//!   L² projection onto a basis, benchmark B1 ([`studies::projection`]), and the
+//!   benchmark studies of `docs/results.md` ([`studies::reproduction`]);
 //! - [`output`]: VTK XML, ParaView collections, CSV and SVG figures (line plots, mesh
 //!   and basis function pictures), apart from the method.
 //!
@@ -38,7 +39,7 @@
 //!
 //! ```
 //! use psmpm::bases;
-//! use psmpm::projection::{l2_errors, project, MassOption, SineProduct};
+//! use psmpm::studies::projection::{l2_errors, project, MassOption, SineProduct};
 //! use psmpm::basis::mesh::generators::lattice_delaunay;
 //!
 //! let mesh = lattice_delaunay(9, 0.0, 1.0, 0.0, 1.0).unwrap();
@@ -57,20 +58,11 @@ pub mod bases;
 pub mod diagnostics;
 pub mod driver;
 pub mod effect;
-pub mod exact;
 pub mod mass;
 pub mod material;
 pub mod output;
 pub mod particles;
-/// Temporary: the old path of the chart items `reproduction` uses, until it moves
-/// to `output::chart` (remove at merge).
-#[doc(hidden)]
-pub(crate) mod plot {
-    pub(crate) use crate::output::chart::{LinePlot, Scale, Series};
-}
-pub mod projection;
-pub mod reproduction;
 pub mod scene;
 pub mod simulation;
 pub mod sparse;
-pub mod ulfem;
+pub mod studies;

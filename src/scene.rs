@@ -407,7 +407,7 @@ pub enum Reference {
     /// B5c: the static stress profile of a column under self-weight; error: the
     /// largest `|σ_yy − σ_yy^exact| / |σ_yy(0)|` over particles at the end. The
     /// exact profile is that of the project's linear law `σ = E (F − 1)`
-    /// ([`crate::exact::column_equilibrium_stress_linear`]); paper eq. (48) belongs
+    /// ([`crate::studies::exact::column_equilibrium_stress_linear`]); paper eq. (48) belongs
     /// to a slightly different law and differs by about `κ² |σ_yy(0)|`.
     ColumnEquilibrium {},
 }

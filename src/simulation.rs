@@ -17,13 +17,13 @@
 use crate::bases::BasisKind;
 use crate::driver::{Driver, Fix, PhaseTimes, SetupError, StepError, StepReport};
 use crate::effect::{BodyForce, Effect, Geostatic, Gravity, InitialStress, LocalDamping, Traction};
-use crate::exact;
 use crate::mass::MassStrategy;
 use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
 use crate::particles::Particles;
 use crate::scene::{
     BlockLayout, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference, Scene,
 };
+use crate::studies::exact;
 use nalgebra::{SMatrix, SVector};
 use psmpm_basis::basis::bspline1d::QuadraticBSpline;
 use psmpm_basis::basis::linear::Linear;

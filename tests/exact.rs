@@ -1,4 +1,4 @@
-//! Independent checks of the exact solutions in `psmpm::exact`:
+//! Independent checks of the exact solutions in `psmpm::studies::exact`:
 //!
 //! * B4 (paper (40)–(46)): the body force of eqs. (42)–(43) balances the imposed
 //!   motion for the project's neo-Hookean law, `ρ⁰ ü − Div P − ρ⁰ g ≈ 0` to round-off,
@@ -13,11 +13,11 @@
 #![allow(clippy::needless_range_loop)]
 
 use nalgebra::Matrix2;
-use psmpm::exact::{
+use psmpm::material::{Elastic, Material, NeoHookean};
+use psmpm::studies::exact::{
     column_equilibrium_position_linear, column_equilibrium_stress,
     column_equilibrium_stress_linear, AxisAligned,
 };
-use psmpm::material::{Elastic, Material, NeoHookean};
 use std::f64::consts::PI;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 

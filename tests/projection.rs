@@ -2,7 +2,7 @@
 //! (thesis Tables 3.1–3.2, paper Fig. 8).
 
 use psmpm::bases::BasisKind;
-use psmpm::projection::{default_levels, unit_square_study, MassOption, StudyRow};
+use psmpm::studies::projection::{default_levels, unit_square_study, MassOption, StudyRow};
 
 fn study(kind: BasisKind, mass: MassOption) -> Vec<StudyRow> {
     let levels = default_levels(kind, 4).unwrap();

@@ -1,11 +1,12 @@
-//! The 1D updated-Lagrangian FEM reference solver (`psmpm::ulfem`): convergence to
-//! the exact solutions of B2, B3 (large amplitude, still exact in 1D) and B5a/B5b
-//! under grid refinement, the time error, the disk cache, and allocation-free steps.
+//! The 1D updated-Lagrangian FEM reference solver (`psmpm::studies::ulfem`):
+//! convergence to the exact solutions of B2, B3 (large amplitude, still exact in 1D)
+//! and B5a/B5b under grid refinement, the time error, the disk cache, and
+//! allocation-free steps.
 //!
 //! `cargo test --release -p psmpm --test ulfem -- --nocapture` prints the tables.
 
-use psmpm::ulfem::{
-    cache_file_name, cached_reference_history_in, history_key, reference_history, End,
+use psmpm::studies::ulfem::{
+    cache_file_name, cached_reference_history, history_key, reference_history, End,
     InitialVelocity, UlFem, UlFemConfig, UlMass,
 };
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -325,7 +326,7 @@ fn history_records_and_cache_round_trip() {
     let dir = scratch_dir("cache");
     let key = history_key(&config, InitialVelocity::Rest, &samples, 100, 0.25);
     let file = dir.join(cache_file_name(&key));
-    let first = cached_reference_history_in(
+    let first = cached_reference_history(
         Some(&dir),
         &config,
         InitialVelocity::Rest,
@@ -337,7 +338,7 @@ fn history_records_and_cache_round_trip() {
     assert_eq!(first, history);
     assert!(file.exists(), "{file:?}");
     // Read back bit for bit (serde_json with float_roundtrip).
-    let second = cached_reference_history_in(
+    let second = cached_reference_history(
         Some(&dir),
         &config,
         InitialVelocity::Rest,
@@ -351,7 +352,7 @@ fn history_records_and_cache_round_trip() {
     let mut doctored = history.clone();
     doctored.records[0].time = 123.0;
     std::fs::write(&file, serde_json::to_vec(&doctored).unwrap()).unwrap();
-    let read = cached_reference_history_in(
+    let read = cached_reference_history(
         Some(&dir),
         &config,
         InitialVelocity::Rest,
@@ -365,7 +366,7 @@ fn history_records_and_cache_round_trip() {
     // both are recomputed and overwritten.
     doctored.key.push('x');
     std::fs::write(&file, serde_json::to_vec(&doctored).unwrap()).unwrap();
-    let read = cached_reference_history_in(
+    let read = cached_reference_history(
         Some(&dir),
         &config,
         InitialVelocity::Rest,
@@ -376,7 +377,7 @@ fn history_records_and_cache_round_trip() {
     .unwrap();
     assert_eq!(read, history);
     std::fs::write(&file, b"{ not json").unwrap();
-    let read = cached_reference_history_in(
+    let read = cached_reference_history(
         Some(&dir),
         &config,
         InitialVelocity::Rest,
@@ -386,7 +387,7 @@ fn history_records_and_cache_round_trip() {
     )
     .unwrap();
     assert_eq!(read, history);
-    let stored: psmpm::ulfem::History =
+    let stored: psmpm::studies::ulfem::History =
         serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
     assert_eq!(stored, history);
     // No temporary files left behind.
@@ -396,7 +397,7 @@ fn history_records_and_cache_round_trip() {
     // An unusable cache directory (a regular file) just computes.
     let blocker = scratch_dir("blocker");
     std::fs::write(&blocker, b"file").unwrap();
-    let computed = cached_reference_history_in(
+    let computed = cached_reference_history(
         Some(&blocker),
         &config,
         InitialVelocity::Rest,
@@ -409,9 +410,7 @@ fn history_records_and_cache_round_trip() {
     std::fs::remove_file(&blocker).unwrap();
     // Bad input is still an error, cache or not.
     let bad = UlFemConfig { dt: -1.0, ..config };
-    assert!(
-        cached_reference_history_in(None, &bad, InitialVelocity::Rest, &samples, 1, 1.0).is_err()
-    );
+    assert!(cached_reference_history(None, &bad, InitialVelocity::Rest, &samples, 1, 1.0).is_err());
 }
 
 #[test]

@@ -73,7 +73,9 @@ enum Command {
     /// Reproduce the seeds' benchmarks B2–B5: tables (markdown) and SVG figures.
     ///
     /// The full studies take about 2 minutes on one core; --quick runs the coarse
-    /// versions the test suite pins.
+    /// versions the test suite pins. The UL-FEM references of b3 and b5b are cached
+    /// in $PSMPM_CACHE_DIR, else $XDG_CACHE_HOME/psmpm, else $HOME/.cache/psmpm (none
+    /// if no variable is set).
     Reproduce(reproduce::ReproduceArgs),
     /// Pictures of the bases: a mesh with its PS refinement and control triangles,
     /// or one basis function.

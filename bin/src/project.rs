@@ -4,7 +4,7 @@ use crate::error::CliError;
 use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
-use psmpm::projection::{self, MassOption, StudyError, StudyRow, MAX_LEVELS};
+use psmpm::studies::projection::{self, MassOption, StudyError, StudyRow, MAX_LEVELS};
 use std::path::PathBuf;
 
 /// Arguments of `mpm-cli project`.

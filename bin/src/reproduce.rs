@@ -1,12 +1,27 @@
 //! `mpm-cli reproduce`: the seeds' benchmarks B2–B5 as studies, printed as the
 //! markdown tables of `docs/results.md`, with their SVG figures.
+//!
+//! The UL-FEM reference runs of `b3` and `b5b` are cached in [`cache_dir`], chosen
+//! here from the environment; the library takes the directory as an argument.
 
 use crate::error::CliError;
 use crate::Format;
 use psmpm::output::chart::line_plot;
-use psmpm::reproduction::{reproduce, Effort, STUDIES};
 use psmpm::simulation::RunError;
+use psmpm::studies::reproduction::{reproduce, Effort, STUDIES};
 use std::path::PathBuf;
+
+/// The cache directory of the UL-FEM reference runs
+/// ([`psmpm::studies::ulfem::cached_reference_history`]): `$PSMPM_CACHE_DIR` if set
+/// (and non-empty), else `$XDG_CACHE_HOME/psmpm`, else `$HOME/.cache/psmpm` (never the
+/// source tree); `None` (no cache) if none is set.
+pub fn cache_dir() -> Option<PathBuf> {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
+    var("PSMPM_CACHE_DIR")
+        .map(PathBuf::from)
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("psmpm")))
+        .or_else(|| var("HOME").map(|d| PathBuf::from(d).join(".cache").join("psmpm")))
+}
 
 /// Arguments of `mpm-cli reproduce`.
 #[derive(Debug, clap::Args)]
@@ -49,9 +64,11 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
     } else {
         Effort::Full
     };
+    let cache = cache_dir();
     for name in &names {
         let clock = std::time::Instant::now();
-        let report = reproduce(name, effort).map_err(|RunError::Setup(m)| CliError::Input(m))?;
+        let report = reproduce(name, effort, cache.as_deref())
+            .map_err(|RunError::Setup(m)| CliError::Input(m))?;
         let mut files = Vec::new();
         for figure in &report.figures {
             let path = args.out.join(&figure.file);

@@ -1,4 +1,3 @@
-
 use super::phases::update_deformation_gradient;
 use crate::material::{Elastic, Material, NeoHookean};
 use nalgebra::Matrix2;

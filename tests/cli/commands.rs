@@ -1,5 +1,6 @@
-//! `scenes`, `scene show`, `compare`, `converge` and `basis plot`: output pinned with
-//! snapshots (wall times removed), round trips, and determinism across threads.
+//! `scenes`, `scene show`, `compare`, `converge`, `basis plot` and the cache of
+//! `reproduce`: output pinned with snapshots (wall times removed), round trips, and
+//! determinism across threads.
 
 use assert_cmd::Command;
 use serde_json::Value;
@@ -318,4 +319,67 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("0..39"));
+}
+
+/// `reproduce` chooses the UL-FEM cache directory from the environment (the library
+/// takes it as an argument): `PSMPM_CACHE_DIR` (if non-empty), else
+/// `XDG_CACHE_HOME/psmpm`, else `HOME/.cache/psmpm`, else none; the tables are the
+/// same whether the reference is computed or read back.
+#[test]
+fn reproduce_caches_the_reference_where_the_environment_says() {
+    let dir = temp_dir("cache");
+    let (own, xdg, home) = (dir.join("own"), dir.join("xdg"), dir.join("home"));
+    let figures = dir.join("figures");
+    let run = |vars: &[(&str, &std::path::Path)]| {
+        let mut cmd = cli();
+        cmd.args(["reproduce", "b3", "--quick", "--format", "json", "--out"])
+            .arg(&figures);
+        for name in ["PSMPM_CACHE_DIR", "XDG_CACHE_HOME", "HOME"] {
+            cmd.env_remove(name);
+        }
+        for (name, value) in vars {
+            cmd.env(name, value);
+        }
+        let out = cmd.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let cached = |d: &std::path::Path| -> Vec<String> {
+        std::fs::read_dir(d).map_or_else(
+            |_| Vec::new(),
+            |entries| {
+                entries
+                    .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.starts_with("ulfem-") && n.ends_with(".json"))
+                    .collect()
+            },
+        )
+    };
+    let empty = std::path::Path::new("");
+    let none = run(&[]);
+    assert!(cached(&own).is_empty() && cached(&xdg.join("psmpm")).is_empty());
+    let first = run(&[
+        ("PSMPM_CACHE_DIR", &own),
+        ("XDG_CACHE_HOME", &xdg),
+        ("HOME", &home),
+    ]);
+    assert_eq!(cached(&own).len(), 1);
+    assert!(cached(&xdg.join("psmpm")).is_empty() && cached(&home.join(".cache")).is_empty());
+    let again = run(&[("PSMPM_CACHE_DIR", &own)]);
+    let from_xdg = run(&[
+        ("PSMPM_CACHE_DIR", empty),
+        ("XDG_CACHE_HOME", &xdg),
+        ("HOME", &home),
+    ]);
+    assert_eq!(cached(&xdg.join("psmpm")).len(), 1);
+    let from_home = run(&[("HOME", &home)]);
+    assert_eq!(cached(&home.join(".cache").join("psmpm")), cached(&own));
+    for out in [&first, &again, &from_xdg, &from_home] {
+        assert_eq!(out, &none);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,0 +1,85 @@
+//! B2 (thesis §4.1): the vibrating bar, small deformation.
+
+use super::{builtin, log_log, opt, order, sci, setup, Effort, Figure, Report, Table};
+use crate::bases::BasisKind;
+use crate::output::chart::Series;
+use crate::simulation::{self, RunError};
+
+/// B2 (thesis §4.1): E_u of the thesis variant against Tables 4.2–4.3, and orders of
+/// the default variant.
+pub(super) fn b2(effort: Effort) -> Result<Report, RunError> {
+    let printed: &[(BasisKind, usize, f64)] = &[
+        (BasisKind::Ps, 2, 3.71e-4),
+        (BasisKind::Ps, 3, 3.14e-5),
+        (BasisKind::Ps, 5, 3.57e-6),
+        (BasisKind::Ps, 9, 4.90e-7),
+        (BasisKind::Ps, 17, 1.77e-7),
+        (BasisKind::Pl, 5, 1.81e-4),
+        (BasisKind::Pl, 9, 4.44e-5),
+        (BasisKind::Pl, 17, 1.08e-5),
+        (BasisKind::Pl, 33, 2.68e-6),
+    ];
+    let limit = if effort == Effort::Quick { 5 } else { 33 };
+    let mut table = Table {
+        title: "B2: E_u at t_end, thesis variant (centroids, Delaunay blocks, 1999 steps) and default variant (incentres, 4-triangle blocks, 2000 steps)".into(),
+        columns: vec!["basis", "n_x", "functions", "thesis", "thesis variant", "default variant", "default order"],
+        rows: Vec::new(),
+    };
+    let mut series: Vec<Series> = Vec::new();
+    for basis in [BasisKind::Ps, BasisKind::Pl] {
+        let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+        let mut previous: Option<(f64, f64)> = None;
+        for &(_, n_x, thesis) in printed.iter().filter(|p| p.0 == basis && p.1 <= limit) {
+            let h = 25.0 / (n_x - 1) as f64;
+            let mut variant = builtin("vibrating-bar-thesis")?;
+            variant.basis = basis;
+            setup(variant.set_blocks(n_x - 1, 1))?;
+            let thesis_run = simulation::run(&variant, &mut |_| {})?;
+            let mut default = builtin("vibrating-bar")?;
+            default.basis = basis;
+            setup(default.set_blocks(n_x - 1, 1))?;
+            default.set_particles_per_block([16, 14]);
+            default.set_dt(1e-5);
+            default.time.t_end = 0.02;
+            let default_run = simulation::run(&default, &mut |_| {})?;
+            let e = default_run.error.unwrap_or(f64::NAN);
+            table.rows.push(vec![
+                basis.name().into(),
+                n_x.to_string(),
+                thesis_run.functions.to_string(),
+                sci(thesis),
+                opt(thesis_run.error),
+                sci(e),
+                previous.map_or("-".into(), |(h0, e0)| order(e0, e, h0, h)),
+            ]);
+            previous = Some((h, e));
+            ours.push((h, thesis_run.error.unwrap_or(f64::NAN)));
+            theirs.push((h, thesis));
+        }
+        series.push(Series::line_and_markers(
+            format!("{} (ours)", basis.name().to_uppercase()),
+            ours,
+        ));
+        series.push(Series::markers(
+            format!("{} (thesis)", basis.name().to_uppercase()),
+            theirs,
+        ));
+    }
+    let mut plot = log_log(
+        "B2: vibrating bar, E_u at t = 0.02 against block width",
+        "block width h (m)",
+        "E_u (m²)",
+    );
+    for s in series {
+        plot = plot.with_series(s);
+    }
+    Ok(Report {
+        benchmark: "b2",
+        tables: vec![table],
+        figures: vec![Figure {
+            file: "b2-convergence.svg".into(),
+            plot,
+        }],
+        findings: Vec::new(),
+    })
+}

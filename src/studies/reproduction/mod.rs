@@ -1,0 +1,158 @@
+//! The seeds' benchmarks B2–B5 reproduced as studies: each runs the built-in scenes
+//! at the resolutions of the seeds and returns the tables and figures of
+//! `docs/results.md` (`mpm-cli reproduce NAME --out docs/figures`).
+//!
+//! Every study has a [`Effort::Quick`] form (coarse, short; the test suite pins it
+//! with snapshots) and the [`Effort::Full`] form of the write-up. Nothing is tuned
+//! to a printed number: the parameters are the seeds' where they give them, and
+//! where they do not the choice is stated in the scene file or here.
+//!
+//! | study | scenes | what is measured |
+//! |---|---|---|
+//! | `b2` | `vibrating-bar-thesis`, `vibrating-bar` | E_u and orders against thesis Tables 4.2–4.3 |
+//! | `b3` | `bar-large` | energies against the 1D UL-FEM reference, 1 % deviation time, decay at t = 20, small-amplitude check |
+//! | `b4` | `axis-aligned` | RMS error (paper eq. (47)) in h and in particles per element; grid crossing |
+//! | `b5b` | `column-large` | stability, condition, E_u and mid-height error against UL-FEM, σ_yy roughness, per mass strategy and grid |
+//! | `b5c` | `column-damped` | σ_yy against the exact equilibrium, lumped and partially lumped |
+
+use crate::output::chart::{LinePlot, Scale};
+use crate::scene::Scene;
+use crate::simulation::{self, Outcome, RunError};
+use std::path::Path;
+
+mod b2;
+mod b3;
+mod b4;
+mod b5;
+
+pub use b5::sigma_yy_roughness;
+
+/// How much to compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Effort {
+    /// Coarse grids and short runs, for tests (seconds).
+    Quick,
+    /// The resolutions of the write-up (minutes).
+    Full,
+}
+
+/// A table of results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// Caption.
+    pub title: String,
+    /// Column names.
+    pub columns: Vec<&'static str>,
+    /// Rows of formatted cells.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// The table as GitHub markdown.
+    pub fn markdown(&self) -> String {
+        let mut out = format!("**{}**\n\n| {} |\n|", self.title, self.columns.join(" | "));
+        out += &"---|".repeat(self.columns.len());
+        out.push('\n');
+        for row in &self.rows {
+            out += &format!("| {} |\n", row.join(" | "));
+        }
+        out
+    }
+}
+
+/// A figure: the file name it is written to and the plot.
+pub struct Figure {
+    /// File name (SVG).
+    pub file: String,
+    /// The plot.
+    pub plot: LinePlot,
+}
+
+/// What a study found.
+pub struct Report {
+    /// Benchmark id (`b3`).
+    pub benchmark: &'static str,
+    /// Tables.
+    pub tables: Vec<Table>,
+    /// Figures.
+    pub figures: Vec<Figure>,
+    /// Measured findings, one sentence each.
+    pub findings: Vec<String>,
+}
+
+/// The studies, in order.
+pub const STUDIES: [&str; 5] = ["b2", "b3", "b4", "b5b", "b5c"];
+
+/// Runs study `name` (one of [`STUDIES`]). The UL-FEM references of `b3` and `b5b`
+/// are read from or stored in the cache directory `cache` (`None`: no cache, they are
+/// computed; see [`cached_reference_history`](crate::studies::ulfem::cached_reference_history)).
+pub fn reproduce(name: &str, effort: Effort, cache: Option<&Path>) -> Result<Report, RunError> {
+    match name {
+        "b2" => b2::b2(effort),
+        "b3" => b3::b3(effort, cache),
+        "b4" => b4::b4(effort),
+        "b5b" => b5::b5b(effort, cache),
+        "b5c" => b5::b5c(effort),
+        other => Err(RunError::Setup(format!(
+            "unknown study `{other}` (known: {})",
+            STUDIES.join(", ")
+        ))),
+    }
+}
+
+/// Three significant digits.
+pub fn sci(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.2e}")
+    } else {
+        "-".into()
+    }
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or_else(|| "-".into(), sci)
+}
+
+/// A plot with logarithmic axes (errors against sizes or particle counts).
+fn log_log(title: impl Into<String>, x: &str, y: &str) -> LinePlot {
+    LinePlot::new(title, x, y)
+        .x_scale(Scale::Log10)
+        .y_scale(Scale::Log10)
+}
+
+fn builtin(name: &str) -> Result<Scene, RunError> {
+    Scene::builtin(name).map_err(RunError::Setup)
+}
+
+fn setup<T>(r: Result<T, crate::scene::SceneError>) -> Result<T, RunError> {
+    r.map_err(|e| RunError::Setup(e.to_string()))
+}
+
+fn order(e0: f64, e1: f64, h0: f64, h1: f64) -> String {
+    format!("{:.2}", (e0 / e1).ln() / (h0 / h1).ln())
+}
+
+/// One run with its energy history `(t, kinetic, strain, total)` every `every` steps
+/// and its condition history `(t, estimate)`.
+struct Run {
+    outcome: Outcome<2>,
+    energy: Vec<(f64, f64, f64, f64)>,
+    condition: Vec<(f64, f64)>,
+}
+
+fn run_2d(scene: &Scene, every: usize) -> Result<Run, RunError> {
+    let (mut energy, mut condition) = (Vec::new(), Vec::new());
+    let outcome = simulation::run_2d(scene, &mut |r| {
+        if r.step % every.max(1) == 0 {
+            energy.push((r.time, r.kinetic, r.strain, r.total_energy()));
+        }
+        if let Some(c) = r.condition {
+            condition.push((r.time, c));
+        }
+    })?;
+    Ok(Run {
+        outcome,
+        energy,
+        condition,
+    })
+}
