@@ -17,7 +17,7 @@
 //! name = "column-small"
 //! dim = 2
 //! basis = "ps"               # ps, pl (2D); bspline, pl1d (1D)
-//! mass = "consistent"        # consistent, lumped, partial[:TAU], deactivate[:M]
+//! mass = "consistent"        # optional: default (extended), consistent, lumped, partial[:TAU], partial-coverage:C, deactivate[:M], extended[:C], fmpm:K
 //!
 //! [mesh]
 //! kind = "blocks"            # blocks, polygon, gmsh (2D); interval (1D)
@@ -75,7 +75,8 @@ pub struct Scene {
     #[serde(default, with = "split_name")]
     pub split: SplitPoint,
     /// Mass strategy.
-    #[serde(with = "mass_name")]
+    /// The mass strategy; absent means [`MassKind::default`] (extension).
+    #[serde(with = "mass_name", default)]
     pub mass: MassKind,
     /// The mesh.
     pub mesh: MeshSpec,
@@ -433,7 +434,8 @@ pub struct OutputSpec {
     /// Print diagnostics every this many steps (0: about 20 rows per run).
     #[serde(default)]
     pub diagnostics_every: usize,
-    /// Estimate the mass-matrix condition number every step (costs ~60 solves).
+    /// Estimate the condition number of the solved mass system every step (about 60
+    /// solves for the factorising strategies, 30 products for `extended`).
     #[serde(default)]
     pub condition: bool,
 }

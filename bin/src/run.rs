@@ -37,7 +37,8 @@ pub struct Overrides {
     /// End time.
     #[arg(long)]
     pub t_end: Option<f64>,
-    /// Estimate the mass-matrix condition number every step (about 60 extra solves).
+    /// Estimate the condition number of the solved mass system every step (about 60
+    /// extra solves; 30 products for `extended`).
     #[arg(long)]
     pub condition: bool,
 }
@@ -92,8 +93,10 @@ pub struct RunArgs {
     /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
     #[arg(long)]
     basis: Option<String>,
-    /// Mass strategy: consistent, lumped, partial (lump rows touching empty elements),
-    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), deactivate or deactivate:THRESHOLD.
+    /// Mass strategy: default (= extended: under-supported functions expressed
+    /// through well-covered neighbours), extended:C (coverage threshold C), consistent,
+    /// lumped, partial (lump rows touching empty elements), partial:TAU (lump rows with
+    /// M_ii < TAU·max M_jj), partial-coverage:C, deactivate[:THRESHOLD] or fmpm:K.
     #[arg(long)]
     mass: Option<String>,
     #[command(flatten)]
@@ -182,6 +185,9 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         "active": r.mass_report.active,
         "lumped_rows": r.mass_report.lumped_rows,
         "deactivated": r.mass_report.deactivated,
+        "extended": r.mass_report.extended,
+        "treated": r.mass_report.treated(),
+        "worst_coverage": r.mass_report.worst_coverage.map(|(f, c)| json!({"function": f, "coverage": c})),
         "condition": r.condition,
     })
 }

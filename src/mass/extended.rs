@@ -491,6 +491,10 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
         self.ext_ptr = vec![0; n + 1];
+        // Room for every function extended through 16 neighbours: steps then
+        // allocate only in the rare case of wider extensions.
+        self.ext_idx = Vec::with_capacity(16 * n);
+        self.ext_w = Vec::with_capacity(16 * n);
         self.scratch = Scratch::new(n);
         self.estimate = std::array::from_fn(|_| vec![T::zero(); n]);
         self.rhs = vec![T::zero(); n];

@@ -494,7 +494,7 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("basis: unknown basis `cubic` (known: ps, pl, bspline, pl1d)"),
         case("unknown-mass-strategy", BAR)
             .edit("mass = \"consistent\"", "mass = @@\"heavy\"")
-            .expect("mass: unknown mass strategy `heavy` (known: consistent, lumped, partial, partial:TAU, deactivate, deactivate:THRESHOLD)"),
+            .expect("mass: unknown mass strategy `heavy` (known: default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, fmpm:K)"),
         case("negative-partial-threshold", BAR)
             .edit("mass = \"consistent\"", "mass = @@\"partial:-1\"")
             .expect("mass: `partial:-1`: the threshold must be a positive number, got `-1`"),
@@ -1204,7 +1204,7 @@ fn a_run_that_fails_numerically_exits_with_1_and_names_the_step() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(stderr.starts_with("error: step 1: "), "{stderr}");
-    assert!(stderr.contains("try a smaller time step"), "{stderr}");
+    assert!(stderr.contains("lower `time.dt`"), "{stderr}");
     // The summary on stdout says where the run stopped.
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert!(stdout.contains("stopped: step 1: "), "{stdout}");

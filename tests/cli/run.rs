@@ -139,7 +139,7 @@ fn a_particle_leaving_the_mesh_is_a_numerical_failure_with_status_1() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
-        stderr.contains("step ") && stderr.contains("try"),
+        stderr.contains("step ") && stderr.contains("time.dt"),
         "{stderr}"
     );
 }
