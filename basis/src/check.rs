@@ -16,8 +16,8 @@
 //! Sample points are deterministic: fixed barycentric points in every polynomial piece.
 
 use crate::basis::{Basis, BasisEval, Constraint, Point};
-use crate::mesh::generators::SplitMix64;
 use crate::mesh::Vec2;
+use crate::rng::SplitMix64;
 use crate::scalar::Real;
 use nalgebra::{DMatrix, DVector, Vector2};
 

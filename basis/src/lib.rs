@@ -9,7 +9,9 @@
 //! - [`basis`]: the [`Basis`] trait and its implementations, piecewise-linear
 //!   ([`basis::linear`], [`basis::linear1d`]), quadratic Powell–Sabin
 //!   ([`basis::powell_sabin`]) and 1D quadratic B-splines ([`basis::bspline1d`]);
-//! - [`check`]: the properties every basis must satisfy, as reusable checks.
+//! - [`check`]: the properties every basis must satisfy, as reusable checks;
+//! - [`rng`]: the small deterministic generator behind the jittered meshes and the
+//!   property tests.
 //!
 //! # Example
 //!
@@ -43,6 +45,7 @@ pub mod check;
 pub mod mesh;
 pub mod quadrature;
 pub mod refinement;
+pub mod rng;
 pub mod scalar;
 
 pub use basis::{Basis, BasisError, BasisEval, Constraint, Point};

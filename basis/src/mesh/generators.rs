@@ -16,6 +16,7 @@
 //! triangulations and constrained refinement come from the `spade` crate.
 
 use super::{MeshError, TriMesh, Vec2};
+use crate::rng::SplitMix64;
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, DelaunayTriangulation, Point2,
     RefinementParameters, Triangulation,
@@ -308,25 +309,6 @@ pub fn block_delaunay(
     let mut points = block_corners(x0, x1, y0, y1, nx, ny);
     points.extend(block_centres(x0, x1, y0, y1, nx, ny));
     Ok(finish_box(delaunay(&points)?, x0, x1, y0, y1))
-}
-
-/// A small deterministic generator (splitmix64) for jittered meshes.
-#[derive(Debug, Clone)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)`.
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 /// Delaunay triangulation of an `nx × ny` vertex lattice of the box `(x0, x1, y0, y1)`

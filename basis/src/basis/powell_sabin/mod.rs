@@ -534,8 +534,9 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
 mod tests {
     use super::*;
     use crate::check;
-    use crate::mesh::generators::{self, PolygonDomain, SplitMix64};
+    use crate::mesh::generators::{self, PolygonDomain};
     use crate::mesh::signed_area;
+    use crate::rng::SplitMix64;
     use proptest::prelude::*;
 
     /// Barycentric sample points of a piece: corners, edge midpoints, interior points.
