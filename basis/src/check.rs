@@ -1,6 +1,7 @@
 //! The properties every basis must satisfy, written once, generic over
 //! [`Basis<T, D>`](Basis) (any scalar type, 1D and 2D), and run on every basis
-//! by the test suites.
+//! (PL, PS, 1D PL, 1D B-spline) and the same families of meshes by the test suite
+//! (`check/suite.rs`, test builds only).
 //!
 //! Each check returns the measured worst violation, so the suite states each basis'
 //! tolerance next to the property (and a failing test prints how far off it was):
@@ -568,3 +569,6 @@ pub fn points_on_segment<const D: usize>(
         .map(|k| a + (b - a) * (k as f64 / (count - 1).max(1) as f64))
         .collect()
 }
+
+#[cfg(test)]
+pub(crate) mod suite;
