@@ -9,7 +9,11 @@
 //! - [`basis`]: the [`Basis`] trait and its implementations, piecewise-linear
 //!   ([`basis::linear`], [`basis::linear1d`]), quadratic Powell–Sabin
 //!   ([`basis::powell_sabin`]) and 1D quadratic B-splines ([`basis::bspline1d`]);
-//! - [`check`]: the properties every basis must satisfy, as reusable checks.
+//! - [`check`]: the properties every basis must satisfy, as checks generic over the
+//!   basis and its dimension, which the test suite runs on every basis and the same
+//!   families of meshes;
+//! - [`rng`]: the small deterministic generator behind the jittered meshes and the
+//!   property tests.
 //!
 //! # Example
 //!
@@ -43,6 +47,7 @@ pub mod check;
 pub mod mesh;
 pub mod quadrature;
 pub mod refinement;
+pub mod rng;
 pub mod scalar;
 
 pub use basis::{Basis, BasisError, BasisEval, Constraint, Point};

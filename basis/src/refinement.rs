@@ -217,12 +217,13 @@ impl Refinement {
 mod tests {
     use super::*;
     use crate::mesh::{barycentric, generators, signed_area};
+    use crate::rng::SplitMix64;
     use proptest::prelude::*;
 
     /// A random Delaunay mesh of the unit square: its corners plus `count` random
     /// interior points.
     fn random_points_mesh(seed: u64, count: usize) -> TriMesh {
-        let mut rng = generators::SplitMix64(seed);
+        let mut rng = SplitMix64(seed);
         let mut points = vec![
             Vec2::new(0.0, 0.0),
             Vec2::new(1.0, 0.0),
@@ -303,7 +304,7 @@ mod tests {
     /// [`Refinement::locate_sub_triangle`] against the brute-force search over the
     /// six sub-triangles, at random points and at the special points `V_k`, `R`, `Z`.
     fn assert_sub_triangle_location(mesh: &TriMesh, r: &Refinement, seed: u64) {
-        let mut rng = generators::SplitMix64(seed);
+        let mut rng = SplitMix64(seed);
         for t in 0..mesh.num_triangles() {
             let [p0, p1, p2] = mesh.triangle_points(t);
             let subs = r.sub_triangles(mesh, t);

@@ -1,7 +1,8 @@
 use super::*;
 use nalgebra::Vector2;
 use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
-use psmpm_basis::mesh::generators::{block_grid, SplitMix64};
+use psmpm_basis::mesh::generators::block_grid;
+use psmpm_basis::rng::SplitMix64;
 use psmpm_basis::{Basis, BasisEval};
 
 /// A PS mass matrix from random particles filling the lower 60 % of a 2 × 4 block

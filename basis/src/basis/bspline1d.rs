@@ -135,116 +135,50 @@ impl<T: Real> Basis<T, 1> for QuadraticBSpline<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::basis::linear1d::Linear1d;
-    use proptest::prelude::*;
+    use crate::check::suite::{Claims, Continuity, Subject};
+    use crate::check::{self, Quadratic};
 
-    /// Values and derivatives of all functions (dense) at `x` evaluated in `element`.
-    fn dense<B: Basis<f64, 1>>(b: &B, element: usize, x: f64) -> (Vec<f64>, Vec<f64>) {
-        let mut ev = BasisEval::for_basis(b);
-        b.eval(element, &Vector1::new(x), &mut ev);
-        let (mut v, mut d) = (vec![0.0; b.num_functions()], vec![0.0; b.num_functions()]);
-        for (i, phi, g) in ev.iter() {
-            v[i] = phi;
-            d[i] = g.x;
+    /// The B-spline in the property suite ([`crate::check::suite`]): C¹, quadratic
+    /// precision with the polar form at the knots as coefficients.
+    impl Subject<1> for QuadraticBSpline<f64> {
+        type Mesh = Mesh1d;
+        const CLAIMS: Claims = Claims {
+            partition_of_unity: 1e-14,
+            negative: 1e-15,
+            linear: 1e-13,
+            linear_per_size: 0.0,
+            per_conditioning: 0.0,
+            linear_gradient: 1e-13,
+            quadratic: Some((1e-14, 1e-14)),
+            gradient: 1e-8,
+            value_jump: 1e-14,
+            continuity: Continuity::C1 {
+                gradient_jump_below: 1e-14,
+            },
+            dirichlet: 1e-14,
+        };
+        fn build(mesh: Mesh1d) -> Self {
+            QuadraticBSpline::new(mesh)
         }
-        (v, d)
-    }
-
-    /// Partition of unity, non-negativity, linear precision, FD derivatives; returns
-    /// the largest derivative jump at interior nodes.
-    fn check_1d<B: Basis<f64, 1>>(b: &B, nodes: &[f64]) -> f64 {
-        for e in 0..nodes.len() - 1 {
-            let (a, c) = (nodes[e], nodes[e + 1]);
-            for s in [0.0, 0.1, 0.37, 0.5, 0.9, 1.0] {
-                let x = a + (c - a) * s;
-                let (v, d) = dense(b, e, x);
-                assert!((v.iter().sum::<f64>() - 1.0).abs() < 1e-14);
-                assert!(v.iter().all(|&p| p >= -1e-15));
-                let lin: f64 = v
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| p * b.function_point(i).x)
-                    .sum();
-                assert!((lin - x).abs() < 1e-13 * (1.0 + x.abs()));
-                let dlin: f64 = d
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| p * b.function_point(i).x)
-                    .sum();
-                assert!((dlin - 1.0).abs() < 1e-11);
-                if (0.05..0.95).contains(&s) {
-                    let h = 1e-6 * (c - a);
-                    let (vp, _) = dense(b, e, x + h);
-                    let (vm, _) = dense(b, e, x - h);
-                    for i in 0..v.len() {
-                        let fd = (vp[i] - vm[i]) / (2.0 * h);
-                        assert!(
-                            (fd - d[i]).abs() < 1e-6 * (1.0 + d[i].abs()),
-                            "fd {fd} vs {}",
-                            d[i]
-                        );
-                    }
-                }
-            }
+        /// `c_k = q[t_{k+1}, t_{k+2}]`, the polar form at the knots (marsden's identity).
+        fn quadratic_coefficient(&self, function: usize, q: &Quadratic<1>) -> f64 {
+            let t = &self.knots;
+            q.polar(
+                &Vector1::new(t[function + 1]),
+                &Vector1::new(t[function + 2]),
+            )
         }
-        let mut jump = 0.0f64;
-        for e in 1..nodes.len() - 1 {
-            let (vl, dl) = dense(b, e - 1, nodes[e]);
-            let (vr, dr) = dense(b, e, nodes[e]);
-            for i in 0..vl.len() {
-                assert!((vl[i] - vr[i]).abs() < 1e-14, "value jump at node {e}");
-                jump = jump.max((dl[i] - dr[i]).abs() * (nodes[e + 1] - nodes[e - 1]));
-            }
-        }
-        jump
-    }
-
-    fn dirichlet_vanishes<B: Basis<f64, 1>>(b: &B, nodes: &[f64]) {
-        for (tag, x) in [("left", nodes[0]), ("right", *nodes.last().unwrap())] {
-            let k = b.dirichlet(tag, &Vector1::new(1.0)).unwrap();
-            let mut c: Vec<f64> = (0..b.num_functions()).map(|i| 1.0 + i as f64).collect();
-            for con in &k {
-                c[con.terms[0].0] = 0.0;
-            }
-            let e = b.locate(&Vector1::new(x), None).unwrap();
-            let (v, _) = dense(b, e, x);
-            let field: f64 = v.iter().zip(&c).map(|(p, c)| p * c).sum();
-            assert!(field.abs() < 1e-14, "{tag}: {field}");
-        }
-        assert!(b.dirichlet("top", &Vector1::new(1.0)).is_err());
     }
 
     #[test]
-    fn uniform_bspline_and_pl() {
+    fn uniform_function_count_and_f32() {
         let mesh = Mesh1d::uniform(0.0, 25.0, 8).unwrap();
         let bs = QuadraticBSpline::<f64>::new(mesh.clone());
         assert_eq!(bs.num_functions(), 10);
-        assert!(check_1d(&bs, mesh.nodes()) < 1e-12, "B-spline must be C¹");
-        dirichlet_vanishes(&bs, mesh.nodes());
-        let pl = Linear1d::<f64>::new(mesh.clone());
-        assert!(check_1d(&pl, mesh.nodes()) > 0.5, "PL derivatives jump");
-        dirichlet_vanishes(&pl, mesh.nodes());
         let f32_basis = QuadraticBSpline::<f32>::new(mesh);
         let mut ev = BasisEval::for_basis(&f32_basis);
         f32_basis.eval(3, &Vector1::new(11.0f32), &mut ev);
         assert!((ev.phi[..3].iter().sum::<f32>() - 1.0).abs() < 1e-6);
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig { cases: 32, rng_seed: proptest::test_runner::RngSeed::Fixed(20261122), .. ProptestConfig::default() })]
-        #[test]
-        fn non_uniform_nodes(steps in proptest::collection::vec(0.05f64..1.0, 1..12), start in -5.0f64..5.0) {
-            let mut nodes = vec![start];
-            for s in &steps {
-                nodes.push(nodes.last().unwrap() + s);
-            }
-            let mesh = Mesh1d::new(nodes.clone()).unwrap();
-            let bs = QuadraticBSpline::<f64>::new(mesh.clone());
-            prop_assert!(check_1d(&bs, &nodes) < 1e-11);
-            dirichlet_vanishes(&bs, &nodes);
-            let pl = Linear1d::<f64>::new(mesh);
-            check_1d(&pl, &nodes);
-            dirichlet_vanishes(&pl, &nodes);
-        }
+        assert!(check::partition_of_unity(&f32_basis) < 1e-6);
     }
 }

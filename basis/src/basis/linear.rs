@@ -138,43 +138,62 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
 mod tests {
     use super::*;
     use crate::check;
+    use crate::check::suite::{Claims, Continuity, Subject};
     use crate::mesh::generators;
     use proptest::prelude::*;
 
-    fn assert_pl(mesh: TriMesh) {
+    /// PL in the property suite ([`crate::check::suite`]): C⁰, linear.
+    impl Subject<2> for Linear<f64> {
+        type Mesh = TriMesh;
+        const CLAIMS: Claims = Claims {
+            partition_of_unity: 1e-14,
+            negative: 1e-14,
+            linear: 1e-14,
+            linear_per_size: 0.0,
+            // On slivers, up to ~0.95 ε times the conditioning (9000 random meshes).
+            per_conditioning: 2.0 * f64::EPSILON,
+            linear_gradient: 1e-13,
+            quadratic: None,
+            gradient: 1e-8,
+            value_jump: 1e-9,
+            continuity: Continuity::C0 {
+                gradient_jump_above: 0.1,
+            },
+            dirichlet: 1e-13,
+        };
+        fn build(mesh: TriMesh) -> Self {
+            Linear::new(mesh)
+        }
+    }
+
+    /// PL sums affine functions stored in global coordinates, so its round-off grows
+    /// with [`check::coordinate_conditioning`] (and so do the suite's bounds, beyond
+    /// 1e-14); on these well-shaped meshes (conditioning at most 65) it stays within
+    /// 1e-14.
+    fn assert_within_1e_14(mesh: TriMesh) {
         let pl = Linear::<f64>::new(mesh);
         assert!(check::partition_of_unity(&pl) < 1e-14);
         assert!(check::min_value(&pl) > -1e-14);
         assert!(check::linear_precision(&pl).0 < 1e-14);
-        assert!(check::gradient_error(&pl) < 1e-8);
-        assert!(check::continuity_jumps(&pl).value < 1e-9);
-        for (tag, a, b) in [
-            ("left", Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)),
-            ("right", Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0)),
-            ("bottom", Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)),
-            ("top", Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)),
-        ] {
-            let points = check::points_on_segment(a, b, 100);
-            for n in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
-                assert!(check::dirichlet_residual(&pl, tag, n, &points, 1) < 1e-13);
-            }
-        }
-        assert!(pl.dirichlet("inlet", &Vec2::new(1.0, 0.0)).is_err());
     }
 
     #[test]
-    fn block_and_lattice_grids() {
-        assert_pl(generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap());
-        assert_pl(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
-        let pl = Linear::<f32>::new(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
-        assert!(check::partition_of_unity(&pl) < 1e-6);
+    fn block_and_lattice_grids_to_1e_14() {
+        assert_within_1e_14(generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap());
+        assert_within_1e_14(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
     }
 
     proptest! {
         #![proptest_config(ProptestConfig { cases: 12, rng_seed: proptest::test_runner::RngSeed::Fixed(20261122), .. ProptestConfig::default() })]
         #[test]
-        fn jittered_meshes(seed in 0u64..1_000_000, jitter in 0.0f64..0.4) {
-            assert_pl(generators::jittered_lattice_delaunay(5, 6, (0.0, 1.0, 0.0, 1.0), jitter, seed).unwrap());
+        fn jittered_lattices_to_1e_14(seed in 0u64..1_000_000, jitter in 0.0f64..0.4) {
+            assert_within_1e_14(generators::jittered_lattice_delaunay(5, 6, (0.0, 1.0, 0.0, 1.0), jitter, seed).unwrap());
         }
+    }
+
+    #[test]
+    fn f32_basis_is_a_partition_of_unity_to_single_precision() {
+        let pl = Linear::<f32>::new(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
+        assert!(check::partition_of_unity(&pl) < 1e-6);
     }
 }

@@ -116,3 +116,32 @@ pub(crate) fn end_constraint<T: Real>(
         terms: vec![(f, T::one())],
     }])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::suite::{Claims, Continuity, Subject};
+
+    /// PL 1D in the property suite ([`crate::check::suite`]): C⁰, linear.
+    impl Subject<1> for Linear1d<f64> {
+        type Mesh = Mesh1d;
+        const CLAIMS: Claims = Claims {
+            partition_of_unity: 1e-14,
+            negative: 1e-15,
+            linear: 1e-13,
+            linear_per_size: 0.0,
+            per_conditioning: 0.0,
+            linear_gradient: 1e-13,
+            quadratic: None,
+            gradient: 1e-8,
+            value_jump: 1e-14,
+            continuity: Continuity::C0 {
+                gradient_jump_above: 0.5,
+            },
+            dirichlet: 1e-14,
+        };
+        fn build(mesh: Mesh1d) -> Self {
+            Linear1d::new(mesh)
+        }
+    }
+}

@@ -174,8 +174,9 @@ fn walk(mesh: &TriMesh, p: Vec2, start: usize) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::generators::{self, PolygonDomain, SplitMix64};
+    use crate::mesh::generators::{self, PolygonDomain};
     use crate::mesh::gmsh;
+    use crate::rng::SplitMix64;
 
     /// Locates, with every kind of hint, random interior points of each triangle, edge
     /// midpoints, vertices, points 1e-9 outside each boundary edge and `outside`.

@@ -101,7 +101,7 @@ pub fn bernstein<T: crate::Real>(tau: [T; 3]) -> ([T; 6], [[T; 3]; 6]) {
 mod tests {
     use super::*;
     use crate::mesh::barycentric;
-    use crate::mesh::generators::SplitMix64;
+    use crate::rng::SplitMix64;
 
     /// Value and gradient at `x` of the quadratic with ordinates `b` on the triangle
     /// `p` (extended outside it).

@@ -533,12 +533,13 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check;
-    use crate::mesh::generators::{self, PolygonDomain, SplitMix64};
+    use crate::check::suite::{self, Claims, Continuity, Subject};
+    use crate::check::{self, Quadratic};
+    use crate::mesh::generators;
     use crate::mesh::signed_area;
-    use proptest::prelude::*;
 
-    /// Barycentric sample points of a piece: corners, edge midpoints, interior points.
+    /// Barycentric sample points of a piece: corners, edge midpoints, interior points
+    /// (for [`piece_gradient_error`]).
     const SAMPLES: [[f64; 3]; 10] = [
         [1.0, 0.0, 0.0],
         [0.0, 1.0, 0.0],
@@ -551,31 +552,6 @@ mod tests {
         [0.1, 0.7, 0.2],
         [0.2, 0.1, 0.7],
     ];
-
-    /// `max |Σ φ − 1|`, `min φ` and `max |Σ Q φ − x|` over [`SAMPLES`] of every piece,
-    /// evaluated through [`Basis::eval`] (sub-triangle location included).
-    fn sampled_properties<T: Real>(ps: &PowellSabin<T>) -> (f64, f64, f64) {
-        let (mut pu, mut min, mut lp) = (0.0f64, f64::INFINITY, 0.0f64);
-        let mut eval = BasisEval::for_basis(ps);
-        for t in 0..ps.mesh().num_triangles() {
-            for sub in ps.refinement().sub_triangles(ps.mesh(), t) {
-                for w in SAMPLES {
-                    let x = sub[0] * w[0] + sub[1] * w[1] + sub[2] * w[2];
-                    ps.eval(t, &Vector2::new(T::of(x.x), T::of(x.y)), &mut eval);
-                    let mut sum = 0.0;
-                    let mut moment = Vec2::zeros();
-                    for (i, phi, _) in eval.iter() {
-                        sum += phi.to_f64();
-                        min = min.min(phi.to_f64());
-                        moment += ps.function_point(i) * phi.to_f64();
-                    }
-                    pu = pu.max((sum - 1.0).abs());
-                    lp = lp.max((moment - x).norm());
-                }
-            }
-        }
-        (pu, min, lp)
-    }
 
     /// Largest jumps `(value, gradient)` across every interior edge of the PS
     /// refinement, found by evaluating the polynomials of the two pieces meeting there
@@ -735,20 +711,6 @@ mod tests {
         }
     }
 
-    /// The largest `diameter / inradius`-like ratio `diam² / (2 area)` of the pieces.
-    fn worst_aspect(ps: &PowellSabin<f64>) -> f64 {
-        (0..ps.mesh().num_triangles())
-            .flat_map(|t| ps.refinement().sub_triangles(ps.mesh(), t))
-            .map(|p| {
-                let diam = (p[1] - p[0])
-                    .norm()
-                    .max((p[2] - p[1]).norm())
-                    .max((p[0] - p[2]).norm());
-                diam * diam / (2.0 * signed_area(p[0], p[1], p[2]))
-            })
-            .fold(0.0, f64::max)
-    }
-
     /// `max |∇φ − central difference|` relative to `max |∇φ|`, differentiating the
     /// quadratic of each piece ([`PowellSabin::eval_piece`]) at its [`SAMPLES`] with
     /// step `10⁻³ ×` its diameter: central differences are exact for quadratics, so
@@ -792,202 +754,74 @@ mod tests {
         worst / scale
     }
 
-    /// The checks of `ps-splines.md` §6 on one mesh; returns the basis.
-    fn assert_ps_properties(mesh: TriMesh) -> PowellSabin<f64> {
-        let (lo, hi) = mesh.bounding_box();
-        let size = (hi - lo).norm();
-        let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
-        let (pu, min, lp) = sampled_properties(&ps);
-        assert!(pu < 1e-13, "partition of unity off by {pu:e}");
-        assert!(min > -1e-13, "negative basis value {min:e}");
-        assert!(lp < 1e-13 * size, "linear precision off by {lp:e}");
-        let (jump, grad_jump) = c1_jumps(&ps);
-        assert!(jump < 1e-13, "value jump {jump:e}");
-        assert!(
-            grad_jump < 1e-9,
-            "relative gradient jump {grad_jump:e} (C¹ violated)"
-        );
-        assert_control_triangles_and_triplets(&ps);
-        // The generic suite (crate::check), at its own interior sample points.
-        assert!(check::partition_of_unity(&ps) < 1e-13);
-        assert!(check::min_value(&ps) > -1e-13);
-        let (lp, lp_grad) = check::linear_precision(&ps);
-        // Σ X ⊗ ∇φ = I: gradients, hence their round-off, grow with the pieces' aspect.
-        let aspect = worst_aspect(&ps);
-        assert!(
-            lp < 1e-13 * size && lp_grad < 1e-13 * aspect.max(100.0),
-            "{lp:e} {lp_grad:e}"
-        );
-        // Its finite differences step 1e-4 × the piece's diameter across pieces, which
-        // on a sliver (random point sets) exceeds its width: O(step |H|) then shows.
-        // `piece_gradient_error` differentiates each piece's own quadratic instead.
-        if aspect < 50.0 {
-            let fd = check::gradient_error(&ps);
-            assert!(fd < 1e-6, "gradient vs central differences: {fd:e}");
-        }
-        let fd = piece_gradient_error(&ps);
-        assert!(
-            fd < 1e-9,
-            "gradient vs central differences on the pieces: {fd:e}"
-        );
-        // Its offset-based continuity check: values only. Its gradient criterion
-        // (jump at x ± 1e-8 h relative to |∇φ|) also measures the Hessian times the
-        // offset, which exceeds 1e-3 next to slivers of random point sets; C¹ is
-        // checked exactly by `c1_jumps` above.
-        let jumps = check::continuity_jumps(&ps);
-        assert!(jumps.points > 0 && jumps.value < 1e-9, "{jumps:?}");
-        ps
-    }
-
-    fn unit_square_walls() -> [(&'static str, Vec2, Vec2); 4] {
-        [
-            ("left", Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)),
-            ("right", Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0)),
-            ("bottom", Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0)),
-            ("top", Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)),
-        ]
-    }
-
-    /// Projects the `n` components of `c` onto the coefficients satisfying all
-    /// `constraints` jointly (single-term ones as rows too): `u ← u − U Uᵀ u` with
-    /// `u_i = n · c_i` and `U` an orthonormal basis of the range of `Aᵀ` (from the SVD
-    /// of `Aᵀ`; the normal equations `A Aᵀ` lose too much to round-off here).
-    fn project(c: &mut [Vec2], constraints: &[Constraint<f64, 2>]) {
-        let Some(n) = constraints.first().map(|k| k.direction) else {
-            return;
+    /// PS in the property suite ([`crate::check::suite`]): C¹, quadratic precision
+    /// with the Hermite data of the quadratic at the vertices as coefficients, and the
+    /// checks below on every mesh of the suite.
+    impl Subject<2> for PowellSabin<f64> {
+        type Mesh = TriMesh;
+        const CLAIMS: Claims = Claims {
+            partition_of_unity: 1e-13,
+            negative: 1e-13,
+            linear: 0.0,
+            linear_per_size: 1e-13,
+            per_conditioning: 0.0,
+            linear_gradient: 1e-13,
+            quadratic: Some((1e-12, 1e-13)),
+            gradient: 1e-6,
+            value_jump: 1e-9,
+            continuity: Continuity::C1 {
+                gradient_jump_below: 1e-11,
+            },
+            dirichlet: 1e-13,
         };
-        let mut at = nalgebra::DMatrix::<f64>::zeros(c.len(), constraints.len());
-        for (r, k) in constraints.iter().enumerate() {
-            assert_eq!(k.direction, n);
-            for &(i, w) in &k.terms {
-                at[(i, r)] += w;
+        fn build(mesh: TriMesh) -> Self {
+            PowellSabin::new(mesh, SplitPoint::Incentre).unwrap()
+        }
+        /// `c_i^q = q(V_i) + ∇q(V_i) · (Q_i^q − V_i)`: the spline with value `q(V_i)`
+        /// and gradient `∇q(V_i)` at every vertex, which is `q` (PS splines contain
+        /// the quadratics).
+        fn quadratic_coefficient(&self, function: usize, q: &Quadratic<2>) -> f64 {
+            let v = self.mesh().vertices()[function / 3];
+            let control = self.control_triangles()[function / 3][function % 3];
+            q.value(&v) + q.gradient(&v).dot(&(control - v))
+        }
+        /// Exact C¹ across every edge of the refinement, the control triangles and
+        /// triplets, gradients of each piece's own quadratic against central
+        /// differences, and, on the unit square, the corner fixed by `left` and
+        /// `bottom` together.
+        fn specific_checks(&self) {
+            let (jump, grad_jump) = c1_jumps(self);
+            assert!(jump < 1e-13, "value jump {jump:e}");
+            assert!(
+                grad_jump < 1e-9,
+                "relative gradient jump {grad_jump:e} (C¹ violated)"
+            );
+            assert_control_triangles_and_triplets(self);
+            let fd = piece_gradient_error(self);
+            assert!(
+                fd < 1e-9,
+                "gradient vs central differences on the pieces: {fd:e}"
+            );
+            let mesh = self.mesh();
+            let corner = mesh.vertices().iter().position(|p| p.norm() == 0.0);
+            if let (Ok(_), Ok(_), Some(corner)) =
+                (mesh.tag_id("left"), mesh.tag_id("bottom"), corner)
+            {
+                let n = Vec2::new(1.0, 0.0);
+                let mut constraints = self.dirichlet("left", &n).unwrap();
+                constraints.extend(self.dirichlet("bottom", &n).unwrap());
+                for q in 0..3 {
+                    assert!(constraints
+                        .iter()
+                        .any(|c| c.terms == vec![(3 * corner + q, 1.0)]));
+                }
             }
         }
-        let svd = at.svd(true, false);
-        let u = svd.u.unwrap();
-        let smax = svd.singular_values.max();
-        let mut x = nalgebra::DVector::from_iterator(c.len(), c.iter().map(|ci| n.dot(ci)));
-        for (k, &sigma) in svd.singular_values.iter().enumerate() {
-            if sigma > 1e-12 * smax {
-                let col = u.column(k);
-                let d = col.dot(&x);
-                x -= col * d;
-            }
-        }
-        for (ci, xi) in c.iter_mut().zip(x.iter()) {
-            *ci += n * (xi - n.dot(ci));
-        }
-    }
-
-    /// `max |n · v|` at `points` for a random field `v = Σ c φ` whose coefficients
-    /// satisfy `constraints` (all with direction `n`).
-    fn residual(
-        ps: &PowellSabin<f64>,
-        constraints: &[Constraint<f64, 2>],
-        points: &[Vec2],
-        seed: u64,
-    ) -> f64 {
-        let n = constraints
-            .first()
-            .map_or(Vec2::new(1.0, 0.0), |c| c.direction);
-        let mut rng = SplitMix64(seed);
-        let mut c: Vec<Vec2> = (0..ps.num_functions())
-            .map(|_| Vec2::new(2.0 * rng.next_f64() - 1.0, 2.0 * rng.next_f64() - 1.0))
-            .collect();
-        project(&mut c, constraints);
-        let mut eval = BasisEval::for_basis(ps);
-        points
-            .iter()
-            .map(|x| {
-                ps.eval(ps.locate(x, None).unwrap(), x, &mut eval);
-                let v: Vec2 = eval.iter().map(|(i, phi, _)| c[i] * phi).sum();
-                n.dot(&v).abs()
-            })
-            .fold(0.0, f64::max)
-    }
-
-    /// Dirichlet exactness on each wall of the unit square (both components and an
-    /// oblique one; single-term constraints only, since the walls are straight and
-    /// meet at right angles), and at the corner of two walls constrained together.
-    fn assert_dirichlet_exact(ps: &PowellSabin<f64>) {
-        let directions = [
-            Vec2::new(1.0, 0.0),
-            Vec2::new(0.0, 1.0),
-            Vec2::new(0.6, 0.8),
-        ];
-        for (tag, a, b) in unit_square_walls() {
-            let points = check::points_on_segment(a, b, 100);
-            for (k, n) in directions.iter().enumerate() {
-                let constraints = ps.dirichlet(tag, n).unwrap();
-                assert!(constraints
-                    .iter()
-                    .all(|c| c.is_single() && c.direction == *n));
-                let r = residual(ps, &constraints, &points, k as u64);
-                assert!(r < 1e-13, "{tag} {n:?}: residual {r:e}");
-            }
-        }
-        let n = Vec2::new(1.0, 0.0);
-        let mut constraints = ps.dirichlet("left", &n).unwrap();
-        constraints.extend(ps.dirichlet("bottom", &n).unwrap());
-        let points: Vec<Vec2> =
-            check::points_on_segment(Vec2::new(0.0, 1.0), Vec2::new(0.0, 0.0), 100)
-                .into_iter()
-                .chain(check::points_on_segment(
-                    Vec2::new(0.0, 0.0),
-                    Vec2::new(1.0, 0.0),
-                    100,
-                ))
-                .collect();
-        let r = residual(ps, &constraints, &points, 5);
-        assert!(r < 1e-13, "corner residual {r:e}");
-        // The corner vertex's three coefficients are all fixed.
-        let corner = ps
-            .mesh()
-            .vertices()
-            .iter()
-            .position(|p| p.norm() == 0.0)
-            .unwrap();
-        for q in 0..3 {
-            assert!(constraints
-                .iter()
-                .any(|c| c.terms == vec![(3 * corner + q, 1.0)]));
-        }
-    }
-
-    /// The unit square cut into two triangles by hand, sides tagged.
-    fn two_triangles() -> TriMesh {
-        let v = vec![
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::new(1.0, 1.0),
-            Vec2::new(0.0, 1.0),
-        ];
-        let mut mesh = TriMesh::new(v, vec![[0, 1, 2], [0, 2, 3]]).unwrap();
-        mesh.tag_box_sides(0.0, 1.0, 0.0, 1.0);
-        mesh
-    }
-
-    /// A random Delaunay mesh of the unit square: its corners and `count` random points.
-    fn random_points_mesh(seed: u64, count: usize) -> TriMesh {
-        let mut rng = SplitMix64(seed);
-        let mut points = vec![
-            Vec2::new(0.0, 0.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::new(1.0, 1.0),
-            Vec2::new(0.0, 1.0),
-        ];
-        points.extend(
-            (0..count).map(|_| Vec2::new(0.05 + 0.9 * rng.next_f64(), 0.05 + 0.9 * rng.next_f64())),
-        );
-        let mut mesh = generators::delaunay(&points).unwrap();
-        mesh.tag_box_sides(0.0, 1.0, 0.0, 1.0);
-        mesh
     }
 
     #[test]
     fn basis_api_on_a_hand_built_mesh() {
-        let ps = assert_ps_properties(two_triangles());
-        assert_dirichlet_exact(&ps);
+        let ps = PowellSabin::<f64>::new(suite::two_triangles(), SplitPoint::Incentre).unwrap();
         assert_eq!((ps.name(), ps.degree()), ("ps", 2));
         assert_eq!((ps.num_functions(), ps.num_elements()), (12, 2));
         assert_eq!(ps.max_functions_per_element(), 9);
@@ -1020,9 +854,10 @@ mod tests {
     }
 
     #[test]
-    fn block_grid_properties_and_dirichlet() {
-        let ps = assert_ps_properties(generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap());
-        assert_dirichlet_exact(&ps);
+    fn block_grid_function_count_and_corner_control_points() {
+        let ps = <PowellSabin<f64> as Subject<2>>::build(
+            generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap(),
+        );
         assert_eq!(ps.num_functions(), 3 * (12 + 6));
         // Corners: Q¹ = V.
         for (v, p) in ps.mesh().vertices().iter().enumerate() {
@@ -1033,161 +868,35 @@ mod tests {
     }
 
     #[test]
-    fn lattice_properties_and_dirichlet() {
-        let ps = assert_ps_properties(generators::lattice_delaunay(6, 0.0, 1.0, 0.0, 1.0).unwrap());
-        assert_dirichlet_exact(&ps);
-    }
-
-    #[test]
-    fn polygon_with_hole_properties_and_dirichlet() {
-        let mut domain = PolygonDomain::rectangle(0.0, 1.0, 0.0, 1.0);
-        let hole: Vec<Vec2> = (0..10)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / 10.0;
-                Vec2::new(0.5 + 0.2 * a.cos(), 0.5 + 0.2 * a.sin())
-            })
-            .collect();
-        domain.holes.push((hole.clone(), "hole".into()));
-        let ps = assert_ps_properties(generators::polygon_mesh(&domain, 0.15).unwrap());
-        assert_dirichlet_exact(&ps);
-        // The hole's corners are reflex: general control triangles, whose general
-        // constraints from the two hole edges at a corner (value, two independent
-        // tangential derivatives) fix all three coefficients: single-term again.
-        let points: Vec<Vec2> = (0..10)
-            .flat_map(|i| check::points_on_segment(hole[i], hole[(i + 1) % 10], 10))
-            .collect();
-        for n in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
-            let constraints = ps.dirichlet("hole", &n).unwrap();
-            assert!(constraints.iter().all(|c| c.is_single()));
-            let r = residual(&ps, &constraints, &points, 3);
-            assert!(r < 1e-13, "hole residual {r:e}");
-        }
-    }
-
-    #[test]
     fn general_constraints_at_a_reflex_corner_between_two_tags() {
         // L-shape with the two walls at the reflex corner (1, 1) tagged apart: each
-        // wall alone constrains value and one tangential derivative there.
-        let domain = PolygonDomain {
-            outer: [
-                (0.0, 0.0),
-                (2.0, 0.0),
-                (2.0, 1.0),
-                (1.0, 1.0),
-                (1.0, 2.0),
-                (0.0, 2.0),
-            ]
-            .map(|(x, y)| Vec2::new(x, y))
-            .to_vec(),
-            outer_tags: ["a", "b", "c", "d", "e", "f"].map(String::from).to_vec(),
-            holes: Vec::new(),
-        };
-        let ps = assert_ps_properties(generators::polygon_mesh(&domain, 0.3).unwrap());
+        // wall alone constrains value and one tangential derivative there (the suite
+        // checks that both walls, alone and together, are exact).
+        let ps = <PowellSabin<f64> as Subject<2>>::build(suite::l_shape_two_tags().mesh);
         let n = Vec2::new(0.6, -0.8);
         let c = ps.dirichlet("c", &n).unwrap();
         let d = ps.dirichlet("d", &n).unwrap();
         let general = |k: &[Constraint<f64, 2>]| k.iter().filter(|c| !c.is_single()).count();
         assert_eq!((general(&c), general(&d)), (2, 2));
-        let wall_c = check::points_on_segment(Vec2::new(2.0, 1.0), Vec2::new(1.0, 1.0), 100);
-        let wall_d = check::points_on_segment(Vec2::new(1.0, 1.0), Vec2::new(1.0, 2.0), 100);
-        assert!(residual(&ps, &c, &wall_c, 1) < 1e-13);
-        assert!(residual(&ps, &d, &wall_d, 2) < 1e-13);
-        // Both together: all three coefficients of the corner are fixed.
-        let both: Vec<Vec2> = wall_c.iter().chain(&wall_d).copied().collect();
-        let mut cd = c.clone();
-        cd.extend(d);
-        assert!(residual(&ps, &cd, &both, 3) < 1e-13);
     }
 
     #[test]
     fn nearly_flat_convex_corner_gets_a_boundary_aligned_control_triangle() {
         // The corner at (1, −0.03) turns by 3.4°: the apex construction would give a
-        // control triangle ~40 times too large; one boundary line is used instead.
-        let domain = PolygonDomain {
-            outer: [(0.0, 0.0), (1.0, -0.03), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)]
-                .map(|(x, y)| Vec2::new(x, y))
-                .to_vec(),
-            outer_tags: ["a", "b", "c", "d", "e"].map(String::from).to_vec(),
-            holes: Vec::new(),
-        };
-        let ps = assert_ps_properties(generators::polygon_mesh(&domain, 0.3).unwrap());
+        // control triangle ~40 times too large; one boundary line is used instead
+        // (the suite checks its walls).
+        let ps = <PowellSabin<f64> as Subject<2>>::build(suite::nearly_flat_corner().mesh);
         let p = Vec2::new(1.0, -0.03);
         let v = ps.mesh().vertices().iter().position(|x| *x == p).unwrap();
         assert!(matches!(vertex_kind(ps.mesh(), v), VertexKind::Corner(..)));
         assert_ne!(ps.control_triangles()[v][0], p);
-        let wall_a = check::points_on_segment(Vec2::new(0.0, 0.0), p, 100);
-        let wall_b = check::points_on_segment(p, Vec2::new(2.0, 0.0), 100);
-        let n = Vec2::new(0.0, 1.0);
-        let (a, b) = (
-            ps.dirichlet("a", &n).unwrap(),
-            ps.dirichlet("b", &n).unwrap(),
-        );
-        assert!(residual(&ps, &a, &wall_a, 1) < 1e-13);
-        assert!(residual(&ps, &b, &wall_b, 2) < 1e-13);
-        let mut ab = a.clone();
-        ab.extend(b);
-        let both: Vec<Vec2> = wall_a.iter().chain(&wall_b).copied().collect();
-        assert!(residual(&ps, &ab, &both, 3) < 1e-13);
-    }
-
-    #[test]
-    fn gmsh_meshes() {
-        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data");
-        let read = |name: &str| crate::mesh::gmsh::read_msh(&data.join(name)).unwrap();
-        assert_dirichlet_exact(&assert_ps_properties(read("square.msh")));
-        let ps = assert_ps_properties(read("square_hole.msh"));
-        assert_dirichlet_exact(&ps);
-        let circle: Vec<Vec2> = (0..=400)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / 400.0;
-                Vec2::new(0.5 + 0.2 * a.cos(), 0.5 + 0.2 * a.sin())
-            })
-            .collect();
-        // The hole is a polygon inscribed in the circle: sample its own edges.
-        let mesh = ps.mesh();
-        let hole = mesh.tag_id("hole").unwrap();
-        let points: Vec<Vec2> = mesh
-            .edges()
-            .iter()
-            .filter(|e| e.tag == Some(hole))
-            .flat_map(|e| {
-                check::points_on_segment(
-                    mesh.vertices()[e.vertices[0]],
-                    mesh.vertices()[e.vertices[1]],
-                    5,
-                )
-            })
-            .collect();
-        assert!(points
-            .iter()
-            .all(|p| circle.iter().any(|c| (p - c).norm() < 0.05)));
-        for n in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
-            let constraints = ps.dirichlet("hole", &n).unwrap();
-            assert!(residual(&ps, &constraints, &points, 4) < 1e-13);
-        }
-        let l = assert_ps_properties(read("lshape.msh"));
-        // Along both walls meeting at the reflex corner (0.5, 0.5).
-        let points: Vec<Vec2> =
-            check::points_on_segment(Vec2::new(1.0, 0.5), Vec2::new(0.5, 0.5), 50)
-                .into_iter()
-                .chain(check::points_on_segment(
-                    Vec2::new(0.5, 0.5),
-                    Vec2::new(0.5, 1.0),
-                    50,
-                ))
-                .collect();
-        for n in [Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)] {
-            let constraints = l.dirichlet("wall", &n).unwrap();
-            assert!(constraints.iter().all(|c| c.is_single()));
-            assert!(residual(&l, &constraints, &points, 5) < 1e-13);
-        }
     }
 
     #[test]
     fn centroid_split_points_accepted_on_the_block_grid_rejected_elsewhere() {
         let mesh = generators::block_grid(0.0, 25.0, 0.0, 2.0, 4, 1).unwrap();
         let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Centroid).unwrap();
-        let (pu, min, _) = sampled_properties(&ps);
+        let (pu, min) = (check::partition_of_unity(&ps), check::min_value(&ps));
         assert!(pu < 1e-13 && min > -1e-13);
         let (jump, grad_jump) = c1_jumps(&ps);
         assert!(jump < 1e-14 && grad_jump < 1e-12);
@@ -1208,66 +917,10 @@ mod tests {
         let mesh =
             generators::jittered_lattice_delaunay(6, 6, (0.0, 1.0, 0.0, 1.0), 0.3, 9).unwrap();
         let ps = PowellSabin::<f32>::new(mesh, SplitPoint::Incentre).unwrap();
-        let (pu, min, lp) = sampled_properties(&ps);
+        let (pu, min) = (check::partition_of_unity(&ps), check::min_value(&ps));
+        let lp = check::linear_precision(&ps).0;
         assert!(pu < 1e-6, "f32 partition of unity off by {pu:e}");
         // Single-precision ordinates and coordinates: ~1e-7 per term.
         assert!(min > -1e-5 && lp < 1e-6, "{min:e} {lp:e}");
-        assert!(check::partition_of_unity(&ps) < 1e-6);
-    }
-
-    #[test]
-    fn pl_fails_the_c1_check_that_ps_passes() {
-        // The continuity check can fail: PL gradients jump across edges.
-        let mesh = generators::lattice_delaunay(4, 0.0, 1.0, 0.0, 1.0).unwrap();
-        let pl = crate::basis::linear::Linear::<f64>::new(mesh.clone());
-        let j = check::continuity_jumps(&pl);
-        assert!(j.value < 1e-9);
-        assert!(j.gradient > 0.1);
-        let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
-        assert!(check::continuity_jumps(&ps).gradient < 1e-5);
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig { cases: 16, .. ProptestConfig::default() })]
-
-        #[test]
-        fn jittered_delaunay_meshes(seed in 0u64..1_000_000, n in 3usize..8, jitter in 0.0f64..0.45) {
-            let mesh = generators::jittered_lattice_delaunay(n, n + 1, (0.0, 1.0, 0.0, 1.0), jitter, seed).unwrap();
-            let ps = assert_ps_properties(mesh);
-            assert_dirichlet_exact(&ps);
-        }
-
-        #[test]
-        fn random_point_delaunay_meshes(seed in 0u64..1_000_000, count in 8usize..50) {
-            let ps = assert_ps_properties(random_points_mesh(seed, count));
-            assert_dirichlet_exact(&ps);
-        }
-
-        #[test]
-        fn random_star_polygons(seed in 0u64..1_000_000, corners in 5usize..10) {
-            // A random star-shaped polygon (convex and reflex corners), meshed with
-            // the quality mesher; every wall tagged separately.
-            let mut rng = SplitMix64(seed);
-            let outer: Vec<Vec2> = (0..corners)
-                .map(|k| {
-                    let a = std::f64::consts::TAU * (k as f64 + 0.3 * rng.next_f64()) / corners as f64;
-                    let r = 0.5 + 0.5 * rng.next_f64();
-                    Vec2::new(r * a.cos(), r * a.sin())
-                })
-                .collect();
-            let domain = PolygonDomain {
-                outer_tags: (0..corners).map(|k| format!("wall{k}")).collect(),
-                outer: outer.clone(),
-                holes: Vec::new(),
-            };
-            let ps = assert_ps_properties(generators::polygon_mesh(&domain, 0.25).unwrap());
-            let n = Vec2::new(0.6, 0.8);
-            for k in 0..corners {
-                let points = check::points_on_segment(outer[k], outer[(k + 1) % corners], 100);
-                let constraints = ps.dirichlet(&format!("wall{k}"), &n).unwrap();
-                let r = residual(&ps, &constraints, &points, k as u64);
-                prop_assert!(r < 1e-13, "wall{} residual {:e}", k, r);
-            }
-        }
     }
 }
