@@ -30,7 +30,7 @@ use super::{
 use crate::sparse::{mul_upper, Scalar, SymmetricPattern};
 
 /// Default coverage threshold `C` of [`Extended`].
-pub const DEFAULT_COVERAGE: f64 = 0.25;
+pub const DEFAULT_COVERAGE: f64 = 0.5;
 /// Rings of neighbours searched for the functions an extended function is
 /// expressed through.
 pub const EXTENSION_RINGS: usize = 3;
