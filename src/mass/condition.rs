@@ -93,7 +93,7 @@ pub(super) fn lanczos_estimate<T: Scalar>(
         steps = j + 1;
         let b = norm(w);
         beta[j] = b;
-        if !(b > 1e-14 * a.abs()) {
+        if b.is_nan() || b <= 1e-14 * a.abs() {
             break;
         }
         for i in 0..w.len() {

@@ -181,7 +181,7 @@ fn conjugate_gradients<T: Scalar>(
         }
         op.apply(&s.p, &mut s.q, &mut s.u, &mut s.w);
         let pq = dot(&s.p, &s.q);
-        if !(pq > 0.0) {
+        if pq.is_nan() || pq <= 0.0 {
             break;
         }
         let alpha = T::of(rz / pq);
@@ -378,7 +378,7 @@ impl<T: Scalar> Extended<T> {
                     s -= g[a * 6 + k] * g[b * 6 + k];
                 }
                 if a == b {
-                    if !(s > 1e-12 * max_diag) {
+                    if s.is_nan() || s <= 1e-12 * max_diag {
                         return None;
                     }
                     g[a * 6 + a] = s.sqrt();
