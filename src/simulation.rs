@@ -87,6 +87,11 @@ pub struct Summary {
     pub max_lumped_rows: usize,
     /// Largest number of deactivated functions in a step.
     pub max_deactivated: usize,
+    /// Most functions the extension expressed through their neighbours in a step.
+    pub max_extended: usize,
+    /// The critical time step of the basis, mass strategy and material at the start
+    /// ([`Driver::critical_time_step`]), when it could be estimated.
+    pub dt_critical: Option<f64>,
     /// Largest condition-number estimate (when requested).
     pub max_condition: Option<f64>,
     /// Total energy at the start.
@@ -762,6 +767,9 @@ where
         })
         .collect();
 
+    // The critical step at the start (a failure here is the failure of step 1,
+    // reported by the first step itself).
+    let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
     let start = driver.report();
     // The initial state (step 0); the public entry points other than
     // `observe_2d`/`observe_1d` pass only steps > 0 on.
@@ -773,7 +781,7 @@ where
         .max(start.strain)
         .max(start.potential.abs());
     let (mut drift, mut growth) = (0.0f64, 0.0f64);
-    let (mut lumped, mut deactivated) = (0usize, 0usize);
+    let (mut lumped, mut deactivated, mut extended) = (0usize, 0usize, 0usize);
     let mut max_condition: Option<f64> = None;
     let mut phases = PhaseTimes::default();
     let mut rms = exact::RmsPositionError::default();
@@ -811,6 +819,7 @@ where
         growth = growth.max(r.total_energy() - e0);
         lumped = lumped.max(r.mass_report.lumped_rows);
         deactivated = deactivated.max(r.mass_report.deactivated);
+        extended = extended.max(r.mass_report.extended);
         phases.evaluate += r.phases.evaluate;
         phases.assemble += r.phases.assemble;
         phases.solve += r.phases.solve;
@@ -877,6 +886,8 @@ where
             error_measure: scene.reference.map(|r| r.error_measure()),
             max_lumped_rows: lumped,
             max_deactivated: deactivated,
+            max_extended: extended,
+            dt_critical,
             max_condition,
             energy_initial: e0,
             energy_final: end.total_energy(),

@@ -19,7 +19,10 @@
 //!
 //! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
 
+mod critical;
 pub mod phases;
+
+pub use critical::CRITICAL_ITERATIONS;
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
@@ -37,9 +40,8 @@ use phases::{Evaluations, UpdateFailure};
 use psmpm_basis::{Basis, BasisError, BasisEval};
 use std::time::Instant;
 
-/// Coverage below which a function counts as under-supported in failure messages
-/// (the threshold of the default strategy).
-pub const UNDER_SUPPORTED_COVERAGE: f64 = crate::mass::DEFAULT_COVERAGE;
+/// Coverage below which a function counts as under-supported in failure messages.
+pub const UNDER_SUPPORTED_COVERAGE: f64 = 0.1;
 
 /// Why a step failed. Each names the step, the cause the driver can see, and a
 /// fix that fits that cause.
@@ -139,6 +141,8 @@ where
     last_report: MassReport,
     last_condition: Option<f64>,
     phases: PhaseTimes,
+    /// The critical time step, once estimated ([`Driver::critical_time_step`]).
+    dt_critical: Option<f64>,
     /// Estimate the condition number every step.
     pub estimate_condition: bool,
 }
@@ -241,6 +245,7 @@ where
             inputs,
             last_condition: None,
             phases: PhaseTimes::default(),
+            dt_critical: None,
             estimate_condition: false,
             basis,
             particles,
@@ -534,6 +539,15 @@ where
 
     /// What the driver can see around a failing particle, and the fix that fits.
     fn diagnose_particle(&self, particle: usize) -> String {
+        if let Some(critical) = self.dt_critical {
+            let dt = self.dt.to_f64();
+            if dt > critical {
+                let speed = self.particles.v[particle].norm().to_f64();
+                return format!(
+                    "the element around it inverted (speed {speed:.3e}): Δt = {dt:.3e} is above the critical step {critical:.3e} of this basis, mass strategy and material (estimated at the start): lower `time.dt` below it"
+                );
+            }
+        }
         // The worst-covered function among those the particle sees (the coverage
         // is measured here if the strategy did not need it).
         let computed;
@@ -577,6 +591,12 @@ where
             }
         }
         let speed = self.particles.v[particle].norm().to_f64();
+        if let Some(critical) = self.dt_critical {
+            let dt = self.dt.to_f64();
+            return format!(
+                "the element around it inverted (speed {speed:.3e}) although Δt = {dt:.3e} is below the critical step {critical:.3e} estimated at the start: the deformation is large (a stiffer response than at the start, or a law that is not objective, `linear-elastic`, under rotation); try `neo-hookean` or a smaller `time.dt`"
+            );
+        }
         format!(
             "the element around it inverted (speed {speed:.3e}, Δt = {:.3e}): the time step is likely above the critical one for this material and mesh, lower `time.dt` or `time.courant`; if the body rotates, a law that is not objective (`linear-elastic`) also builds spurious stress",
             self.dt.to_f64()

@@ -27,7 +27,7 @@ use super::{
     distinct_fixed_sets, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext,
     SupportFacts,
 };
-use crate::sparse::{mul_upper, Scalar, SymmetricPattern};
+use crate::sparse::{Scalar, SymmetricPattern};
 
 /// Default coverage threshold `C` of [`Extended`].
 pub const DEFAULT_COVERAGE: f64 = 0.5;
@@ -64,35 +64,50 @@ struct Reduced<'a, T> {
     ext_idx: &'a [usize],
     ext_w: &'a [T],
     fixed: &'a [bool],
+    /// Functions with particles (solved or extended), ascending.
+    active: &'a [usize],
+    /// Extended functions, ascending.
+    extended: &'a [usize],
 }
 
 impl<T: Scalar> Reduced<'_, T> {
     fn free(&self, i: usize) -> bool {
         self.role[i] == Role::Solved && !self.fixed[i]
     }
-    /// `u = E x`.
-    fn expand(&self, x: &[T], u: &mut [T]) {
-        for i in 0..u.len() {
-            u[i] = match self.role[i] {
-                Role::Solved if !self.fixed[i] => x[i],
-                Role::Extended if !self.fixed[i] => {
-                    let mut s = T::zero();
-                    for t in self.ext_ptr[i]..self.ext_ptr[i + 1] {
-                        s += self.ext_w[t] * x[self.ext_idx[t]];
-                    }
-                    s
+    /// `(E x)_i` for an active function `i`.
+    #[inline]
+    fn expanded(&self, x: &[T], i: usize) -> T {
+        match self.role[i] {
+            Role::Solved if !self.fixed[i] => x[i],
+            Role::Extended if !self.fixed[i] => {
+                let mut s = T::zero();
+                for t in self.ext_ptr[i]..self.ext_ptr[i + 1] {
+                    s += self.ext_w[t] * x[self.ext_idx[t]];
                 }
-                _ => T::zero(),
-            };
+                s
+            }
+            _ => T::zero(),
         }
     }
-    /// `y = Eᵀ w`, zero off the free functions.
+    /// `u = E x` on the active functions (the others stay zero).
+    fn expand(&self, x: &[T], u: &mut [T]) {
+        for &i in self.active {
+            u[i] = self.expanded(x, i);
+        }
+    }
+    /// `u = E x` on every function.
+    fn expand_all(&self, x: &[T], u: &mut [T]) {
+        for i in 0..u.len() {
+            u[i] = self.expanded(x, i);
+        }
+    }
+    /// `y = Eᵀ w`, zero off the free functions (written on the active ones).
     fn restrict(&self, w: &[T], y: &mut [T]) {
-        for i in 0..y.len() {
+        for &i in self.active {
             y[i] = if self.free(i) { w[i] } else { T::zero() };
         }
-        for j in 0..y.len() {
-            if self.role[j] == Role::Extended && !self.fixed[j] {
+        for &j in self.extended {
+            if !self.fixed[j] {
                 for t in self.ext_ptr[j]..self.ext_ptr[j + 1] {
                     let i = self.ext_idx[t];
                     if self.free(i) {
@@ -102,11 +117,35 @@ impl<T: Scalar> Reduced<'_, T> {
             }
         }
     }
+    /// `w = M u` over the active columns: `M_ij = 0` as soon as `i` or `j` has no
+    /// particle, so the other entries contribute nothing.
+    fn mass_product(&self, u: &[T], w: &mut [T]) {
+        for &c in self.active {
+            w[c] = T::zero();
+        }
+        for &c in self.active {
+            for k in self.col_ptr[c]..self.col_ptr[c + 1] {
+                let r = self.row_idx[k];
+                let a = self.values[k];
+                w[r] += a * u[c];
+                if r != c {
+                    w[c] += a * u[r];
+                }
+            }
+        }
+    }
     /// `y = Eᵀ M E x`.
     fn apply(&self, x: &[T], y: &mut [T], u: &mut [T], w: &mut [T]) {
         self.expand(x, u);
-        mul_upper(self.col_ptr, self.row_idx, self.values, u, w);
+        self.mass_product(u, w);
         self.restrict(w, y);
+    }
+    /// `Σ a_i b_i` over the active functions.
+    fn dot(&self, a: &[T], b: &[T]) -> f64 {
+        self.active
+            .iter()
+            .map(|&i| (a[i] * b[i]).to_f64())
+            .sum::<f64>()
     }
 }
 
@@ -145,15 +184,8 @@ fn conjugate_gradients<T: Scalar>(
     b: &[T],
     s: &mut Scratch<T>,
 ) -> Result<usize, MassError> {
-    let n = b.len();
-    let dot = |a: &[T], c: &[T]| {
-        a.iter()
-            .zip(c)
-            .map(|(a, c)| (*a * *c).to_f64())
-            .sum::<f64>()
-    };
-    let b_norm = dot(b, b).sqrt();
-    for i in 0..n {
+    let b_norm = op.dot(b, b).sqrt();
+    for &i in op.active {
         s.x[i] = if op.free(i) {
             b[i] / precond[i]
         } else {
@@ -164,28 +196,28 @@ fn conjugate_gradients<T: Scalar>(
         return Ok(0);
     }
     op.apply(&s.x, &mut s.q, &mut s.u, &mut s.w);
-    for i in 0..n {
+    for &i in op.active {
         s.r[i] = b[i] - s.q[i];
         s.z[i] = if op.free(i) {
             s.r[i] / precond[i]
         } else {
             T::zero()
         };
+        s.p[i] = s.z[i];
     }
-    s.p.copy_from_slice(&s.z);
-    let mut rz = dot(&s.r, &s.z);
-    let mut residual = dot(&s.r, &s.r).sqrt() / b_norm;
+    let mut rz = op.dot(&s.r, &s.z);
+    let mut residual = op.dot(&s.r, &s.r).sqrt() / b_norm;
     for iteration in 0..CG_MAX_ITERATIONS {
         if residual <= CG_TOLERANCE {
             return Ok(iteration);
         }
         op.apply(&s.p, &mut s.q, &mut s.u, &mut s.w);
-        let pq = dot(&s.p, &s.q);
+        let pq = op.dot(&s.p, &s.q);
         if pq.is_nan() || pq <= 0.0 {
             break;
         }
         let alpha = T::of(rz / pq);
-        for i in 0..n {
+        for &i in op.active {
             s.x[i] += alpha * s.p[i];
             s.r[i] -= alpha * s.q[i];
             s.z[i] = if op.free(i) {
@@ -194,13 +226,13 @@ fn conjugate_gradients<T: Scalar>(
                 T::zero()
             };
         }
-        let rz_new = dot(&s.r, &s.z);
+        let rz_new = op.dot(&s.r, &s.z);
         let beta = T::of(rz_new / rz);
         rz = rz_new;
-        for i in 0..n {
+        for &i in op.active {
             s.p[i] = s.z[i] + beta * s.p[i];
         }
-        residual = dot(&s.r, &s.r).sqrt() / b_norm;
+        residual = op.dot(&s.r, &s.r).sqrt() / b_norm;
     }
     if residual <= CG_TOLERANCE {
         return Ok(CG_MAX_ITERATIONS);
@@ -221,6 +253,8 @@ pub struct Extended<T: Scalar> {
     row_idx: Vec<usize>,
     values: Vec<T>,
     role: Vec<Role>,
+    active: Vec<usize>,
+    extended: Vec<usize>,
     ext_ptr: Vec<usize>,
     ext_idx: Vec<usize>,
     ext_w: Vec<T>,
@@ -252,6 +286,8 @@ impl<T: Scalar> Extended<T> {
             row_idx: Vec::new(),
             values: Vec::new(),
             role: Vec::new(),
+            active: Vec::new(),
+            extended: Vec::new(),
             ext_ptr: Vec::new(),
             ext_idx: Vec::new(),
             ext_w: Vec::new(),
@@ -279,6 +315,8 @@ impl<T: Scalar> Extended<T> {
             ext_idx: &self.ext_idx,
             ext_w: &self.ext_w,
             fixed: &self.fixed[s],
+            active: &self.active,
+            extended: &self.extended,
         }
     }
 
@@ -490,6 +528,8 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.row_idx = pattern.row_idx().to_vec();
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
+        self.active = Vec::with_capacity(n);
+        self.extended = Vec::with_capacity(n);
         self.ext_ptr = vec![0; n + 1];
         // Room for every function extended through 16 neighbours: steps then
         // allocate only in the rare case of wider extensions.
@@ -546,6 +586,32 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             }
         }
         self.ext_ptr[n] = self.ext_idx.len();
+        self.active.clear();
+        self.extended.clear();
+        for i in 0..n {
+            match self.role[i] {
+                Role::Inactive => {}
+                Role::Solved => self.active.push(i),
+                Role::Extended => {
+                    self.active.push(i);
+                    self.extended.push(i);
+                }
+            }
+        }
+        // The solves touch only the active entries; the others stay zero.
+        let s = &mut self.scratch;
+        for v in [
+            &mut s.x,
+            &mut s.r,
+            &mut s.z,
+            &mut s.p,
+            &mut s.q,
+            &mut s.u,
+            &mut s.w,
+            &mut self.rhs,
+        ] {
+            v.iter_mut().for_each(|a| *a = T::zero());
+        }
         // Jacobi preconditioner: M_ii + Σ_j e_ji² M_jj.
         for s in 0..self.fixed.len() {
             let mut precond = std::mem::take(&mut self.precond[s]);
@@ -585,7 +651,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             if std::env::var("PSMPM_DEBUG_CG").is_ok() {
                 eprintln!("cg {:?} extended {}", result, self.ext_ptr[self.role.len()]);
             }
-            op.expand(&scratch.x, rhs);
+            op.expand_all(&scratch.x, rhs);
             result
         };
         self.rhs = b;
@@ -596,6 +662,9 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
     fn condition_estimate(&mut self, _pattern: &SymmetricPattern) -> f64 {
         let mut worst = 0.0f64;
         let [mut u, mut w, mut x, mut q, mut y] = std::mem::take(&mut self.estimate);
+        for v in [&mut u, &mut w, &mut q, &mut y] {
+            v.iter_mut().for_each(|a| *a = T::zero());
+        }
         for s in 0..self.fixed.len() {
             let op = self.reduced(s);
             for i in 0..x.len() {

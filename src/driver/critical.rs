@@ -1,0 +1,136 @@
+//! The critical time step of the explicit update for the basis and mass strategy in
+//! use: `Δt_crit = 2 / ω_max` with `ω_max² = λ_max(M⁻¹ K)`, `M` the system the mass
+//! strategy solves (its own inverse, walls included) and `K` the small-strain
+//! stiffness `K v = Σ_p V_p σ(∇v_p) ∇phi_i` with the material's Lamé constants at
+//! the current particle positions. `λ_max` by power iteration: a lower bound, so the
+//! estimate is an upper bound on `Δt_crit` that tightens with the iterations.
+
+use super::{phases, Driver, StepError};
+use crate::mass::MassStrategy;
+use crate::material::Material;
+use crate::sparse::Scalar;
+use nalgebra::SMatrix;
+use psmpm_basis::Basis;
+
+/// Power iterations of the critical-step estimate.
+pub const CRITICAL_ITERATIONS: usize = 40;
+
+impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
+where
+    T: Scalar,
+    B: Basis<T, D>,
+    M: MassStrategy<T>,
+    Mat: Material<T, D>,
+{
+    /// The critical time step at the current state (see the module doc). Uses the
+    /// step's own buffers; call before a step (e.g. at the start of a run).
+    pub fn critical_time_step(&mut self) -> Result<f64, StepError> {
+        self.locate_and_evaluate()?;
+        phases::assemble_mass_and_internal_force(
+            &self.pattern,
+            &self.particles,
+            &self.evals,
+            &mut self.values,
+            &mut self.rhs,
+        );
+        if self.inputs.needs.empty_elements {
+            phases::mark_empty_elements(
+                &self.basis,
+                &self.particles.element,
+                &mut self.inputs.occupied,
+                &mut self.inputs.touches_empty,
+            );
+        }
+        if self.inputs.needs.coverage {
+            phases::particle_volume(
+                &self.evals,
+                &self.particles.volume,
+                &mut self.inputs.particle_volume,
+            );
+        }
+        self.factorize()?;
+        let (lambda, mu) = self.material.elastic().lame(D);
+        let n = self.basis.num_functions();
+        // Start: a fixed, non-smooth field (excites the highest modes).
+        let mut v: Vec<Vec<T>> = (0..D)
+            .map(|k| {
+                (0..n)
+                    .map(|i| {
+                        T::of(
+                            1.0 + ((i * 7 + k * 3) % 11) as f64
+                                * 0.1
+                                * if i % 2 == 0 { 1.0 } else { -1.0 },
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        let norm = |v: &[Vec<T>]| {
+            v.iter()
+                .flat_map(|c| c.iter())
+                .map(|a| (*a * *a).to_f64())
+                .sum::<f64>()
+                .sqrt()
+        };
+        let mut f = vec![vec![T::zero(); n]; D];
+        let mut estimate = 0.0;
+        for _ in 0..CRITICAL_ITERATIONS {
+            let nv = norm(&v);
+            if nv == 0.0 {
+                break;
+            }
+            v.iter_mut()
+                .flat_map(|c| c.iter_mut())
+                .for_each(|a| *a /= T::of(nv));
+            stiffness_product(&self.evals, &self.particles.volume, lambda, mu, &v, &mut f);
+            for k in 0..D {
+                if let Err(source) = self.mass.solve(k, &mut f[k]) {
+                    return Err(self.mass_failure(source));
+                }
+            }
+            self.constraints.project(&mut f);
+            estimate = norm(&f);
+            std::mem::swap(&mut v, &mut f);
+        }
+        let critical = if estimate > 0.0 {
+            2.0 / estimate.sqrt()
+        } else {
+            f64::INFINITY
+        };
+        self.dt_critical = Some(critical);
+        Ok(critical)
+    }
+}
+
+/// `f_i = Σ_p V_p σ(∇v_p) ∇phi_i(x_p)` with the small-strain law
+/// `σ = λ tr(ε) I + 2 μ ε`, `ε = sym ∇v` (the stiffness applied to `v`).
+fn stiffness_product<T: Scalar, const D: usize>(
+    evals: &phases::Evaluations<T, D>,
+    volume: &[T],
+    lambda: f64,
+    mu: f64,
+    v: &[Vec<T>],
+    f: &mut [Vec<T>],
+) {
+    phases::zero(f);
+    for p in 0..volume.len() {
+        let mut grad = SMatrix::<T, D, D>::zeros();
+        for s in evals.range(p) {
+            let i = evals.index[s];
+            for k in 0..D {
+                for l in 0..D {
+                    grad[(k, l)] += v[k][i] * evals.grad_phi[s][l];
+                }
+            }
+        }
+        let eps = (grad + grad.transpose()) * T::of(0.5);
+        let sigma =
+            SMatrix::<T, D, D>::identity() * (T::of(lambda) * eps.trace()) + eps * T::of(2.0 * mu);
+        for s in evals.range(p) {
+            let g = sigma * evals.grad_phi[s] * volume[p];
+            for k in 0..D {
+                f[k][evals.index[s]] += g[k];
+            }
+        }
+    }
+}
