@@ -326,14 +326,16 @@ fn reason(s: &Summary) -> Option<String> {
         return Some(f.clone());
     }
     let mut why = Vec::new();
-    if let Some(c) = s.max_condition.filter(|c| !(*c < STABLE_CONDITION)) {
+    // NaN counts as above a bound, as in the verdict.
+    let above = |x: f64, bound: f64| x.partial_cmp(&bound) != Some(Ordering::Less);
+    if let Some(c) = s.max_condition.filter(|c| above(*c, STABLE_CONDITION)) {
         why.push(format!(
             "condition estimate {} above the bound {}",
             sci(c),
             sci(STABLE_CONDITION)
         ));
     }
-    if !(s.energy_growth < STABLE_ENERGY_GROWTH) {
+    if above(s.energy_growth, STABLE_ENERGY_GROWTH) {
         why.push(format!(
             "energy growth {} above the bound {}",
             sci(s.energy_growth),
