@@ -35,6 +35,7 @@
 //! min = [0.0, 0.0]
 //! max = [2.0, 25.0]
 //! per_block = [6, 8]         # or count = [NX, NY] over the body
+//! # jitter = 0.3             # optional: random offsets, a fraction of the cell
 //!
 //! [[boundary]]
 //! tag = "bottom"
@@ -250,6 +251,22 @@ pub struct Body {
     /// Particles along each axis of the box.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub count: Option<Vec<usize>>,
+    /// Moves each particle off its cell centre by a uniform random offset of up to
+    /// this fraction of the lattice cell along each axis (`0 ≤ jitter < 0.5`, so
+    /// particles stay in their cells); 0: the regular lattice.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub jitter: f64,
+    /// Seed of the jitter's random numbers ([`DEFAULT_JITTER_SEED`] when absent):
+    /// the same seed gives the same particles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+/// The seed of a body's jitter when the scene gives none.
+pub const DEFAULT_JITTER_SEED: u64 = 1;
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// Initial velocity.
@@ -1022,6 +1039,15 @@ impl Scene {
                     ));
                 }
             }
+            if !(0.0..0.5).contains(&body.jitter) {
+                return Err(bad(
+                    field("jitter"),
+                    format!(
+                        "must be in [0, 0.5) (a fraction of the lattice cell), got {}",
+                        body.jitter
+                    ),
+                ));
+            }
             match (&body.per_block, &body.count) {
                 (Some(p), None) => {
                     if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
@@ -1395,6 +1421,43 @@ mod tests {
                 Scene::from_toml(&text, "shown.toml").unwrap_or_else(|e| panic!("{e}\n{text}"));
             assert_eq!(scene, back, "{name}");
         }
+    }
+
+    #[test]
+    fn jitter_is_validated_and_moves_particles_inside_their_cells_deterministically() {
+        let text = Scene::builtin("column-small").unwrap().to_toml();
+        let jittered = text.replace("per_block = [6, 8]", "per_block = [6, 8]\njitter = 0.3");
+        let scene = Scene::from_toml(&jittered, "j.toml").unwrap();
+        assert_eq!(
+            Scene::from_toml(&scene.to_toml(), "back.toml").unwrap(),
+            scene
+        );
+        for bad_value in ["0.5", "-0.1", "nan"] {
+            let broken = text.replace(
+                "per_block = [6, 8]",
+                &format!("per_block = [6, 8]\njitter = {bad_value}"),
+            );
+            let e = Scene::from_toml(&broken, "j.toml").unwrap_err();
+            assert!(
+                e.message.starts_with("body[0].jitter: must be in [0, 0.5)"),
+                "{e}"
+            );
+        }
+        let regular =
+            crate::simulation::particle_lattice(&Scene::builtin("column-small").unwrap()).unwrap();
+        let moved = crate::simulation::particle_lattice(&scene).unwrap();
+        assert_eq!(moved, crate::simulation::particle_lattice(&scene).unwrap());
+        let (hx, hy) = (2.0 / 6.0, 25.0 / 8.0 / 8.0);
+        let mut largest: f64 = 0.0;
+        for (p, q) in regular.positions.iter().zip(&moved.positions) {
+            let (dx, dy) = ((q[0] - p[0]) / hx, (q[1] - p[1]) / hy);
+            assert!(dx.abs() <= 0.3 && dy.abs() <= 0.3, "{p:?} -> {q:?}");
+            largest = largest.max(dx.abs()).max(dy.abs());
+        }
+        assert!(largest > 0.25, "{largest}");
+        let mut other = scene.clone();
+        other.bodies[0].seed = Some(7);
+        assert_ne!(crate::simulation::particle_lattice(&other).unwrap(), moved);
     }
 
     #[test]

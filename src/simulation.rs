@@ -395,7 +395,9 @@ where
 }
 
 /// Particle positions and volumes of the scene's bodies, block by block for
-/// `per_block` layouts (the order of the seeds' codes), row by row otherwise.
+/// `per_block` layouts (the order of the seeds' codes), row by row otherwise; a
+/// body's `jitter` moves each particle inside its cell (deterministic, see
+/// [`crate::scene::Body::jitter`]).
 pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
     let d = scene.dim;
     let mut lattice = Lattice::default();
@@ -427,6 +429,13 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
             cells[k] = n;
         }
         let volume: f64 = spacing[..d].iter().product();
+        // Jitter: a uniform offset in [-jitter, jitter) cells per axis, drawn in the
+        // order the particles are made, from a generator seeded per body.
+        let mut rng = generators::SplitMix64(
+            body.seed
+                .unwrap_or(crate::scene::DEFAULT_JITTER_SEED)
+                .wrapping_add(b as u64),
+        );
         let groups = [cells[0].div_ceil(group[0]), cells[1].div_ceil(group[1])];
         for gj in 0..groups[1] {
             for gi in 0..groups[0] {
@@ -437,9 +446,13 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
                             continue;
                         }
                         let mut p = [0.0; 2];
-                        p[0] = body.min[0] + (ci as f64 + 0.5) * spacing[0];
-                        if d == 2 {
-                            p[1] = body.min[1] + (cj as f64 + 0.5) * spacing[1];
+                        for (k, c) in [ci, cj].into_iter().enumerate().take(d) {
+                            let offset = if body.jitter > 0.0 {
+                                body.jitter * (2.0 * rng.next_f64() - 1.0)
+                            } else {
+                                0.0
+                            };
+                            p[k] = body.min[k] + (c as f64 + 0.5 + offset) * spacing[k];
                         }
                         lattice.positions.push(p);
                         lattice.volumes.push(volume);

@@ -13,6 +13,7 @@ mod project;
 mod reproduce;
 mod run;
 mod scenes;
+mod stability;
 mod table;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -81,6 +82,15 @@ enum Command {
     /// or one basis function.
     #[command(subcommand)]
     Basis(basis_cmd::BasisCommand),
+    /// The stability matrix: every case of scenes/stability with every mass strategy.
+    ///
+    /// Per case and strategy: stable or not (with the failure and its step, or the
+    /// bound the verdict broke), the error against the case's reference (or the
+    /// energy growth), the σ_yy roughness of the column cases, the largest
+    /// condition estimate, lumped rows and deactivated functions, and the wall time
+    /// per step. Cases run in parallel; every column but the wall time is the same
+    /// on any number of threads. See docs/stability.md.
+    Stability(stability::StabilityArgs),
 }
 
 fn main() -> ExitCode {
@@ -94,6 +104,7 @@ fn main() -> ExitCode {
         Command::Converge(args) => converge::converge(args),
         Command::Reproduce(args) => reproduce::run(args),
         Command::Basis(command) => basis_cmd::basis(command),
+        Command::Stability(args) => stability::stability(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

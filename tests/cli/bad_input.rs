@@ -410,7 +410,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .expect("material.young_modulus: unknown field `young_modulus`, expected one of `model`, `young`, `poisson`, `density`"),
         case("unknown-field-in-body", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, 4]\n@@speed = 1.0")
-            .expect("body[0].speed: unknown field `speed`, expected one of `min`, `max`, `per_block`, `count`"),
+            .expect("body[0].speed: unknown field `speed`, expected one of `min`, `max`, `per_block`, `count`, `jitter`, `seed`"),
         case("unknown-field-in-boundary", BAR)
             .edit("tag = \"right\"", "tag = \"right\"\n@@fixed = true")
             .expect("boundary[1].fixed: unknown field `fixed`, expected `tag` or `fix`"),
@@ -555,6 +555,16 @@ fn range_cases() -> Vec<Case> {
         case("nan-dt", BAR)
             .edit("dt = 1e-3", "dt = @@nan")
             .expect("time.dt: must be positive and finite, got NaN"),
+        case("jitter-one-half", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\njitter = @@0.5")
+            .expect(
+                "body[0].jitter: must be in [0, 0.5) (a fraction of the lattice cell), got 0.5",
+            ),
+        case("negative-jitter", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\njitter = @@-0.1")
+            .expect(
+                "body[0].jitter: must be in [0, 0.5) (a fraction of the lattice cell), got -0.1",
+            ),
         case("negative-courant", COLUMN)
             .edit("courant = 0.5", "courant = @@-0.5")
             .expect("time.courant: must be positive and finite, got -0.5"),
