@@ -431,7 +431,7 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
         let volume: f64 = spacing[..d].iter().product();
         // Jitter: a uniform offset in [-jitter, jitter) cells per axis, drawn in the
         // order the particles are made, from a generator seeded per body.
-        let mut rng = generators::SplitMix64(
+        let mut rng = psmpm_basis::rng::SplitMix64(
             body.seed
                 .unwrap_or(crate::scene::DEFAULT_JITTER_SEED)
                 .wrapping_add(b as u64),
