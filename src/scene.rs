@@ -46,7 +46,7 @@
 //! g = [0.0, -9.81]
 //!
 //! [time]
-//! dt = 1e-4                  # or courant = 0.5
+//! dt = 1e-4                  # or courant = 0.5 (fraction of the critical step)
 //! t_end = 1.0
 //!
 //! [reference]
@@ -394,9 +394,11 @@ pub struct TimeSpec {
     /// Time step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dt: Option<f64>,
-    /// Courant number `C`: `Δt = C h / c` with the P-wave speed `c = √((λ+2μ)/ρ)` and
-    /// `h` the smallest mesh edge (halved for PS, whose sub-triangles have about
-    /// half the edge).
+    /// Courant number `C` (in `(0, 1)` to be stable): `Δt = C Δt_crit`, the critical
+    /// step of the basis, mass strategy and material estimated at the start of the run
+    /// (power iteration on `M⁻¹K`, see `Driver::critical_time_step`), shortened so that
+    /// a whole number of steps ends exactly at `t_end`. The same `C` means the same
+    /// margin for PL and PS and for every mass strategy.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub courant: Option<f64>,
     /// End time.
@@ -1254,8 +1256,9 @@ impl Scene {
         })
     }
 
-    /// The time step: `dt`, or from the Courant number with the characteristic
-    /// length `h` (see [`TimeSpec::courant`]).
+    /// The time step `dt`, or with `courant` a mesh-based guess `C h / c` (P-wave
+    /// speed `c`, `h` halved for PS) used to set a run up and to estimate its cost;
+    /// the run itself takes `C Δt_crit` (see [`TimeSpec::courant`]).
     pub fn dt(&self, h: f64) -> f64 {
         match (self.time.dt, self.time.courant) {
             (Some(dt), _) => dt,

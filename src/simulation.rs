@@ -714,13 +714,14 @@ where
             })
         })
         .collect();
-    let dt = scene.dt(h);
+    // With `courant` the step is fixed below, from the critical step; this one
+    // (a mesh-based guess) only sets the driver up.
+    let mut dt = scene.dt(h);
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(RunError::Setup(format!(
             "time: the time step {dt} is not positive"
         )));
     }
-    let steps = (scene.time.t_end / dt).round().max(1.0) as usize;
     let functions = basis.num_functions();
     let mut driver: Driver<f64, D, B, Box<dyn MassStrategy<f64>>, AnyMaterial> =
         Driver::new(
@@ -756,6 +757,22 @@ where
         driver.add_slip_wall(tag, &n)?;
     }
 
+    // The critical step at the start (a failure here is the failure of step 1,
+    // reported by the first step itself).
+    let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
+    let steps = match scene.time.courant {
+        // Courant number of the critical step, rounded so that the run ends at t_end.
+        Some(c) => {
+            let steps = (scene.time.t_end / (c * dt_critical.unwrap_or(dt / c)))
+                .ceil()
+                .max(1.0) as usize;
+            dt = scene.time.t_end / steps as f64;
+            driver.set_dt(dt);
+            steps
+        }
+        None => (scene.time.t_end / dt).round().max(1.0) as usize,
+    };
+
     let mut tracked: Vec<Tracked> = scene
         .output
         .tracked
@@ -780,9 +797,6 @@ where
         })
         .collect();
 
-    // The critical step at the start (a failure here is the failure of step 1,
-    // reported by the first step itself).
-    let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
     let start = driver.report();
     // The initial state (step 0); the public entry points other than
     // `observe_2d`/`observe_1d` pass only steps > 0 on.

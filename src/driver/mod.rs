@@ -294,6 +294,10 @@ where
     pub fn dt(&self) -> f64 {
         self.dt.to_f64()
     }
+    /// Changes the time step (e.g. to a fraction of [`Driver::critical_time_step`]).
+    pub fn set_dt(&mut self, dt: f64) {
+        self.dt = T::of(dt);
+    }
     /// The material.
     pub fn material(&self) -> &Mat {
         &self.material
