@@ -19,10 +19,13 @@
 //!
 //! The reduced system changes pattern whenever the set of extended functions
 //! does, so it is solved matrix-free by conjugate gradients with a Jacobi
-//! preconditioner (`Eᵀ M E` applied as three sparse products); it needs no
-//! factorisation and its condition is bounded by the coverage threshold.
+//! preconditioner (`Eᵀ M E` applied as three sparse products over the functions
+//! with particles); it needs no factorisation and its condition is bounded by the
+//! coverage threshold. In a step where nothing is extended the system is `M` and
+//! is solved exactly as the consistent strategy solves it (sparse Cholesky).
 
 use super::condition::lanczos_estimate;
+use super::masked::MaskedCholesky;
 use super::{
     distinct_fixed_sets, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext,
     SupportFacts,
@@ -260,6 +263,10 @@ pub struct Extended<T: Scalar> {
     ext_w: Vec<T>,
     /// Jacobi preconditioner per fixed set.
     precond: Vec<Vec<T>>,
+    /// The consistent solve, for the steps in which nothing is extended.
+    cholesky: MaskedCholesky<T>,
+    /// This step is solved by `cholesky` (nothing extended, factor exists).
+    direct: bool,
     scratch: Scratch<T>,
     /// Buffers of the condition estimate.
     estimate: [Vec<T>; 5],
@@ -292,6 +299,8 @@ impl<T: Scalar> Extended<T> {
             ext_idx: Vec::new(),
             ext_w: Vec::new(),
             precond: Vec::new(),
+            cholesky: MaskedCholesky::default(),
+            direct: false,
             scratch: Scratch::default(),
             estimate: Default::default(),
             rhs: Vec::new(),
@@ -518,6 +527,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         let n = pattern.dim();
         let (distinct, solver_of) = distinct_fixed_sets(setup.fixed);
         self.precond = distinct.iter().map(|_| vec![T::zero(); n]).collect();
+        self.cholesky.prepare(setup);
         self.fixed = distinct;
         self.solver_of = solver_of;
         self.support = setup
@@ -638,9 +648,22 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             }
             self.precond[s] = precond;
         }
+        // Nothing extended: `E = I`, the consistent system, solved as the
+        // consistent strategy solves it (bit for bit).
+        self.direct = false;
+        if self.extended.is_empty() {
+            for i in 0..n {
+                self.cholesky.inactive[i] = self.role[i] == Role::Inactive;
+                self.cholesky.lumped[i] = false;
+            }
+            self.direct = self.cholesky.factorize(pattern, values).is_ok();
+        }
         Ok(report)
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
+        if self.direct {
+            return self.cholesky.solve(k, rhs);
+        }
         let s = self.solver_of[k];
         let mut b = std::mem::take(&mut self.rhs);
         let mut scratch = std::mem::take(&mut self.scratch);
@@ -659,7 +682,10 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         result.map(|_| ())
     }
     /// `κ(Eᵀ M E)` on the solved functions, from Lanczos steps (no solves).
-    fn condition_estimate(&mut self, _pattern: &SymmetricPattern) -> f64 {
+    fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
+        if self.direct {
+            return self.cholesky.condition_estimate(pattern);
+        }
         let mut worst = 0.0f64;
         let [mut u, mut w, mut x, mut q, mut y] = std::mem::take(&mut self.estimate);
         for v in [&mut u, &mut w, &mut q, &mut y] {
