@@ -26,28 +26,7 @@ where
     /// step's own buffers; call before a step (e.g. at the start of a run).
     pub fn critical_time_step(&mut self) -> Result<f64, StepError> {
         self.locate_and_evaluate()?;
-        phases::assemble_mass_and_internal_force(
-            &self.pattern,
-            &self.particles,
-            &self.evals,
-            &mut self.values,
-            &mut self.rhs,
-        );
-        if self.inputs.needs.empty_elements {
-            phases::mark_empty_elements(
-                &self.basis,
-                &self.particles.element,
-                &mut self.inputs.occupied,
-                &mut self.inputs.touches_empty,
-            );
-        }
-        if self.inputs.needs.coverage {
-            phases::particle_volume(
-                &self.evals,
-                &self.particles.volume,
-                &mut self.inputs.particle_volume,
-            );
-        }
+        self.assemble_mass();
         self.factorize()?;
         let (lambda, mu) = self.material.elastic().lame(D);
         let n = self.basis.num_functions();

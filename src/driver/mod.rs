@@ -371,9 +371,9 @@ where
         })
     }
 
-    /// Phase 2: `M`, `F = −F^int + effects` into `rhs`, and the facts the mass
-    /// strategy asked for.
-    fn assemble(&mut self) {
+    /// Phase 2a: `M`, `F = −F^int` into `rhs`, and the facts the mass strategy
+    /// asked for.
+    fn assemble_mass(&mut self) {
         phases::assemble_mass_and_internal_force(
             &self.pattern,
             &self.particles,
@@ -396,6 +396,12 @@ where
                 &mut self.inputs.particle_volume,
             );
         }
+    }
+
+    /// Phase 2: [`assemble_mass`](Self::assemble_mass), then the effects' forces
+    /// into `rhs`.
+    fn assemble(&mut self) {
+        self.assemble_mass();
         if self.effects.is_empty() {
             return;
         }
