@@ -63,6 +63,7 @@ pub mod material;
 pub mod output;
 pub mod particles;
 pub mod scene;
+pub mod setup;
 pub mod simulation;
 pub mod sparse;
 pub mod studies;
