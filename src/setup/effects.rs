@@ -1,6 +1,6 @@
 //! The effects a scene declares, built for its particles.
 
-use super::{from_vec, to_vec, Solution};
+use super::Solution;
 use crate::effect::{BodyForce, Effect, Gravity, LocalDamping, Traction};
 use crate::particles::Particles;
 use crate::scene::{EffectSpec, Scene};
@@ -43,25 +43,16 @@ pub fn build_effects<const D: usize>(
                     ramp: *ramp,
                 }));
             }
-            EffectSpec::BodyForce { value } => {
-                let b = SVector::<f64, D>::from_fn(|k, _| value[k]);
-                effects.push(Box::new(BodyForce {
-                    label: "body-force",
-                    field: Box::new(move |_, _| b),
-                }));
-            }
+            EffectSpec::BodyForce { value } => effects.push(Box::new(BodyForce::Uniform(
+                SVector::<f64, D>::from_fn(|k, _| value[k]),
+            ))),
             EffectSpec::ManufacturedBodyForce {} => {
                 let Some(Solution::AxisAligned(a)) = solution else {
                     return Err(RunError::Setup(format!(
                         "effect[{i}].kind: `manufactured-body-force` needs reference kind `axis-aligned`"
                     )));
                 };
-                effects.push(Box::new(BodyForce {
-                    label: "manufactured-body-force",
-                    field: Box::new(move |x0: &SVector<f64, D>, t| {
-                        to_vec::<D>(a.body_force(from_vec(x0), t))
-                    }),
-                }));
+                effects.push(Box::new(BodyForce::Manufactured(a)));
             }
             // An initial state, not an effect: `particles::apply_initial_states`.
             EffectSpec::GeostaticStress { .. } => {}
