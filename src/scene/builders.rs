@@ -65,7 +65,7 @@ impl Scene {
         Ok(s)
     }
 
-    /// The scene refined `level` times as [`StudySpec`] says, validated.
+    /// The scene refined `level` times as [`StudySpec`](super::StudySpec) says, validated.
     pub fn refined(&self, level: u32) -> Result<Scene, SceneError> {
         let mut s = self.clone();
         let factor = 1usize

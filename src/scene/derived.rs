@@ -37,7 +37,7 @@ impl Scene {
 
     /// The time step `dt`, or with `courant` a mesh-based guess `C h / c` (P-wave
     /// speed `c`, `h` halved for PS) used to set a run up and to estimate its cost;
-    /// the run itself takes `C Δt_crit` (see [`TimeSpec::courant`]).
+    /// the run itself takes `C Δt_crit` (see [`TimeSpec::courant`](super::TimeSpec::courant)).
     pub fn dt(&self, h: f64) -> f64 {
         match (self.time.dt, self.time.courant) {
             (Some(dt), _) => dt,
