@@ -19,6 +19,7 @@
 
 use crate::particles::Particles;
 use crate::sparse::Scalar;
+use crate::studies::exact::AxisAligned;
 use nalgebra::{SMatrix, SVector};
 
 /// Basis values of every particle at the start of a step, as the driver evaluated
@@ -118,23 +119,51 @@ impl<T: Scalar, const D: usize> Effect<T, D> for Gravity<T, D> {
     }
 }
 
-/// A body-force field `b(x⁰, t)` per unit mass.
-pub type ForceField<T, const D: usize> =
-    Box<dyn Fn(&SVector<T, D>, f64) -> SVector<T, D> + Send + Sync>;
-
 /// A prescribed body force per unit mass `b(x⁰, t)`, evaluated at each particle's
 /// reference position and the start-of-step time: `F_{k,i} = Σ_p m_p phi_i(x_p) b_k`
-/// (paper eq. (16)); used for manufactured solutions (paper eqs. (42)–(46)).
-pub struct BodyForce<T: Scalar, const D: usize> {
-    /// Name for output.
-    pub label: &'static str,
-    /// The field `b(x⁰, t)`.
-    pub field: ForceField<T, D>,
+/// (paper eq. (16)). The fields a scene can declare, chosen by a `match` once per
+/// step (no call through a pointer per particle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BodyForce<T: Scalar, const D: usize> {
+    /// The same force everywhere, at all times.
+    Uniform(SVector<T, D>),
+    /// The body force that makes the B4 manufactured solution exact (paper eqs.
+    /// (42)–(46)): [`AxisAligned::body_force`].
+    Manufactured(AxisAligned),
+}
+
+impl<T: Scalar, const D: usize> BodyForce<T, D> {
+    /// `b(x⁰, t)`.
+    #[inline]
+    pub fn at(&self, x0: &SVector<T, D>, t: f64) -> SVector<T, D> {
+        match self {
+            BodyForce::Uniform(b) => *b,
+            BodyForce::Manufactured(a) => manufactured(a, x0, t),
+        }
+    }
+}
+
+/// [`AxisAligned::body_force`] at `x0` (the second coordinate 0 in 1D).
+#[inline]
+fn manufactured<T: Scalar, const D: usize>(
+    a: &AxisAligned,
+    x0: &SVector<T, D>,
+    t: f64,
+) -> SVector<T, D> {
+    let mut p = [0.0; 2];
+    for k in 0..D {
+        p[k] = x0[k].to_f64();
+    }
+    let b = a.body_force(p, t);
+    SVector::<T, D>::from_fn(|k, _| T::of(b[k]))
 }
 
 impl<T: Scalar, const D: usize> Effect<T, D> for BodyForce<T, D> {
     fn name(&self) -> &'static str {
-        self.label
+        match self {
+            BodyForce::Uniform(_) => "body-force",
+            BodyForce::Manufactured(_) => "manufactured-body-force",
+        }
     }
     fn add_forces(
         &self,
@@ -142,9 +171,18 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyForce<T, D> {
         state: &StepState<T, D>,
         forces: &mut [Vec<T>],
     ) {
-        for p in 0..particles.len() {
-            let b = (self.field)(&particles.x0[p], state.time);
-            state.basis.scatter(p, &(b * particles.mass[p]), forces);
+        match self {
+            BodyForce::Uniform(b) => {
+                for p in 0..particles.len() {
+                    state.basis.scatter(p, &(*b * particles.mass[p]), forces);
+                }
+            }
+            BodyForce::Manufactured(a) => {
+                for p in 0..particles.len() {
+                    let b = manufactured(a, &particles.x0[p], state.time);
+                    state.basis.scatter(p, &(b * particles.mass[p]), forces);
+                }
+            }
         }
     }
     fn does_work(&self) -> bool {

@@ -9,9 +9,14 @@
 //!   (symbolic once, numeric per call);
 //! - [`driver`]: the MPM time step, generic over basis, [`mass`] strategy and
 //!   [`material`]; [`particles`]; [`effect`]s (gravity, local damping, traction,
-//!   body forces, initial stress) with their work in the energy balance;
-//! - [`scene`]: a run declared as data (TOML), and the built-in scenes;
-//!   [`simulation`]: building and running a scene, its summary and stability verdict;
+//!   body-force fields) with their work in the energy balance, and initial stress
+//!   states;
+//! - [`scene`]: a run declared as data (TOML): the schema, validation, the location
+//!   of errors in the file, and the built-in scenes;
+//! - [`setup`]: a scene turned into mesh, basis, particles with their initial states
+//!   (velocity, geostatic stress), effects and the one concrete driver;
+//!   [`simulation`]: the run loop with its observers, the summary and stability
+//!   verdict;
 //! - [`studies`]: the checks of the method, apart from it: the seeds' exact solutions
 //!   ([`studies::exact`]), the 1D updated-Lagrangian FEM reference ([`studies::ulfem`]),
 //!   L² projection onto a basis, benchmark B1 ([`studies::projection`]), and the
@@ -63,6 +68,7 @@ pub mod material;
 pub mod output;
 pub mod particles;
 pub mod scene;
+pub mod setup;
 pub mod simulation;
 pub mod sparse;
 pub mod studies;

@@ -1,5 +1,6 @@
-//! Running a [`Scene`]: build its mesh, basis, particles, effects and driver, step to
-//! the end time, and measure the error against the scene's reference solution.
+//! Running a [`Scene`]: set it up ([`crate::setup`]: mesh, basis, particles, effects,
+//! driver), step to the end time, and measure the error against the scene's reference
+//! solution.
 //!
 //! The run reports every step through a callback (the CLI prints from it, tests read
 //! the same values) and ends with a [`Summary`]. A run that fails numerically (a
@@ -14,25 +15,15 @@
 //! scale, and every condition estimate (when requested) stays below
 //! [`STABLE_CONDITION`].
 
-use crate::bases::BasisKind;
-use crate::driver::{Driver, Fix, PhaseTimes, SetupError, StepError, StepReport};
-use crate::effect::{BodyForce, Effect, Geostatic, Gravity, InitialStress, LocalDamping, Traction};
-use crate::mass::MassStrategy;
-use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
+use crate::driver::{PhaseTimes, SetupError, StepError, StepReport};
 use crate::particles::Particles;
-use crate::scene::{
-    BlockLayout, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference, Scene,
-};
+use crate::scene::Scene;
+use crate::setup::{self, from_vec, Basis1d, Basis2d, Domain, Prepared, Solution};
 use crate::studies::exact;
-use nalgebra::{SMatrix, SVector};
-use psmpm_basis::basis::bspline1d::QuadraticBSpline;
-use psmpm_basis::basis::linear::Linear;
-use psmpm_basis::basis::linear1d::Linear1d;
-use psmpm_basis::basis::powell_sabin::PowellSabin;
-use psmpm_basis::mesh::generators::{self, PolygonDomain};
-use psmpm_basis::{Basis, Mesh1d, TriMesh, Vec2};
+use psmpm_basis::Basis;
 use serde::Serialize;
-use std::f64::consts::PI;
+
+pub use crate::setup::{build_effects, particle_lattice, triangulation, Lattice};
 
 /// Energy growth (relative to the energy scale) above which a run is unstable.
 pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
@@ -90,7 +81,7 @@ pub struct Summary {
     /// Most functions the extension expressed through their neighbours in a step.
     pub max_extended: usize,
     /// The critical time step of the basis, mass strategy and material at the start
-    /// ([`Driver::critical_time_step`]), when it could be estimated.
+    /// ([`crate::driver::Driver::critical_time_step`]), when it could be estimated.
     pub dt_critical: Option<f64>,
     /// Largest condition-number estimate (when requested).
     pub max_condition: Option<f64>,
@@ -202,118 +193,6 @@ pub fn observe_1d(scene: &Scene, observer: &mut Observer) -> Result<Outcome<1>, 
     run_1d_observed(scene, observer)
 }
 
-/// The mesh of a 2D scene and its smallest edge length.
-pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
-    let mesh = match &scene.mesh {
-        MeshSpec::Blocks {
-            x,
-            y,
-            blocks,
-            layout,
-        } => match layout {
-            BlockLayout::FourTriangles => {
-                generators::block_grid(x[0], x[1], y[0], y[1], blocks[0], blocks[1])
-            }
-            BlockLayout::Delaunay => {
-                generators::block_delaunay(x[0], x[1], y[0], y[1], blocks[0], blocks[1])
-            }
-        }
-        .map_err(|e| RunError::Setup(format!("mesh: {e}")))?,
-        MeshSpec::Polygon {
-            outline,
-            tags,
-            holes,
-            edge_length,
-        } => {
-            let points = |o: &[[f64; 2]]| o.iter().map(|p| Vec2::new(p[0], p[1])).collect();
-            let domain = PolygonDomain {
-                outer: points(outline),
-                outer_tags: if tags.is_empty() {
-                    vec!["boundary".to_string(); outline.len()]
-                } else {
-                    tags.clone()
-                },
-                holes: holes
-                    .iter()
-                    .map(|h| (points(&h.outline), h.tag.clone()))
-                    .collect(),
-            };
-            generators::polygon_mesh(&domain, *edge_length).map_err(|e| {
-                let e = e.to_string();
-                let field = if e.contains("edge_length") {
-                    "mesh.edge_length"
-                } else {
-                    "mesh.outline"
-                };
-                RunError::Setup(format!("{field}: {e}"))
-            })?
-        }
-        MeshSpec::Gmsh { file } => psmpm_basis::mesh::gmsh::read_msh(std::path::Path::new(file))
-            .map_err(|e| RunError::Setup(format!("mesh.file: {e}")))?,
-        MeshSpec::Interval { .. } => {
-            return Err(RunError::Setup("mesh.kind: `interval` is a 1D mesh".into()))
-        }
-    };
-    Ok(mesh)
-}
-
-/// Every boundary condition names a tag of the mesh.
-fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
-    for (b, bc) in scene.boundaries.iter().enumerate() {
-        if !tags.contains(&bc.tag) {
-            return Err(RunError::Setup(format!(
-                "boundary[{b}].tag: unknown boundary tag `{}`; the mesh has tags {tags:?}",
-                bc.tag
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// The unit normal of every slip wall (`fix = ["normal"]`): the boundary edges with
-/// the wall's tag must all be parallel (a straight wall).
-fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>, RunError> {
-    let mut walls = Vec::new();
-    for (b, bc) in scene.boundaries.iter().enumerate() {
-        if !bc.fix.contains(&Component::Normal) {
-            continue;
-        }
-        let id = mesh
-            .tag_id(&bc.tag)
-            .map_err(|e| RunError::Setup(format!("boundary[{b}].tag: {e}")))?;
-        let mut normal: Option<Vec2> = None;
-        for e in mesh.edges().iter().filter(|e| e.tag == Some(id)) {
-            let d = mesh.vertices()[e.vertices[1]] - mesh.vertices()[e.vertices[0]];
-            let n = Vec2::new(d[1], -d[0]).normalize();
-            match normal {
-                None => normal = Some(n),
-                Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > 1e-9 => {
-                    return Err(RunError::Setup(format!(
-                        "boundary[{b}].fix: `normal` needs a straight wall, but `{}` bends",
-                        bc.tag
-                    )))
-                }
-                Some(_) => {}
-            }
-        }
-        let n = normal.ok_or_else(|| {
-            RunError::Setup(format!(
-                "boundary[{b}].tag: `{}` has no boundary edge",
-                bc.tag
-            ))
-        })?;
-        walls.push((bc.tag.clone(), [n[0], n[1]]));
-    }
-    Ok(walls)
-}
-
-fn smallest_edge(mesh: &TriMesh) -> f64 {
-    mesh.edges()
-        .iter()
-        .map(|e| (mesh.vertices()[e.vertices[0]] - mesh.vertices()[e.vertices[1]]).norm())
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// Runs a 2D scene and returns its particles too.
 pub fn run_2d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<2>, RunError> {
     run_2d_observed(scene, &mut |r, _| {
@@ -333,447 +212,58 @@ pub fn run_1d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Out
 }
 
 fn run_2d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<2>, RunError> {
-    scene.validate()?;
-    if scene.dim != 2 {
-        return Err(RunError::Setup(format!("dim: the scene is {}D", scene.dim)));
-    }
-    let mesh = triangulation(scene)?;
-    let h = smallest_edge(&mesh);
-    check_tags(scene, mesh.tags())?;
-    let walls = wall_normals(scene, &mesh)?;
-    match scene.basis {
-        BasisKind::Ps => {
-            let b = PowellSabin::<f64>::new(mesh, scene.split)
-                .map_err(|e| RunError::Setup(format!("basis: {e}")))?;
-            dispatch_mass::<2, _>(scene, b, h, &walls, on_step)
-        }
-        _ => dispatch_mass::<2, _>(scene, Linear::<f64>::new(mesh), h, &walls, on_step),
+    let Domain { basis, h, walls } = setup::domain_2d(scene)?;
+    match basis {
+        Basis2d::Ps(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
+        Basis2d::Linear(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
     }
 }
 
 fn run_1d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<1>, RunError> {
-    scene.validate()?;
-    let MeshSpec::Interval { x, elements } = scene.mesh else {
-        return Err(RunError::Setup(
-            "mesh.kind: a 1D scene needs an `interval` mesh".into(),
-        ));
-    };
-    let mesh =
-        Mesh1d::uniform(x[0], x[1], elements).map_err(|e| RunError::Setup(format!("mesh: {e}")))?;
-    let h = (x[1] - x[0]) / elements as f64;
-    // In 1D the normal of a wall is the axis.
-    check_tags(scene, &mesh.tags().map(String::from))?;
-    let walls: Vec<(String, [f64; 2])> = scene
-        .boundaries
-        .iter()
-        .filter(|bc| bc.fix.contains(&Component::Normal))
-        .map(|bc| (bc.tag.clone(), [1.0, 0.0]))
-        .collect();
-    match scene.basis {
-        BasisKind::Bspline => dispatch_mass::<1, _>(
-            scene,
-            QuadraticBSpline::<f64>::new(mesh),
-            h,
-            &walls,
-            on_step,
-        ),
-        _ => dispatch_mass::<1, _>(scene, Linear1d::<f64>::new(mesh), h, &walls, on_step),
+    let Domain { basis, h, walls } = setup::domain_1d(scene)?;
+    match basis {
+        Basis1d::Bspline(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
+        Basis1d::Linear(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
     }
 }
 
-fn dispatch_mass<const D: usize, B: Basis<f64, D>>(
-    scene: &Scene,
-    basis: B,
-    h: f64,
-    walls: &[(String, [f64; 2])],
-    on_step: &mut Observer,
-) -> Result<Outcome<D>, RunError>
-where
-    Particles<f64, D>: AsParticlesRef,
-{
-    run_with::<D, B>(scene, basis, h, walls, on_step)
-}
-
-/// Particle positions and volumes of the scene's bodies, block by block for
-/// `per_block` layouts (the order of the seeds' codes), row by row otherwise; a
-/// body's `jitter` moves each particle inside its cell (deterministic, see
-/// [`crate::scene::Body::jitter`]).
-pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
-    let d = scene.dim;
-    let mut lattice = Lattice::default();
-    for (b, body) in scene.bodies.iter().enumerate() {
-        let first = lattice.positions.len();
-        let mut spacing = [1.0; 2];
-        let mut cells = [1usize; 2];
-        let mut group = [1usize; 2];
-        for k in 0..d {
-            let extent = body.max[k] - body.min[k];
-            let h = scene.lattice_spacing(body, k).ok_or_else(|| {
-                RunError::Setup(format!("body[{b}].per_block: the mesh has no blocks"))
-            })?;
-            let n = if let Some(per) = &body.per_block {
-                let n = extent / h;
-                if (n - n.round()).abs() > 1e-6 * n.max(1.0) || n.round() < 1.0 {
-                    return Err(RunError::Setup(format!(
-                        "body[{b}].max: the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h}"
-                    )));
-                }
-                group[k] = per[k];
-                n.round() as usize
-            } else {
-                let c = body.count.as_ref().map_or(1, |c| c[k]);
-                group[k] = c;
-                c
-            };
-            spacing[k] = h;
-            cells[k] = n;
-        }
-        let volume: f64 = spacing[..d].iter().product();
-        // Jitter: a uniform offset in [-jitter, jitter) cells per axis, drawn in the
-        // order the particles are made, from a generator seeded per body.
-        let mut rng = psmpm_basis::rng::SplitMix64(
-            body.seed
-                .unwrap_or(crate::scene::DEFAULT_JITTER_SEED)
-                .wrapping_add(b as u64),
-        );
-        let groups = [cells[0].div_ceil(group[0]), cells[1].div_ceil(group[1])];
-        for gj in 0..groups[1] {
-            for gi in 0..groups[0] {
-                for j in 0..group[1] {
-                    for i in 0..group[0] {
-                        let (ci, cj) = (gi * group[0] + i, gj * group[1] + j);
-                        if ci >= cells[0] || cj >= cells[1] {
-                            continue;
-                        }
-                        let mut p = [0.0; 2];
-                        for (k, c) in [ci, cj].into_iter().enumerate().take(d) {
-                            let offset = if body.jitter > 0.0 {
-                                body.jitter * (2.0 * rng.next_f64() - 1.0)
-                            } else {
-                                0.0
-                            };
-                            p[k] = body.min[k] + (c as f64 + 0.5 + offset) * spacing[k];
-                        }
-                        lattice.positions.push(p);
-                        lattice.volumes.push(volume);
-                    }
-                }
-            }
-        }
-        lattice.body_sizes.push(lattice.positions.len() - first);
-    }
-    Ok(lattice)
-}
-
-/// The particles of a scene's bodies before the run: positions, volumes, and how
-/// many belong to each body (bodies in order).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Lattice {
-    /// Positions (the second entry is 0 in 1D).
-    pub positions: Vec<[f64; 2]>,
-    /// Volumes.
-    pub volumes: Vec<f64>,
-    /// Particles per body.
-    pub body_sizes: Vec<usize>,
-}
-
-fn to_vec<const D: usize>(p: [f64; 2]) -> SVector<f64, D> {
-    SVector::<f64, D>::from_fn(|k, _| p[k])
-}
-
-fn from_vec<const D: usize>(v: &SVector<f64, D>) -> [f64; 2] {
-    let mut p = [0.0; 2];
-    for k in 0..D {
-        p[k] = v[k];
-    }
-    p
-}
-
-/// The scene's reference solution with its parameters resolved.
-#[derive(Debug, Clone, Copy)]
-enum Solution {
-    Bar(exact::VibratingBar),
-    Column(exact::ColumnSelfWeight),
-    AxisAligned(exact::AxisAligned),
-    Equilibrium {
-        height: f64,
-        density: f64,
-        gravity: f64,
-        young: f64,
-    },
-}
-
-impl Solution {
-    fn new(scene: &Scene) -> Option<Self> {
-        let m = &scene.material;
-        let body = &scene.bodies[0];
-        let d = scene.dim;
-        let gravity = scene.gravity().map_or(0.0, |g| g[d - 1]);
-        Some(match scene.reference? {
-            Reference::VibratingBar { v0 } => Solution::Bar(exact::VibratingBar {
-                length: body.max[0] - body.min[0],
-                young: m.young,
-                density: m.density,
-                v0,
-            }),
-            Reference::ColumnSelfWeight {} => Solution::Column(exact::ColumnSelfWeight {
-                height: body.max[d - 1] - body.min[d - 1],
-                young: m.young,
-                density: m.density,
-                gravity,
-            }),
-            Reference::AxisAligned { u0 } => Solution::AxisAligned(exact::AxisAligned {
-                u0,
-                young: m.young,
-                poisson: m.poisson,
-                density: m.density,
-            }),
-            Reference::ColumnEquilibrium {} => Solution::Equilibrium {
-                height: body.max[d - 1] - body.min[d - 1],
-                density: m.density,
-                gravity,
-                young: m.young,
-            },
-        })
-    }
-
-    /// Exact displacement at reference position `x0` (relative to the body's
-    /// lower corner `origin`) and time `t`, in the scene's dimension.
-    fn displacement(&self, x0: [f64; 2], origin: [f64; 2], dim: usize, t: f64) -> [f64; 2] {
-        match self {
-            Solution::Bar(bar) => [bar.displacement(x0[0] - origin[0], t), 0.0],
-            Solution::Column(column) => {
-                let u = column.displacement(x0[dim - 1] - origin[dim - 1], t);
-                if dim == 1 {
-                    [u, 0.0]
-                } else {
-                    [0.0, u]
-                }
-            }
-            Solution::AxisAligned(a) => a.displacement(x0, t),
-            Solution::Equilibrium { .. } => [0.0; 2],
-        }
-    }
-
-    fn velocity(&self, x0: [f64; 2], origin: [f64; 2], dim: usize, t: f64) -> [f64; 2] {
-        match self {
-            Solution::Bar(bar) => [bar.velocity(x0[0] - origin[0], t), 0.0],
-            Solution::AxisAligned(a) => a.velocity(x0, t),
-            Solution::Column(column) => {
-                let v = column.velocity(x0[dim - 1] - origin[dim - 1], t);
-                if dim == 1 {
-                    [v, 0.0]
-                } else {
-                    [0.0, v]
-                }
-            }
-            Solution::Equilibrium { .. } => [0.0; 2],
-        }
-    }
-}
-
-/// The effects `scene` declares, built for `particles` (traction selects its
-/// particles here). Only these are assembled in a run.
-pub fn build_effects<const D: usize>(
-    scene: &Scene,
-    particles: &Particles<f64, D>,
-) -> Result<Vec<Box<dyn Effect<f64, D>>>, RunError> {
-    let solution = Solution::new(scene);
-    let mut effects: Vec<Box<dyn Effect<f64, D>>> = Vec::new();
-    for (i, spec) in scene.effects.iter().enumerate() {
-        match spec {
-            EffectSpec::Gravity { g } => effects.push(Box::new(Gravity {
-                g: SVector::<f64, D>::from_fn(|k, _| g[k]),
-            })),
-            EffectSpec::Damping { alpha } => effects.push(Box::new(LocalDamping { alpha: *alpha })),
-            EffectSpec::Traction {
-                min,
-                max,
-                traction,
-                length,
-                ramp,
-            } => {
-                let selected: Vec<usize> = (0..particles.len())
-                    .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
-                    .collect();
-                if selected.is_empty() {
-                    return Err(RunError::Setup(format!(
-                        "effect[{i}].min: the traction box selects no particle"
-                    )));
-                }
-                let share = length / selected.len() as f64;
-                effects.push(Box::new(Traction {
-                    particles: selected,
-                    force: SVector::<f64, D>::from_fn(|k, _| traction[k] * share),
-                    ramp: *ramp,
-                }));
-            }
-            EffectSpec::BodyForce { value } => {
-                let b = SVector::<f64, D>::from_fn(|k, _| value[k]);
-                effects.push(Box::new(BodyForce {
-                    label: "body-force",
-                    field: Box::new(move |_, _| b),
-                }));
-            }
-            EffectSpec::ManufacturedBodyForce {} => {
-                let Some(Solution::AxisAligned(a)) = solution else {
-                    return Err(RunError::Setup(format!(
-                        "effect[{i}].kind: `manufactured-body-force` needs reference kind `axis-aligned`"
-                    )));
-                };
-                effects.push(Box::new(BodyForce {
-                    label: "manufactured-body-force",
-                    field: Box::new(move |x0: &SVector<f64, D>, t| {
-                        to_vec::<D>(a.body_force(from_vec(x0), t))
-                    }),
-                }));
-            }
-            EffectSpec::GeostaticStress { .. } => {} // set up on the particles
-        }
-    }
-    Ok(effects)
-}
-
+/// Set up, step, summarise.
 fn run_with<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
-    basis: B,
-    h: f64,
-    walls: &[(String, [f64; 2])],
+    domain: Domain<B>,
     on_step: &mut Observer,
 ) -> Result<Outcome<D>, RunError>
 where
     Particles<f64, D>: AsParticlesRef,
 {
-    let m = &scene.material;
-    let elastic = Elastic::new(m.young, m.poisson, m.density)
-        .map_err(|e| RunError::Setup(format!("material: {e}")))?;
-    let material = match m.model {
-        MaterialModel::LinearElastic => AnyMaterial::Linear(LinearElastic::new(elastic, D)),
-        MaterialModel::NeoHookean => AnyMaterial::NeoHookean(NeoHookean::new(elastic, D)),
-    };
-    let solution = Solution::new(scene);
-    let origin = {
-        let mut o = [0.0; 2];
-        o[..D].copy_from_slice(&scene.bodies[0].min[..D]);
-        o
-    };
-    let Lattice {
-        positions,
-        volumes,
-        body_sizes,
-    } = particle_lattice(scene)?;
-    let mut particles = Particles::<f64, D>::new(
-        positions.iter().map(|&p| to_vec::<D>(p)).collect(),
-        volumes,
-        elastic.density,
-    );
-    for (p, &x0) in positions.iter().enumerate() {
-        let v = match &scene.initial_velocity {
-            InitialVelocity::Rest {} => [0.0; 2],
-            InitialVelocity::Uniform { value } => {
-                let mut v = [0.0; 2];
-                v[..D].copy_from_slice(&value[..D]);
-                v
-            }
-            InitialVelocity::SineMode { v0 } => {
-                let body = &scene.bodies[0];
-                let length = body.max[0] - body.min[0];
-                [v0 * (PI * (x0[0] - body.min[0]) / length).sin(), 0.0]
-            }
-            InitialVelocity::Exact {} => {
-                solution.map_or([0.0; 2], |s| s.velocity(x0, origin, D, 0.0))
-            }
-        };
-        particles.v[p] = to_vec::<D>(v);
-    }
-    for spec in &scene.effects {
-        if let EffectSpec::GeostaticStress { surface, k0 } = spec {
-            let g = scene.gravity().map_or(0.0, |g| g[D - 1]);
-            let state = Geostatic {
-                surface: *surface,
-                density: elastic.density,
-                gravity: g,
-                k0: *k0,
-            };
-            for p in 0..particles.len() {
-                let s: SMatrix<f64, D, D> = state.sigma0(&particles.x0[p]);
-                particles.sigma0[p] += s;
-            }
-        }
-    }
-    let effects = build_effects(scene, &particles)?;
-    let fixes: Vec<Fix> = scene
-        .boundaries
-        .iter()
-        .flat_map(|bc| {
-            bc.fix.iter().filter_map(|c| {
-                c.axis().map(|component| Fix {
-                    tag: bc.tag.clone(),
-                    component,
-                })
-            })
-        })
-        .collect();
-    // With `courant` the step is fixed below, from the critical step; this one
-    // (a mesh-based guess) only sets the driver up.
-    let mut dt = scene.dt(h);
-    if !(dt > 0.0 && dt.is_finite()) {
-        return Err(RunError::Setup(format!(
-            "time: the time step {dt} is not positive"
-        )));
-    }
-    let functions = basis.num_functions();
-    let mut driver: Driver<f64, D, B, Box<dyn MassStrategy<f64>>, AnyMaterial> =
-        Driver::new(
-            basis,
-            particles,
-            material,
-            scene.mass.build::<f64>(),
-            &fixes,
-            effects,
-            dt,
-        ).map_err(
-            |e| match e {
-                SetupError::ParticleOutside { particle, position } => {
-                    // Name the body the particle belongs to.
-                    let mut first = 0;
-                    let body = body_sizes
-                        .iter()
-                        .position(|&n| {
-                            first += n;
-                            particle < first
-                        })
-                        .unwrap_or(0);
-                    RunError::Setup(format!(
-                        "body[{body}].max: the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"
-                    ))
-                }
-                other => other.into(),
-            },
-        )?;
-    driver.estimate_condition = scene.output.condition;
-    for (tag, normal) in walls {
-        let n = SVector::<f64, D>::from_fn(|k, _| normal[k]);
-        driver.add_slip_wall(tag, &n)?;
-    }
+    let mut run = setup::set_up::<D, B>(scene, domain)?;
+    let tally = step_loop(scene, &mut run, on_step);
+    Ok(summarise(scene, run, tally))
+}
 
-    // The critical step at the start (a failure here is the failure of step 1,
-    // reported by the first step itself).
-    let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
-    let steps = match scene.time.courant {
-        // Courant number of the critical step, rounded so that the run ends at t_end.
-        Some(c) => {
-            let steps = (scene.time.t_end / (c * dt_critical.unwrap_or(dt / c)))
-                .ceil()
-                .max(1.0) as usize;
-            dt = scene.time.t_end / steps as f64;
-            driver.set_dt(dt);
-            steps
-        }
-        None => (scene.time.t_end / dt).round().max(1.0) as usize,
-    };
+/// What the loop gathers over the steps.
+struct Tally {
+    tracked: Vec<Tracked>,
+    /// Total energy at the start.
+    e0: f64,
+    /// Largest energy scale seen.
+    scale: f64,
+    drift: f64,
+    growth: f64,
+    lumped: usize,
+    deactivated: usize,
+    extended: usize,
+    max_condition: Option<f64>,
+    phases: PhaseTimes,
+    rms: exact::RmsPositionError,
+    failure: Option<StepError>,
+    seconds: f64,
+}
 
-    let mut tracked: Vec<Tracked> = scene
+/// The tracked particles: the particle nearest each of the scene's tracked points.
+fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>) -> Vec<Tracked> {
+    let (positions, steps) = (&run.positions, run.steps);
+    scene
         .output
         .tracked
         .iter()
@@ -792,11 +282,29 @@ where
                 time: Vec::with_capacity(steps),
                 velocity: Vec::with_capacity(steps),
                 displacement: Vec::with_capacity(steps),
-                exact_displacement: Vec::with_capacity(if solution.is_some() { steps } else { 0 }),
+                exact_displacement: Vec::with_capacity(if run.solution.is_some() {
+                    steps
+                } else {
+                    0
+                }),
             }
         })
-        .collect();
+        .collect()
+}
 
+/// Shows `on_step` the initial state, then takes the steps (until the first
+/// failure), recording the tracked particles and the energy and mass facts.
+fn step_loop<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    run: &mut Prepared<D, B>,
+    on_step: &mut Observer,
+) -> Tally
+where
+    Particles<f64, D>: AsParticlesRef,
+{
+    let mut tracked = tracked(scene, run);
+    let (solution, origin) = (run.solution, run.origin);
+    let driver = &mut run.driver;
     let start = driver.report();
     // The initial state (step 0); the public entry points other than
     // `observe_2d`/`observe_1d` pass only steps > 0 on.
@@ -814,7 +322,7 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let clock = std::time::Instant::now();
-    for _ in 0..steps {
+    for _ in 0..run.steps {
         let r = match driver.step() {
             Ok(r) => r,
             Err(e) => {
@@ -855,10 +363,31 @@ where
             max_condition = Some(max_condition.map_or(c, |m: f64| m.max(c)));
         }
     }
-    let seconds = clock.elapsed().as_secs_f64();
-    let end = driver.report();
+    Tally {
+        tracked,
+        e0,
+        scale,
+        drift,
+        growth,
+        lumped,
+        deactivated,
+        extended,
+        max_condition,
+        phases,
+        rms,
+        failure,
+        seconds: clock.elapsed().as_secs_f64(),
+    }
+}
+
+/// The error against the reference solution at the end of the run.
+fn error<const D: usize, B: Basis<f64, D>>(
+    run: &Prepared<D, B>,
+    rms: &exact::RmsPositionError,
+) -> Option<f64> {
+    let (driver, origin) = (&run.driver, run.origin);
     let parts = &driver.particles;
-    let error = solution.and_then(|s| match s {
+    run.solution.and_then(|s| match s {
         // Paper eq. (47) needs at least one step.
         Solution::AxisAligned(_) => (rms.steps() > 0).then(|| rms.value()),
         Solution::Equilibrium {
@@ -893,40 +422,53 @@ where
             }
             Some(err2.sqrt())
         }
-    });
-    let scale = scale.max(f64::MIN_POSITIVE);
-    let (energy_drift, energy_growth) = (drift / scale, growth / scale);
+    })
+}
+
+/// The summary and outcome of a run: error, energy drift and growth, the verdict.
+fn summarise<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    run: Prepared<D, B>,
+    tally: Tally,
+) -> Outcome<D> {
+    let end = run.driver.report();
+    let error = error(&run, &tally.rms);
+    let scale = tally.scale.max(f64::MIN_POSITIVE);
+    let (energy_drift, energy_growth) = (tally.drift / scale, tally.growth / scale);
+    let failure = tally.failure;
+    let max_condition = tally.max_condition;
     let stable = failure.is_none()
         && energy_growth < STABLE_ENERGY_GROWTH
         && max_condition.is_none_or(|c| c < STABLE_CONDITION);
-    Ok(Outcome {
+    let driver = run.driver;
+    Outcome {
         summary: Summary {
             scene: scene.name.clone(),
             basis: scene.basis.name(),
             mass: scene.mass.spec(),
-            functions,
-            particles: parts.len(),
+            functions: run.functions,
+            particles: driver.particles.len(),
             steps: driver.steps(),
-            dt,
+            dt: run.dt,
             t_end: driver.time(),
             error,
             error_measure: scene.reference.map(|r| r.error_measure()),
-            max_lumped_rows: lumped,
-            max_deactivated: deactivated,
-            max_extended: extended,
-            dt_critical,
+            max_lumped_rows: tally.lumped,
+            max_deactivated: tally.deactivated,
+            max_extended: tally.extended,
+            dt_critical: run.dt_critical,
             max_condition,
-            energy_initial: e0,
+            energy_initial: tally.e0,
             energy_final: end.total_energy(),
             energy_drift,
             energy_growth,
             stable,
             failure: failure.as_ref().map(|e| e.to_string()),
-            seconds,
-            phases,
+            seconds: tally.seconds,
+            phases: tally.phases,
         },
         particles: driver.particles,
-        tracked,
+        tracked: tally.tracked,
         failure,
-    })
+    }
 }

@@ -1,7 +1,8 @@
 //! The effects a scene can declare, each checked against what it must do physically:
 //! traction and damping reach the static solution, a body force does what gravity
-//! does with its work booked instead of a potential, a geostatic initial stress
-//! holds a column at rest, and damping's work closes the energy balance.
+//! does with its work booked instead of a potential (and the body-force fields give
+//! their values), a geostatic initial stress holds a column at rest, and damping's
+//! work closes the energy balance.
 
 use psmpm::scene::{
     Body, BoundaryCondition, Component, EffectSpec, InitialVelocity, MaterialModel, MaterialSpec,
@@ -122,6 +123,38 @@ fn a_body_force_moves_the_column_as_gravity_does_and_books_its_work() {
         b_last.1
     );
     assert!(g.summary.energy_drift < 1e-3 && b.summary.energy_drift < 1e-3);
+}
+
+/// The body-force fields a scene can declare: a uniform value, and the manufactured
+/// B4 field, `AxisAligned::body_force` at the particle's reference position.
+#[test]
+fn body_force_fields_give_their_values() {
+    use nalgebra::{Vector1, Vector2};
+    use psmpm::effect::{BodyForce, Effect};
+    use psmpm::studies::exact::AxisAligned;
+
+    let uniform = BodyForce::Uniform(Vector2::new(0.0, -9.81));
+    assert_eq!(
+        uniform.at(&Vector2::new(0.3, 0.7), 1.0),
+        Vector2::new(0.0, -9.81)
+    );
+    assert_eq!(Effect::<f64, 2>::name(&uniform), "body-force");
+    let a = AxisAligned::PAPER;
+    let manufactured = BodyForce::<f64, 2>::Manufactured(a);
+    let b = a.body_force([0.3, 0.7], 0.004);
+    assert_eq!(
+        manufactured.at(&Vector2::new(0.3, 0.7), 0.004),
+        Vector2::new(b[0], b[1])
+    );
+    assert_eq!(
+        Effect::<f64, 2>::name(&manufactured),
+        "manufactured-body-force"
+    );
+    let in_1d = BodyForce::<f64, 1>::Manufactured(a);
+    assert_eq!(
+        in_1d.at(&Vector1::new(0.3), 0.004)[0],
+        a.body_force([0.3, 0.0], 0.004)[0]
+    );
 }
 
 #[test]

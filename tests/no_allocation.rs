@@ -8,10 +8,11 @@ use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
 use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::Basis;
 use psmpm::driver::{Driver, Fix};
-use psmpm::effect::{BodyForce, Effect, ForceField, Gravity, LocalDamping};
+use psmpm::effect::{BodyForce, Effect, Gravity, LocalDamping};
 use psmpm::mass::MassKind;
 use psmpm::material::{Elastic, LinearElastic};
 use psmpm::particles::Particles;
+use psmpm::studies::exact::AxisAligned;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -85,11 +86,12 @@ fn steps_allocate<B: Basis<f64, 2>>(basis: B, kind: MassKind, rows: usize, extra
         g: Vector2::new(0.0, -9.81),
     })];
     if extra {
-        let field: ForceField<f64, 2> = Box::new(|_, t| Vector2::new(0.1 * t, 0.0));
-        effects.push(Box::new(BodyForce {
-            label: "body-force",
-            field,
-        }));
+        effects.push(Box::new(BodyForce::Uniform(Vector2::new(0.1, 0.0))));
+        // The manufactured field is evaluated per particle, at its reference position.
+        effects.push(Box::new(BodyForce::Manufactured(AxisAligned {
+            u0: 1e-4,
+            ..AxisAligned::PAPER
+        })));
         effects.push(Box::new(LocalDamping { alpha: 0.05 }));
     }
     let mut driver = Driver::new(

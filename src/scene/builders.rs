@@ -1,0 +1,102 @@
+//! Changes to a scene made by the command line, comparisons (a basis with its own
+//! resolution) and refinement studies.
+
+use super::{bad, BlockLayout, MeshSpec, Scene, SceneError};
+use crate::bases::BasisKind;
+
+impl Scene {
+    /// Sets the block counts of a `blocks` mesh (`[n, 1]` sets the elements of an
+    /// `interval` mesh).
+    pub fn set_blocks(&mut self, nx: usize, ny: usize) -> Result<(), SceneError> {
+        match &mut self.mesh {
+            MeshSpec::Blocks { blocks, .. } => *blocks = [nx, ny],
+            MeshSpec::Interval { elements, .. } => *elements = nx,
+            _ => return Err(bad("mesh.blocks", "the scene's mesh has no blocks")),
+        }
+        Ok(())
+    }
+
+    /// Sets the block layout of a `blocks` mesh.
+    pub fn set_layout(&mut self, new: BlockLayout) -> Result<(), SceneError> {
+        match &mut self.mesh {
+            MeshSpec::Blocks { layout, .. } => *layout = new,
+            _ => return Err(bad("mesh.layout", "the scene's mesh has no blocks")),
+        }
+        Ok(())
+    }
+
+    /// Sets the particles per block of every body (the first `dim` entries of `p`).
+    pub fn set_particles_per_block(&mut self, p: [usize; 2]) {
+        for body in &mut self.bodies {
+            body.per_block = Some(p[..self.dim].to_vec());
+            body.count = None;
+        }
+    }
+
+    /// Sets a fixed time step.
+    pub fn set_dt(&mut self, dt: f64) {
+        self.time.dt = Some(dt);
+        self.time.courant = None;
+    }
+
+    /// The scene for `basis`, with the resolution the scene gives that basis (see
+    /// [`Scene::resolutions`]), validated.
+    pub fn with_basis(&self, basis: BasisKind) -> Result<Scene, SceneError> {
+        let mut s = self.clone();
+        s.basis = basis;
+        if let Some(r) = self.resolutions.iter().find(|r| r.basis == basis) {
+            if let Some([nx, ny]) = r.blocks {
+                s.set_blocks(nx, ny)?;
+            }
+            if let Some(h) = r.edge_length {
+                match &mut s.mesh {
+                    MeshSpec::Polygon { edge_length, .. } => *edge_length = h,
+                    _ => return Err(bad("resolution.edge_length", "the mesh is not a polygon")),
+                }
+            }
+            if let Some(p) = &r.per_block {
+                for body in &mut s.bodies {
+                    body.per_block = Some(p.clone());
+                    body.count = None;
+                }
+            }
+        }
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The scene refined `level` times as [`StudySpec`](super::StudySpec) says, validated.
+    pub fn refined(&self, level: u32) -> Result<Scene, SceneError> {
+        let mut s = self.clone();
+        let factor = 1usize
+            .checked_shl(level)
+            .filter(|f| *f <= 4096)
+            .ok_or_else(|| bad("study", format!("level {level} is too fine")))?;
+        let refine = |axis: usize| {
+            self.study.refine.is_empty() || self.study.refine.iter().any(|c| c.index() == axis)
+        };
+        match &mut s.mesh {
+            MeshSpec::Blocks { blocks, .. } => {
+                for (axis, n) in blocks.iter_mut().enumerate() {
+                    if refine(axis) {
+                        *n *= factor;
+                    }
+                }
+            }
+            MeshSpec::Interval { elements, .. } => *elements *= factor,
+            MeshSpec::Polygon { edge_length, .. } => {
+                *edge_length /= factor as f64;
+                for body in &mut s.bodies {
+                    if let Some(c) = &mut body.count {
+                        c.iter_mut().for_each(|n| *n *= factor);
+                    }
+                }
+            }
+            MeshSpec::Gmsh { .. } => {
+                return Err(bad("mesh.kind", "a Gmsh mesh cannot be refined by a study"))
+            }
+        }
+        s.validate()?;
+        Ok(s)
+    }
+}

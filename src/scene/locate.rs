@@ -1,0 +1,258 @@
+//! Finding things in a scene's TOML text for error messages: the line and column of
+//! a byte offset, the line that sets a key, the value a message quotes, the dotted
+//! field a line sets, the value of a field path. A small line scanner over the text
+//! as written (the TOML parser reports spans, not fields).
+
+/// 1-based line and column of byte offset `at` in `text`.
+pub(super) fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    // Columns count characters, not bytes.
+    let column = before[before.rfind('\n').map_or(0, |i| i + 1)..]
+        .chars()
+        .count()
+        + 1;
+    (line, column)
+}
+
+/// Byte offset of the first line at or after `from` that sets `key`.
+fn key_line_after(text: &str, from: usize, key: &str) -> Option<usize> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        if offset + line.len() > from
+            && line
+                .split_once('=')
+                .is_some_and(|(k, _)| k.trim() == key && !line.trim_start().starts_with('#'))
+        {
+            return Some(offset + line.len() - line.trim_start().len());
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// Byte offset of the first value at or after `from` (in a `key = value` line, before
+/// the next table header but one) that contains `value`.
+fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
+    let mut offset = 0;
+    let mut headers = 0;
+    for line in text.split_inclusive('\n') {
+        if offset >= from {
+            if line.trim_start().starts_with('[') {
+                headers += 1;
+                if headers > 1 {
+                    return None;
+                }
+            } else if let Some(eq) = line.find('=') {
+                if let Some(i) = line[eq..].find(value) {
+                    return Some(offset + eq + i);
+                }
+            }
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// The dotted field (`mesh.blocks`, `effect[1].kind`, `basis`) set on the line of
+/// byte offset `at`, if that line is a `key = value` line.
+fn field_at(text: &str, at: usize) -> Option<String> {
+    let mut table: Option<String> = None;
+    let mut counts = std::collections::HashMap::<String, usize>::new();
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim();
+        if let Some(name) = trimmed.strip_prefix("[[").and_then(|r| r.split_once("]]")) {
+            let name = name.0.trim().to_string();
+            let count = counts.entry(name.clone()).or_insert(0);
+            table = Some(format!("{name}[{count}]"));
+            *count += 1;
+        } else if let Some(name) = trimmed.strip_prefix('[').and_then(|r| r.split_once(']')) {
+            table = Some(name.0.trim().to_string());
+        }
+        if at < offset + line.len() {
+            let (key, _) = line.split_once('=')?;
+            let key = key.trim();
+            if key.is_empty()
+                || key.starts_with('#')
+                || !key
+                    .chars()
+                    .all(|c| c.is_alphanumeric() || c == '_' || c == '-')
+            {
+                return None;
+            }
+            return Some(match table {
+                Some(t) => format!("{t}.{key}"),
+                None => key.to_string(),
+            });
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// Byte offset of the value of field `path` (`time.dt`, `body[1].count`, `mesh`) in
+/// the TOML `text`, found by walking its tables; the start of the file if not found.
+pub(super) fn field_offset(text: &str, path: &str) -> usize {
+    // A whole array-of-tables entry (`body[1]`) or table (`body`): its header.
+    if !path.contains('.') {
+        let (name, index) = match path.split_once('[') {
+            Some((n, i)) => (n, i.trim_end_matches(']').parse::<usize>().unwrap_or(0)),
+            None => (path, 0),
+        };
+        let mut offset = 0;
+        let mut seen = 0;
+        for line in text.split_inclusive('\n') {
+            let t = line.trim();
+            if t == format!("[[{name}]]") || t == format!("[{name}]") {
+                if seen == index {
+                    return offset;
+                }
+                seen += 1;
+            }
+            offset += line.len();
+        }
+    }
+    // Split `body[1].count` into table `body`, index 1, key `count`.
+    let (table, index, key) = match path.split_once('.') {
+        Some((head, key)) => {
+            let (name, index) = match head.split_once('[') {
+                Some((n, i)) => (n, i.trim_end_matches(']').parse::<usize>().unwrap_or(0)),
+                None => (head, 0),
+            };
+            (Some(name), index, key)
+        }
+        None => {
+            let (name, _) = path.split_once('[').unwrap_or((path, ""));
+            (None, 0, name)
+        }
+    };
+    let mut offset = 0;
+    let mut current: Option<String> = None;
+    let mut seen = std::collections::HashMap::<String, usize>::new();
+    let mut current_index = 0;
+    let mut table_start = None;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim();
+        if let Some(name) = trimmed
+            .strip_prefix("[[")
+            .and_then(|r| r.split_once("]]"))
+            .map(|(n, _)| n.trim().to_string())
+        {
+            let count = seen.entry(name.clone()).or_insert(0);
+            current_index = *count;
+            *count += 1;
+            current = Some(name);
+            if table.is_some_and(|t| Some(t.to_string()) == current && current_index == index) {
+                table_start = Some(offset);
+            }
+        } else if let Some(name) = trimmed
+            .strip_prefix('[')
+            .and_then(|r| r.split_once(']'))
+            .map(|(n, _)| n.trim().to_string())
+        {
+            current = Some(name);
+            current_index = 0;
+            if table.is_some_and(|t| Some(t.to_string()) == current) && index == 0 {
+                table_start = Some(offset);
+            }
+        } else {
+            let in_table = match table {
+                Some(t) => current.as_deref() == Some(t) && current_index == index,
+                None => current.is_none(),
+            };
+            let key_here = trimmed
+                .split_once('=')
+                .map(|(k, _)| k.trim() == key)
+                .unwrap_or(false);
+            if in_table && key_here {
+                let eq = line.find('=').unwrap_or(0);
+                let after = &line[eq + 1..];
+                return offset + eq + 1 + (after.len() - after.trim_start().len());
+            }
+            // An inline table: `reference = { kind = ... }`.
+            if table.is_some()
+                && current.is_none()
+                && trimmed
+                    .split_once('=')
+                    .is_some_and(|(k, _)| Some(k.trim()) == table)
+            {
+                if let Some(at) = line.find(&format!("{key} ")).or_else(|| line.find(key)) {
+                    return offset + at;
+                }
+            }
+        }
+        offset += line.len();
+    }
+    table_start.unwrap_or(0)
+}
+
+/// `message` located in the scene file `text` (named `file`) when it starts with a
+/// field path (`body[0].max: ...`, `boundary[1].tag: ...`): `file:line:column: message`.
+/// For errors found while a run is built, after the file parsed.
+pub fn locate_message(text: &str, file: &str, message: &str) -> String {
+    let Some((field, _)) = message.split_once(':') else {
+        return message.to_string();
+    };
+    let is_path = !field.is_empty()
+        && field
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_[].".contains(c));
+    if !is_path {
+        return message.to_string();
+    }
+    let (line, column) = line_column(text, field_offset(text, field));
+    format!("{file}:{line}:{column}: {message}")
+}
+
+/// Where a TOML parse error `e` in `text` belongs (a byte offset) and its message,
+/// prefixed with the field when the error is about a key or a value.
+pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, String) {
+    let mut at = e.span().map_or(0, |s| s.start);
+    let message = e.message().trim().to_string();
+    // An unknown field is reported at its table's header: find its line.
+    if let Some(name) = message
+        .strip_prefix("unknown field `")
+        .and_then(|r| r.split_once('`'))
+        .map(|(n, _)| n)
+    {
+        if let Some(offset) = key_line_after(text, at, name) {
+            at = offset;
+        }
+    } else if text[at.min(text.len())..].starts_with('[')
+        && [
+            "invalid type",
+            "invalid value",
+            "unknown variant",
+            "invalid length",
+        ]
+        .iter()
+        .any(|m| message.starts_with(m))
+    {
+        // A value error inside a tagged table is reported at its header: find
+        // the value the message quotes.
+        if let Some(value) = message.split('`').nth(1) {
+            if let Some(offset) = value_after(text, at, value) {
+                at = offset;
+            }
+        }
+    }
+    // Name the field when the error is about a key or a value (not about the
+    // syntax between them).
+    let about_value = {
+        let line_start = text[..at.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
+        text[line_start..at.min(text.len())].contains('=')
+    };
+    let about_key = message.starts_with("unknown field") || message.starts_with("duplicate key");
+    let message = match field_at(text, at) {
+        Some(field) if (about_value || about_key) && !message.starts_with(&field) => {
+            format!("{field}: {message}")
+        }
+        _ => message,
+    };
+    (at, message)
+}

@@ -1,0 +1,541 @@
+//! Scenes: a run declared as data. A scene is a TOML file (and the same struct built
+//! in code) that says everything a run needs and nothing more: the mesh (a generator
+//! or a Gmsh file), the basis and mass strategy, the material, the bodies and how
+//! particles fill them, the initial velocity, boundary conditions per boundary tag,
+//! the effects (gravity, damping, traction, body forces, initial stress), time
+//! stepping, the reference solution that errors are measured against, and outputs.
+//!
+//! A run simulates only the effects its scene lists: a scene without gravity never
+//! evaluates it. [`crate::simulation`] turns a scene into a driver and runs it.
+//!
+//! The built-in scenes are TOML files under `scenes/` compiled into the library
+//! ([`BUILTIN`], [`Scene::builtin`]); `mpm-cli scene show NAME` prints them and
+//! `mpm-cli run FILE.toml` reads a file back. Every error in a file names the file,
+//! line and column, and the field.
+//!
+//! ```toml
+//! name = "column-small"
+//! dim = 2
+//! basis = "ps"               # ps, pl (2D); bspline, pl1d (1D)
+//! mass = "consistent"        # optional: default (extended), consistent, lumped, partial[:TAU], partial-coverage:C, deactivate[:M], extended[:C], fmpm:K
+//!
+//! [mesh]
+//! kind = "blocks"            # blocks, polygon, gmsh (2D); interval (1D)
+//! x = [0.0, 2.0]
+//! y = [0.0, 25.0]
+//! blocks = [1, 8]
+//!
+//! [material]
+//! model = "linear-elastic"   # or neo-hookean
+//! young = 5e4
+//! poisson = 0.0
+//! density = 1.0
+//!
+//! [[body]]
+//! min = [0.0, 0.0]
+//! max = [2.0, 25.0]
+//! per_block = [6, 8]         # or count = [NX, NY] over the body
+//! # jitter = 0.3             # optional: random offsets, a fraction of the cell
+//!
+//! [[boundary]]
+//! tag = "bottom"
+//! fix = ["x", "y"]
+//!
+//! [[effect]]
+//! kind = "gravity"
+//! g = [0.0, -9.81]
+//!
+//! [time]
+//! dt = 1e-4                  # or courant = 0.5 (fraction of the critical step)
+//! t_end = 1.0
+//!
+//! [reference]
+//! kind = "column-self-weight"
+//! ```
+
+//!
+//! The module is split by concept: the schema (here), [`validate`](Scene::validate)
+//! (validate.rs), locating errors in the TOML text (locate.rs), the built-in scenes
+//! (builtin.rs), the names of bases and split points in files (names.rs), values
+//! derived from a scene (derived.rs) and changes made by comparisons and studies
+//! (builders.rs).
+
+use crate::bases::BasisKind;
+use crate::mass::MassKind;
+use psmpm_basis::basis::powell_sabin::SplitPoint;
+use serde::{Deserialize, Serialize};
+
+mod builders;
+mod builtin;
+mod derived;
+mod locate;
+mod names;
+mod validate;
+
+pub use builtin::BUILTIN;
+pub use locate::locate_message;
+pub use names::{parse_split, split_to_str};
+pub use validate::{MAX_BLOCKS, MAX_PARTICLES};
+
+/// A fully declared run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Scene name.
+    pub name: String,
+    /// One line saying what the scene is.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub description: String,
+    /// 1 or 2.
+    pub dim: usize,
+    /// Basis.
+    #[serde(with = "names::basis_name")]
+    pub basis: BasisKind,
+    /// PS split points (ignored by the other bases).
+    #[serde(default, with = "names::split_name")]
+    pub split: SplitPoint,
+    /// Mass strategy.
+    /// The mass strategy; absent means [`MassKind::default`] (extension).
+    #[serde(with = "names::mass_name", default)]
+    pub mass: MassKind,
+    /// The mesh.
+    pub mesh: MeshSpec,
+    /// The material.
+    pub material: MaterialSpec,
+    /// Bodies: boxes filled with particles.
+    #[serde(rename = "body")]
+    pub bodies: Vec<Body>,
+    /// Initial velocity of the particles.
+    #[serde(default)]
+    pub initial_velocity: InitialVelocity,
+    /// Homogeneous Dirichlet conditions per boundary tag.
+    #[serde(default, rename = "boundary", skip_serializing_if = "Vec::is_empty")]
+    pub boundaries: Vec<BoundaryCondition>,
+    /// Effects beyond elasticity; only these are assembled.
+    #[serde(default, rename = "effect", skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<EffectSpec>,
+    /// Time stepping.
+    pub time: TimeSpec,
+    /// The exact or reference solution the error is measured against.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<Reference>,
+    /// What to record.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// The resolution each basis gets when bases are compared (`mpm-cli compare`),
+    /// chosen so that they have about the same number of functions.
+    #[serde(default, rename = "resolution", skip_serializing_if = "Vec::is_empty")]
+    pub resolutions: Vec<Resolution>,
+    /// How refinement studies refine the scene (`mpm-cli converge`).
+    #[serde(default)]
+    pub study: StudySpec,
+}
+
+/// The resolution of one basis in comparisons: every field given replaces the
+/// scene's value when the scene is switched to `basis`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Resolution {
+    /// The basis this resolution is for.
+    #[serde(with = "names::basis_name")]
+    pub basis: BasisKind,
+    /// Blocks of a `blocks` mesh (`[elements, 1]` for an interval).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<[usize; 2]>,
+    /// Target edge length of a `polygon` mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_length: Option<f64>,
+    /// Particles per block of every body.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_block: Option<Vec<usize>>,
+}
+
+/// How a refinement study refines a scene: level `l` multiplies the block counts
+/// along the `refine` axes (all axes by default) and the elements of an interval by
+/// `2^l`, divides a polygon's edge length by `2^l` (and multiplies particle counts
+/// along every axis by `2^l`, keeping particles per element about constant). The
+/// time step and particles per block stay.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudySpec {
+    /// Axes whose block counts are refined (empty: all).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refine: Vec<Component>,
+}
+
+/// The mesh of a scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum MeshSpec {
+    /// `[x0, x1] × [y0, y1]` cut into `blocks = [nx, ny]` rectangular blocks (sides
+    /// tagged `bottom`, `right`, `top`, `left`).
+    Blocks {
+        /// `[x0, x1]`.
+        x: [f64; 2],
+        /// `[y0, y1]`.
+        y: [f64; 2],
+        /// `[nx, ny]`.
+        blocks: [usize; 2],
+        /// How each block is triangulated.
+        #[serde(default)]
+        layout: BlockLayout,
+    },
+    /// A quality triangulation of a polygon (with holes) by the project's mesher.
+    Polygon {
+        /// Corners of the outer boundary.
+        outline: Vec<[f64; 2]>,
+        /// Tag of each outline segment `i → i + 1` (default: all `boundary`).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        tags: Vec<String>,
+        /// Holes.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        holes: Vec<Hole>,
+        /// Target edge length.
+        edge_length: f64,
+    },
+    /// A Gmsh `.msh` file (ASCII 2.2 or 4.1; physical names become boundary tags);
+    /// a relative path is relative to the scene file.
+    Gmsh {
+        /// Path.
+        file: String,
+    },
+    /// 1D: `[x0, x1]` cut into `elements` equal elements (ends tagged `left`, `right`).
+    Interval {
+        /// `[x0, x1]`.
+        x: [f64; 2],
+        /// Number of elements.
+        elements: usize,
+    },
+}
+
+/// A hole of a polygon mesh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hole {
+    /// Corners.
+    pub outline: Vec<[f64; 2]>,
+    /// Tag of its boundary.
+    pub tag: String,
+}
+
+/// How a block is triangulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BlockLayout {
+    /// Four triangles around a centre vertex (the seeds' grid).
+    #[default]
+    FourTriangles,
+    /// Delaunay triangulation of block corners and centres (the thesis' tables).
+    Delaunay,
+}
+
+/// The constitutive model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Model.
+    pub model: MaterialModel,
+    /// Young's modulus `E > 0`.
+    pub young: f64,
+    /// Poisson's ratio `−1 < ν < 0.5`.
+    #[serde(default)]
+    pub poisson: f64,
+    /// Reference density `ρ0 > 0`.
+    pub density: f64,
+}
+
+/// Constitutive models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MaterialModel {
+    /// Linear elasticity on `F` (paper eqs. (25)–(26)).
+    LinearElastic,
+    /// Compressible neo-Hookean (paper eq. (27)).
+    NeoHookean,
+}
+
+/// A body: the box `[min, max]` filled with particles at the cell centres of a
+/// regular lattice; the particle volume is the cell volume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Lower corner (`dim` entries).
+    pub min: Vec<f64>,
+    /// Upper corner (`dim` entries).
+    pub max: Vec<f64>,
+    /// Particles per mesh block along each axis (block and interval meshes): the
+    /// lattice spacing is the block size divided by this.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_block: Option<Vec<usize>>,
+    /// Particles along each axis of the box.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<Vec<usize>>,
+    /// Moves each particle off its cell centre by a uniform random offset of up to
+    /// this fraction of the lattice cell along each axis (`0 ≤ jitter < 0.5`, so
+    /// particles stay in their cells); 0: the regular lattice.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub jitter: f64,
+    /// Seed of the jitter's random numbers ([`DEFAULT_JITTER_SEED`] when absent):
+    /// the same seed gives the same particles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+/// The seed of a body's jitter when the scene gives none.
+pub const DEFAULT_JITTER_SEED: u64 = 1;
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// Initial velocity.
+///
+/// (Variants without parameters are written `Rest {}` so that a stray key next to
+/// their `kind` is rejected as an unknown field.)
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum InitialVelocity {
+    /// At rest.
+    Rest {},
+    /// The same velocity everywhere.
+    Uniform {
+        /// Velocity (`dim` entries).
+        value: Vec<f64>,
+    },
+    /// `v_x = v0 sin(π (x − x_min) / L)` over the first body's extent `L` along x.
+    SineMode {
+        /// Amplitude.
+        v0: f64,
+    },
+    /// The velocity of the scene's reference solution at `t = 0`.
+    Exact {},
+}
+
+impl Default for InitialVelocity {
+    fn default() -> Self {
+        InitialVelocity::Rest {}
+    }
+}
+
+/// A homogeneous Dirichlet condition on the boundary with tag `tag`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundaryCondition {
+    /// Boundary tag.
+    pub tag: String,
+    /// Velocity components held at zero: `x`, `y`, or `normal` (a slip wall: the
+    /// component along the wall's normal; the wall must be straight).
+    pub fix: Vec<Component>,
+}
+
+/// A velocity component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Component {
+    /// First axis.
+    X,
+    /// Second axis.
+    Y,
+    /// The normal of a straight wall (a slip wall, oblique or not).
+    Normal,
+}
+
+impl Component {
+    /// Axis index (`None` for the wall normal).
+    pub fn axis(self) -> Option<usize> {
+        match self {
+            Component::X => Some(0),
+            Component::Y => Some(1),
+            Component::Normal => None,
+        }
+    }
+
+    /// Axis index of `x` and `y`; the normal counts as axis 0 (for `study.refine`,
+    /// where only axes are meaningful and validation rejects `normal`).
+    pub fn index(self) -> usize {
+        self.axis().unwrap_or(0)
+    }
+}
+
+/// An effect a scene declares.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum EffectSpec {
+    /// Uniform gravity (conservative: its potential energy is in the total).
+    Gravity {
+        /// Acceleration (`dim` entries).
+        g: Vec<f64>,
+    },
+    /// Local damping, paper eq. (49).
+    Damping {
+        /// Damping factor `0 ≤ α < 1`.
+        alpha: f64,
+    },
+    /// A traction on the particles in the box `[min, max]`: force per unit length
+    /// `traction` over the boundary length `length`, shared by those particles.
+    Traction {
+        /// Lower corner of the box selecting particles.
+        min: Vec<f64>,
+        /// Upper corner.
+        max: Vec<f64>,
+        /// Traction (force per unit length, `dim` entries).
+        traction: Vec<f64>,
+        /// Loaded boundary length.
+        length: f64,
+        /// Linear ramp time (0: sudden).
+        #[serde(default)]
+        ramp: f64,
+    },
+    /// A uniform body force per unit mass (non-conservative bookkeeping: its work
+    /// is accumulated).
+    BodyForce {
+        /// Force per unit mass (`dim` entries).
+        value: Vec<f64>,
+    },
+    /// The body force that makes the reference solution exact (paper eqs. (42)–(46)
+    /// for `axis-aligned`).
+    ManufacturedBodyForce {},
+    /// Geostatic initial stress: `σ_yy = ρ g (surface − y)`, `σ_xx = k0 σ_yy`, with
+    /// the density of the material and `g` of the gravity effect.
+    GeostaticStress {
+        /// Height of the free surface.
+        surface: f64,
+        /// Lateral coefficient.
+        #[serde(default)]
+        k0: f64,
+    },
+}
+
+/// Time stepping: a fixed `dt`, or one from a Courant number.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// Time step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dt: Option<f64>,
+    /// Courant number `C` (in `(0, 1)` to be stable): `Δt = C Δt_crit`, the critical
+    /// step of the basis, mass strategy and material estimated at the start of the run
+    /// (power iteration on `M⁻¹K`, see `Driver::critical_time_step`), shortened so that
+    /// a whole number of steps ends exactly at `t_end`. The same `C` means the same
+    /// margin for PL and PS and for every mass strategy.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub courant: Option<f64>,
+    /// End time.
+    pub t_end: f64,
+}
+
+/// The exact or reference solution of a scene, and so its error measure.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Reference {
+    /// B2: first-mode vibration of a bar fixed at both ends (thesis eq. (4.2)), over
+    /// the first body's length; error `E_u` (thesis eq. (4.4)) at the end.
+    VibratingBar {
+        /// Velocity amplitude.
+        v0: f64,
+    },
+    /// B5a: column settling under self-weight from rest (thesis eq. (4.6),
+    /// corrected), height of the first body, `g` of the gravity effect; error `E_u`.
+    ColumnSelfWeight {},
+    /// B4: the neo-Hookean manufactured solution (paper §4.2); error: the
+    /// time-averaged RMS position error of paper eq. (47).
+    AxisAligned {
+        /// Displacement amplitude.
+        u0: f64,
+    },
+    /// B5c: the static stress profile of a column under self-weight; error: the
+    /// largest `|σ_yy − σ_yy^exact| / |σ_yy(0)|` over particles at the end. The
+    /// exact profile is that of the project's linear law `σ = E (F − 1)`
+    /// ([`crate::studies::exact::column_equilibrium_stress_linear`]); paper eq. (48) belongs
+    /// to a slightly different law and differs by about `κ² |σ_yy(0)|`.
+    ColumnEquilibrium {},
+}
+
+impl Reference {
+    /// Name of the error measure.
+    pub fn error_measure(&self) -> &'static str {
+        match self {
+            Reference::VibratingBar { .. } | Reference::ColumnSelfWeight {} => "E_u",
+            Reference::AxisAligned { .. } => "rms-position",
+            Reference::ColumnEquilibrium {} => "max-relative-sigma-yy",
+        }
+    }
+}
+
+/// What a run records.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Points whose nearest particles are tracked every step.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tracked: Vec<Vec<f64>>,
+    /// Print diagnostics every this many steps (0: about 20 rows per run).
+    #[serde(default)]
+    pub diagnostics_every: usize,
+    /// Estimate the condition number of the solved mass system every step (about 60
+    /// solves for the factorising strategies, 30 products for `extended`).
+    #[serde(default)]
+    pub condition: bool,
+}
+
+/// An error in a scene, located in its file when it came from one.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}:{line}:{column}: {message}")]
+pub struct SceneFileError {
+    /// File name.
+    pub file: String,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// What is wrong, starting with the field.
+    pub message: String,
+}
+
+/// A scene that is inconsistent: the field and what is wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct SceneError {
+    /// Dotted path of the field (`time.dt`, `body[0].per_block`).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn bad(field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+impl Scene {
+    /// Parses and validates a scene file (`file` names it in errors).
+    pub fn from_toml(text: &str, file: &str) -> Result<Self, SceneFileError> {
+        let locate = |at: usize, message: String| {
+            let (line, column) = locate::line_column(text, at);
+            SceneFileError {
+                file: file.to_string(),
+                line,
+                column,
+                message,
+            }
+        };
+        let scene: Scene = toml::from_str(text).map_err(|e| {
+            let (at, message) = locate::parse_error(text, &e);
+            locate(at, message)
+        })?;
+        scene
+            .validate()
+            .map_err(|e| locate(locate::field_offset(text, &e.field), e.to_string()))?;
+        Ok(scene)
+    }
+
+    /// The scene as TOML that [`Scene::from_toml`] reads back.
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_else(|e| format!("# cannot serialise: {e}\n"))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,58 @@
+use super::*;
+
+#[test]
+fn every_builtin_scene_parses_and_round_trips() {
+    for (name, _, _) in BUILTIN {
+        let scene = Scene::builtin(name).unwrap();
+        let text = scene.to_toml();
+        let back = Scene::from_toml(&text, "shown.toml").unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(scene, back, "{name}");
+    }
+}
+
+#[test]
+fn jitter_is_validated_and_moves_particles_inside_their_cells_deterministically() {
+    let text = Scene::builtin("column-small").unwrap().to_toml();
+    let jittered = text.replace("per_block = [6, 8]", "per_block = [6, 8]\njitter = 0.3");
+    let scene = Scene::from_toml(&jittered, "j.toml").unwrap();
+    assert_eq!(
+        Scene::from_toml(&scene.to_toml(), "back.toml").unwrap(),
+        scene
+    );
+    for bad_value in ["0.5", "-0.1", "nan"] {
+        let broken = text.replace(
+            "per_block = [6, 8]",
+            &format!("per_block = [6, 8]\njitter = {bad_value}"),
+        );
+        let e = Scene::from_toml(&broken, "j.toml").unwrap_err();
+        assert!(
+            e.message.starts_with("body[0].jitter: must be in [0, 0.5)"),
+            "{e}"
+        );
+    }
+    let regular =
+        crate::simulation::particle_lattice(&Scene::builtin("column-small").unwrap()).unwrap();
+    let moved = crate::simulation::particle_lattice(&scene).unwrap();
+    assert_eq!(moved, crate::simulation::particle_lattice(&scene).unwrap());
+    let (hx, hy) = (2.0 / 6.0, 25.0 / 8.0 / 8.0);
+    let mut largest: f64 = 0.0;
+    for (p, q) in regular.positions.iter().zip(&moved.positions) {
+        let (dx, dy) = ((q[0] - p[0]) / hx, (q[1] - p[1]) / hy);
+        assert!(dx.abs() <= 0.3 && dy.abs() <= 0.3, "{p:?} -> {q:?}");
+        largest = largest.max(dx.abs()).max(dy.abs());
+    }
+    assert!(largest > 0.25, "{largest}");
+    let mut other = scene.clone();
+    other.bodies[0].seed = Some(7);
+    assert_ne!(crate::simulation::particle_lattice(&other).unwrap(), moved);
+}
+
+#[test]
+fn errors_name_line_column_and_field() {
+    let text = Scene::builtin("column-small").unwrap().to_toml();
+    let broken = text.replace("t_end = 1.0", "t_end = -1.0");
+    let e = Scene::from_toml(&broken, "c.toml").unwrap_err();
+    let line = broken.lines().position(|l| l.starts_with("t_end")).unwrap() + 1;
+    assert_eq!((e.file.as_str(), e.line), ("c.toml", line), "{e}");
+    assert!(e.message.starts_with("time.t_end: must be positive"), "{e}");
+}

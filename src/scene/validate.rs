@@ -1,0 +1,351 @@
+//! Validation: a scene is consistent, or the error names the field.
+
+use super::{
+    bad, Body, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference, Scene,
+    SceneError,
+};
+
+/// Most blocks a `blocks` mesh may have.
+pub const MAX_BLOCKS: usize = 1_000_000;
+/// Most particles a scene may have.
+pub const MAX_PARTICLES: usize = 10_000_000;
+
+impl Scene {
+    /// Checks that the scene is consistent; the error names the field.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let d = self.dim;
+        if !(d == 1 || d == 2) {
+            return Err(bad("dim", format!("must be 1 or 2, got {d}")));
+        }
+        if self.basis.dim() != d {
+            return Err(bad(
+                "basis",
+                format!(
+                    "`{}` is a {}D basis but the scene is {d}D (2D: ps, pl; 1D: bspline, pl1d)",
+                    self.basis.name(),
+                    self.basis.dim()
+                ),
+            ));
+        }
+        let finite = |field: &str, v: f64| -> Result<(), SceneError> {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(field, format!("must be finite, got {v}")))
+            }
+        };
+        let positive = |field: &str, v: f64| -> Result<(), SceneError> {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(field, format!("must be positive and finite, got {v}")))
+            }
+        };
+        let vector = |field: &str, v: &[f64]| -> Result<(), SceneError> {
+            if v.len() != d {
+                return Err(bad(field, format!("needs {d} entries, got {}", v.len())));
+            }
+            v.iter().try_for_each(|&x| finite(field, x))
+        };
+        let interval = |field: &str, r: [f64; 2]| -> Result<(), SceneError> {
+            finite(field, r[0])?;
+            finite(field, r[1])?;
+            if r[0] < r[1] {
+                Ok(())
+            } else {
+                Err(bad(
+                    field,
+                    format!("needs min < max, got [{}, {}]", r[0], r[1]),
+                ))
+            }
+        };
+        match &self.mesh {
+            MeshSpec::Blocks { x, y, blocks, .. } => {
+                if d != 2 {
+                    return Err(bad(
+                        "mesh.kind",
+                        "`blocks` is a 2D mesh; use `interval` in 1D",
+                    ));
+                }
+                interval("mesh.x", *x)?;
+                interval("mesh.y", *y)?;
+                if blocks.iter().any(|&n| n == 0 || n > 4096) {
+                    return Err(bad(
+                        "mesh.blocks",
+                        format!("each count must be in 1..=4096, got {blocks:?}"),
+                    ));
+                }
+                if blocks[0] * blocks[1] > MAX_BLOCKS {
+                    return Err(bad(
+                        "mesh.blocks",
+                        format!(
+                            "{} blocks in all is above the limit of {MAX_BLOCKS}",
+                            blocks[0] * blocks[1]
+                        ),
+                    ));
+                }
+            }
+            MeshSpec::Polygon {
+                outline,
+                tags,
+                edge_length,
+                ..
+            } => {
+                if d != 2 {
+                    return Err(bad("mesh.kind", "`polygon` is a 2D mesh"));
+                }
+                if outline.len() < 3 {
+                    return Err(bad("mesh.outline", "needs at least 3 corners"));
+                }
+                if !tags.is_empty() && tags.len() != outline.len() {
+                    return Err(bad(
+                        "mesh.tags",
+                        format!(
+                            "needs one tag per outline segment ({}), got {}",
+                            outline.len(),
+                            tags.len()
+                        ),
+                    ));
+                }
+                positive("mesh.edge_length", *edge_length)?;
+            }
+            MeshSpec::Gmsh { file } => {
+                if d != 2 {
+                    return Err(bad("mesh.kind", "`gmsh` meshes are 2D"));
+                }
+                if file.is_empty() {
+                    return Err(bad("mesh.file", "is empty"));
+                }
+            }
+            MeshSpec::Interval { x, elements } => {
+                if d != 1 {
+                    return Err(bad(
+                        "mesh.kind",
+                        "`interval` is a 1D mesh; use `blocks` in 2D",
+                    ));
+                }
+                interval("mesh.x", *x)?;
+                if *elements == 0 || *elements > 1_000_000 {
+                    return Err(bad(
+                        "mesh.elements",
+                        format!("must be in 1..=1000000, got {elements}"),
+                    ));
+                }
+            }
+        }
+        crate::material::Elastic::new(
+            self.material.young,
+            self.material.poisson,
+            self.material.density,
+        )
+        .map_err(|e| {
+            let field = match &e {
+                crate::material::MaterialError::OutOfRange { name, .. } => {
+                    format!("material.{name}")
+                }
+            };
+            bad(field, e.to_string())
+        })?;
+        if self.bodies.is_empty() {
+            return Err(bad("body", "a scene needs at least one [[body]]"));
+        }
+        for (b, body) in self.bodies.iter().enumerate() {
+            let field = |f: &str| format!("body[{b}].{f}");
+            vector(&field("min"), &body.min)?;
+            vector(&field("max"), &body.max)?;
+            for k in 0..d {
+                if body.min[k] >= body.max[k] {
+                    return Err(bad(
+                        field("max"),
+                        format!(
+                            "needs min < max on every axis, got min = {:?}, max = {:?}",
+                            body.min, body.max
+                        ),
+                    ));
+                }
+            }
+            if !(0.0..0.5).contains(&body.jitter) {
+                return Err(bad(
+                    field("jitter"),
+                    format!(
+                        "must be in [0, 0.5) (a fraction of the lattice cell), got {}",
+                        body.jitter
+                    ),
+                ));
+            }
+            match (&body.per_block, &body.count) {
+                (Some(p), None) => {
+                    if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
+                        return Err(bad(
+                            field("per_block"),
+                            format!("needs {d} counts in 1..=1000, got {p:?}"),
+                        ));
+                    }
+                    if !matches!(
+                        self.mesh,
+                        MeshSpec::Blocks { .. } | MeshSpec::Interval { .. }
+                    ) {
+                        return Err(bad(
+                            field("per_block"),
+                            "needs a `blocks` or `interval` mesh; use `count` on other meshes",
+                        ));
+                    }
+                }
+                (None, Some(c)) => {
+                    if c.len() != d || c.iter().any(|&n| n == 0 || n > 100_000) {
+                        return Err(bad(
+                            field("count"),
+                            format!("needs {d} counts in 1..=100000, got {c:?}"),
+                        ));
+                    }
+                }
+                _ => {
+                    return Err(bad(
+                        field("per_block"),
+                        "give exactly one of `per_block` and `count`",
+                    ))
+                }
+            }
+        }
+        let particles: f64 = self
+            .bodies
+            .iter()
+            .map(|b| self.estimated_particles(b))
+            .sum();
+        if particles > MAX_PARTICLES as f64 {
+            return Err(bad(
+                "body[0]",
+                format!(
+                    "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
+                ),
+            ));
+        }
+        match &self.initial_velocity {
+            InitialVelocity::Uniform { value } => vector("initial_velocity.value", value)?,
+            InitialVelocity::SineMode { v0 } => finite("initial_velocity.v0", *v0)?,
+            InitialVelocity::Exact {} if self.reference.is_none() => {
+                return Err(bad(
+                    "initial_velocity.kind",
+                    "`exact` needs a [reference] solution",
+                ))
+            }
+            _ => {}
+        }
+        for (i, bc) in self.boundaries.iter().enumerate() {
+            if bc.fix.is_empty() {
+                return Err(bad(format!("boundary[{i}].fix"), "lists no component"));
+            }
+            if bc.fix.contains(&Component::Normal) && bc.fix.len() > 1 {
+                return Err(bad(
+                    format!("boundary[{i}].fix"),
+                    "`normal` fixes the normal component alone; list it on its own",
+                ));
+            }
+            if let Some(c) = bc.fix.iter().find(|c| c.axis().is_some_and(|a| a >= d)) {
+                return Err(bad(
+                    format!("boundary[{i}].fix"),
+                    format!(
+                        "component `{}` does not exist in {d}D",
+                        format!("{c:?}").to_lowercase()
+                    ),
+                ));
+            }
+        }
+        let gravity = self.gravity();
+        for (i, effect) in self.effects.iter().enumerate() {
+            let field = |f: &str| format!("effect[{i}].{f}");
+            match effect {
+                EffectSpec::Gravity { g } => vector(&field("g"), g)?,
+                EffectSpec::Damping { alpha } => {
+                    if !(0.0..1.0).contains(alpha) {
+                        return Err(bad(
+                            field("alpha"),
+                            format!("must be in [0, 1), got {alpha}"),
+                        ));
+                    }
+                }
+                EffectSpec::Traction {
+                    min,
+                    max,
+                    traction,
+                    length,
+                    ramp,
+                } => {
+                    vector(&field("min"), min)?;
+                    vector(&field("max"), max)?;
+                    vector(&field("traction"), traction)?;
+                    positive(&field("length"), *length)?;
+                    if !(*ramp >= 0.0 && ramp.is_finite()) {
+                        return Err(bad(field("ramp"), format!("must be ≥ 0, got {ramp}")));
+                    }
+                }
+                EffectSpec::BodyForce { value } => vector(&field("value"), value)?,
+                EffectSpec::ManufacturedBodyForce {} => {
+                    if !matches!(self.reference, Some(Reference::AxisAligned { .. })) {
+                        return Err(bad(
+                            field("kind"),
+                            "`manufactured-body-force` needs reference kind `axis-aligned`",
+                        ));
+                    }
+                }
+                EffectSpec::GeostaticStress { surface, k0 } => {
+                    finite(&field("surface"), *surface)?;
+                    finite(&field("k0"), *k0)?;
+                    if gravity.is_none() {
+                        return Err(bad(
+                            field("kind"),
+                            "geostatic stress needs a gravity effect",
+                        ));
+                    }
+                }
+            }
+        }
+        match (self.time.dt, self.time.courant) {
+            (Some(dt), None) => positive("time.dt", dt)?,
+            (None, Some(c)) => positive("time.courant", c)?,
+            _ => return Err(bad("time.dt", "give exactly one of `dt` and `courant`")),
+        }
+        positive("time.t_end", self.time.t_end)?;
+        if self.study.refine.contains(&Component::Normal) {
+            return Err(bad("study.refine", "lists axes, `x` or `y`"));
+        }
+        for (i, t) in self.output.tracked.iter().enumerate() {
+            vector(&format!("output.tracked[{i}]"), t)?;
+        }
+        match self.reference {
+            Some(Reference::VibratingBar { v0 }) => finite("reference.v0", v0)?,
+            Some(Reference::ColumnSelfWeight {}) | Some(Reference::ColumnEquilibrium {})
+                if gravity.is_none() =>
+            {
+                return Err(bad(
+                    "reference.kind",
+                    "a column reference needs a gravity effect",
+                ));
+            }
+            Some(Reference::AxisAligned { u0 }) => {
+                finite("reference.u0", u0)?;
+                if d != 2 || self.material.model != MaterialModel::NeoHookean {
+                    return Err(bad(
+                        "reference.kind",
+                        "`axis-aligned` is a 2D neo-Hookean solution",
+                    ));
+                }
+            }
+            _ => {}
+        }
+        if self.steps() == 0 {
+            return Err(bad("time.t_end", "is shorter than one time step"));
+        }
+        Ok(())
+    }
+
+    /// About how many particles `body` gets (exact for aligned boxes).
+    fn estimated_particles(&self, body: &Body) -> f64 {
+        (0..self.dim)
+            .map(|k| {
+                self.lattice_spacing(body, k)
+                    .map_or(1.0, |h| (body.max[k] - body.min[k]) / h)
+            })
+            .product()
+    }
+}

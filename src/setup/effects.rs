@@ -1,0 +1,62 @@
+//! The effects a scene declares, built for its particles.
+
+use super::Solution;
+use crate::effect::{BodyForce, Effect, Gravity, LocalDamping, Traction};
+use crate::particles::Particles;
+use crate::scene::{EffectSpec, Scene};
+use crate::simulation::RunError;
+use nalgebra::SVector;
+
+/// The effects `scene` declares, built for `particles` (traction selects its
+/// particles here). Only these are assembled in a run.
+pub fn build_effects<const D: usize>(
+    scene: &Scene,
+    particles: &Particles<f64, D>,
+) -> Result<Vec<Box<dyn Effect<f64, D>>>, RunError> {
+    let solution = Solution::new(scene);
+    let mut effects: Vec<Box<dyn Effect<f64, D>>> = Vec::new();
+    for (i, spec) in scene.effects.iter().enumerate() {
+        match spec {
+            EffectSpec::Gravity { g } => effects.push(Box::new(Gravity {
+                g: SVector::<f64, D>::from_fn(|k, _| g[k]),
+            })),
+            EffectSpec::Damping { alpha } => effects.push(Box::new(LocalDamping { alpha: *alpha })),
+            EffectSpec::Traction {
+                min,
+                max,
+                traction,
+                length,
+                ramp,
+            } => {
+                let selected: Vec<usize> = (0..particles.len())
+                    .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
+                    .collect();
+                if selected.is_empty() {
+                    return Err(RunError::Setup(format!(
+                        "effect[{i}].min: the traction box selects no particle"
+                    )));
+                }
+                let share = length / selected.len() as f64;
+                effects.push(Box::new(Traction {
+                    particles: selected,
+                    force: SVector::<f64, D>::from_fn(|k, _| traction[k] * share),
+                    ramp: *ramp,
+                }));
+            }
+            EffectSpec::BodyForce { value } => effects.push(Box::new(BodyForce::Uniform(
+                SVector::<f64, D>::from_fn(|k, _| value[k]),
+            ))),
+            EffectSpec::ManufacturedBodyForce {} => {
+                let Some(Solution::AxisAligned(a)) = solution else {
+                    return Err(RunError::Setup(format!(
+                        "effect[{i}].kind: `manufactured-body-force` needs reference kind `axis-aligned`"
+                    )));
+                };
+                effects.push(Box::new(BodyForce::Manufactured(a)));
+            }
+            // An initial state, not an effect: `particles::apply_initial_states`.
+            EffectSpec::GeostaticStress { .. } => {}
+        }
+    }
+    Ok(effects)
+}

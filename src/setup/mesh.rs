@@ -1,0 +1,188 @@
+//! The geometry of a scene: its mesh (generated or read), the checks of its boundary
+//! conditions against the mesh's tags, the normals of its slip walls, and the basis
+//! on it.
+
+use super::Domain;
+use crate::bases::BasisKind;
+use crate::scene::{BlockLayout, Component, MeshSpec, Scene};
+use crate::simulation::RunError;
+use psmpm_basis::basis::bspline1d::QuadraticBSpline;
+use psmpm_basis::basis::linear::Linear;
+use psmpm_basis::basis::linear1d::Linear1d;
+use psmpm_basis::basis::powell_sabin::PowellSabin;
+use psmpm_basis::mesh::generators::{self, PolygonDomain};
+use psmpm_basis::{Mesh1d, TriMesh, Vec2};
+
+/// The basis of a 2D scene, as the scene chose it.
+pub(crate) enum Basis2d {
+    /// Powell–Sabin splines.
+    Ps(PowellSabin<f64>),
+    /// Piecewise-linear.
+    Linear(Linear<f64>),
+}
+
+/// The basis of a 1D scene, as the scene chose it.
+pub(crate) enum Basis1d {
+    /// Quadratic B-splines.
+    Bspline(QuadraticBSpline<f64>),
+    /// Piecewise-linear.
+    Linear(Linear1d<f64>),
+}
+
+/// The mesh, basis and slip walls of a 2D scene (validated here).
+pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
+    scene.validate()?;
+    if scene.dim != 2 {
+        return Err(RunError::Setup(format!("dim: the scene is {}D", scene.dim)));
+    }
+    let mesh = triangulation(scene)?;
+    let h = smallest_edge(&mesh);
+    check_tags(scene, mesh.tags())?;
+    let walls = wall_normals(scene, &mesh)?;
+    let basis = match scene.basis {
+        BasisKind::Ps => Basis2d::Ps(
+            PowellSabin::<f64>::new(mesh, scene.split)
+                .map_err(|e| RunError::Setup(format!("basis: {e}")))?,
+        ),
+        _ => Basis2d::Linear(Linear::<f64>::new(mesh)),
+    };
+    Ok(Domain { basis, h, walls })
+}
+
+/// The mesh, basis and walls of a 1D scene (validated here).
+pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
+    scene.validate()?;
+    let MeshSpec::Interval { x, elements } = scene.mesh else {
+        return Err(RunError::Setup(
+            "mesh.kind: a 1D scene needs an `interval` mesh".into(),
+        ));
+    };
+    let mesh =
+        Mesh1d::uniform(x[0], x[1], elements).map_err(|e| RunError::Setup(format!("mesh: {e}")))?;
+    let h = (x[1] - x[0]) / elements as f64;
+    // In 1D the normal of a wall is the axis.
+    check_tags(scene, &mesh.tags().map(String::from))?;
+    let walls: Vec<(String, [f64; 2])> = scene
+        .boundaries
+        .iter()
+        .filter(|bc| bc.fix.contains(&Component::Normal))
+        .map(|bc| (bc.tag.clone(), [1.0, 0.0]))
+        .collect();
+    let basis = match scene.basis {
+        BasisKind::Bspline => Basis1d::Bspline(QuadraticBSpline::<f64>::new(mesh)),
+        _ => Basis1d::Linear(Linear1d::<f64>::new(mesh)),
+    };
+    Ok(Domain { basis, h, walls })
+}
+
+/// The mesh of a 2D scene and its smallest edge length.
+pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
+    let mesh = match &scene.mesh {
+        MeshSpec::Blocks {
+            x,
+            y,
+            blocks,
+            layout,
+        } => match layout {
+            BlockLayout::FourTriangles => {
+                generators::block_grid(x[0], x[1], y[0], y[1], blocks[0], blocks[1])
+            }
+            BlockLayout::Delaunay => {
+                generators::block_delaunay(x[0], x[1], y[0], y[1], blocks[0], blocks[1])
+            }
+        }
+        .map_err(|e| RunError::Setup(format!("mesh: {e}")))?,
+        MeshSpec::Polygon {
+            outline,
+            tags,
+            holes,
+            edge_length,
+        } => {
+            let points = |o: &[[f64; 2]]| o.iter().map(|p| Vec2::new(p[0], p[1])).collect();
+            let domain = PolygonDomain {
+                outer: points(outline),
+                outer_tags: if tags.is_empty() {
+                    vec!["boundary".to_string(); outline.len()]
+                } else {
+                    tags.clone()
+                },
+                holes: holes
+                    .iter()
+                    .map(|h| (points(&h.outline), h.tag.clone()))
+                    .collect(),
+            };
+            generators::polygon_mesh(&domain, *edge_length).map_err(|e| {
+                let e = e.to_string();
+                let field = if e.contains("edge_length") {
+                    "mesh.edge_length"
+                } else {
+                    "mesh.outline"
+                };
+                RunError::Setup(format!("{field}: {e}"))
+            })?
+        }
+        MeshSpec::Gmsh { file } => psmpm_basis::mesh::gmsh::read_msh(std::path::Path::new(file))
+            .map_err(|e| RunError::Setup(format!("mesh.file: {e}")))?,
+        MeshSpec::Interval { .. } => {
+            return Err(RunError::Setup("mesh.kind: `interval` is a 1D mesh".into()))
+        }
+    };
+    Ok(mesh)
+}
+
+/// Every boundary condition names a tag of the mesh.
+fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
+    for (b, bc) in scene.boundaries.iter().enumerate() {
+        if !tags.contains(&bc.tag) {
+            return Err(RunError::Setup(format!(
+                "boundary[{b}].tag: unknown boundary tag `{}`; the mesh has tags {tags:?}",
+                bc.tag
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The unit normal of every slip wall (`fix = ["normal"]`): the boundary edges with
+/// the wall's tag must all be parallel (a straight wall).
+fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>, RunError> {
+    let mut walls = Vec::new();
+    for (b, bc) in scene.boundaries.iter().enumerate() {
+        if !bc.fix.contains(&Component::Normal) {
+            continue;
+        }
+        let id = mesh
+            .tag_id(&bc.tag)
+            .map_err(|e| RunError::Setup(format!("boundary[{b}].tag: {e}")))?;
+        let mut normal: Option<Vec2> = None;
+        for e in mesh.edges().iter().filter(|e| e.tag == Some(id)) {
+            let d = mesh.vertices()[e.vertices[1]] - mesh.vertices()[e.vertices[0]];
+            let n = Vec2::new(d[1], -d[0]).normalize();
+            match normal {
+                None => normal = Some(n),
+                Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > 1e-9 => {
+                    return Err(RunError::Setup(format!(
+                        "boundary[{b}].fix: `normal` needs a straight wall, but `{}` bends",
+                        bc.tag
+                    )))
+                }
+                Some(_) => {}
+            }
+        }
+        let n = normal.ok_or_else(|| {
+            RunError::Setup(format!(
+                "boundary[{b}].tag: `{}` has no boundary edge",
+                bc.tag
+            ))
+        })?;
+        walls.push((bc.tag.clone(), [n[0], n[1]]));
+    }
+    Ok(walls)
+}
+
+fn smallest_edge(mesh: &TriMesh) -> f64 {
+    mesh.edges()
+        .iter()
+        .map(|e| (mesh.vertices()[e.vertices[0]] - mesh.vertices()[e.vertices[1]]).norm())
+        .fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,226 @@
+//! Set-up: a scene becomes the pieces of its run. The mesh (generated or read,
+//! [`triangulation`]) and its basis, checked against the scene's boundary conditions
+//! (mesh.rs); the particles filling the bodies ([`particle_lattice`]) with their
+//! initial states, velocity and initial stress (particles.rs); the effects the scene
+//! declares ([`build_effects`], effects.rs); the reference solution (solution.rs);
+//! and the one driver a scene runs on ([`SceneDriver`]), with the time step and the
+//! number of steps (here).
+//! [`crate::simulation`] runs what this builds.
+
+mod effects;
+mod mesh;
+mod particles;
+mod solution;
+
+pub use effects::build_effects;
+pub use mesh::triangulation;
+pub use particles::{particle_lattice, Lattice};
+
+pub(crate) use mesh::{domain_1d, domain_2d, Basis1d, Basis2d};
+pub(crate) use solution::Solution;
+
+use crate::driver::{Driver, Fix, SetupError};
+use crate::effect::Effect;
+use crate::mass::MassStrategy;
+use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
+use crate::particles::Particles;
+use crate::scene::{MaterialModel, Scene};
+use crate::simulation::RunError;
+use nalgebra::SVector;
+use psmpm_basis::Basis;
+
+/// The driver of a scene's run: the mass strategy and the material are chosen by
+/// the scene, at run time.
+pub type SceneDriver<const D: usize, B> =
+    Driver<f64, D, B, Box<dyn MassStrategy<f64>>, AnyMaterial>;
+
+/// A scene's basis (in one of its typed choices, or chosen), its smallest mesh
+/// length and the unit normals of its slip walls.
+pub(crate) struct Domain<B> {
+    /// The basis.
+    pub basis: B,
+    /// Smallest edge (2D) or element length (1D).
+    pub h: f64,
+    /// Tag and unit normal of every slip wall.
+    pub walls: Vec<(String, [f64; 2])>,
+}
+
+/// A run ready to step.
+pub(crate) struct Prepared<const D: usize, B: Basis<f64, D>> {
+    /// The driver, with particles, effects, fixes and walls.
+    pub driver: SceneDriver<D, B>,
+    /// The time step.
+    pub dt: f64,
+    /// Steps to take.
+    pub steps: usize,
+    /// The critical time step at the start, when it could be estimated.
+    pub dt_critical: Option<f64>,
+    /// Basis functions.
+    pub functions: usize,
+    /// Initial particle positions (the second entry is 0 in 1D).
+    pub positions: Vec<[f64; 2]>,
+    /// The reference solution.
+    pub solution: Option<Solution>,
+    /// The lower corner of the first body (the origin of the reference solutions).
+    pub origin: [f64; 2],
+}
+
+/// Sets up the run of `scene` on `domain`: material, particles with their initial
+/// states, effects, driver, time step.
+pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    domain: Domain<B>,
+) -> Result<Prepared<D, B>, RunError> {
+    let (material, density) = material::<D>(scene)?;
+    let solution = Solution::new(scene);
+    let mut origin = [0.0; 2];
+    origin[..D].copy_from_slice(&scene.bodies[0].min[..D]);
+    let lattice = particle_lattice(scene)?;
+    let mut particles = particles::place::<D>(&lattice, density);
+    particles::apply_initial_states(scene, &lattice.positions, solution, origin, &mut particles);
+    let effects = build_effects(scene, &particles)?;
+    let Domain { basis, h, walls } = domain;
+    let functions = basis.num_functions();
+    // With `courant` the step is fixed by `time_steps`, from the critical step; this
+    // one (a mesh-based guess) only sets the driver up.
+    let dt = scene.dt(h);
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(RunError::Setup(format!(
+            "time: the time step {dt} is not positive"
+        )));
+    }
+    let mut driver = driver(
+        scene,
+        basis,
+        particles,
+        material,
+        effects,
+        dt,
+        &walls,
+        &lattice.body_sizes,
+    )?;
+    let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt);
+    Ok(Prepared {
+        driver,
+        dt,
+        steps,
+        dt_critical,
+        functions,
+        positions: lattice.positions,
+        solution,
+        origin,
+    })
+}
+
+/// The scene's material law in `D` dimensions, and its density.
+fn material<const D: usize>(scene: &Scene) -> Result<(AnyMaterial, f64), RunError> {
+    let m = &scene.material;
+    let elastic = Elastic::new(m.young, m.poisson, m.density)
+        .map_err(|e| RunError::Setup(format!("material: {e}")))?;
+    let material = match m.model {
+        MaterialModel::LinearElastic => AnyMaterial::Linear(LinearElastic::new(elastic, D)),
+        MaterialModel::NeoHookean => AnyMaterial::NeoHookean(NeoHookean::new(elastic, D)),
+    };
+    Ok((material, elastic.density))
+}
+
+/// The one place a scene's driver is built: fixes from the boundary conditions,
+/// the scene's mass strategy, the condition estimate on request, slip walls. A
+/// particle outside the mesh is reported against its body.
+#[allow(clippy::too_many_arguments)]
+fn driver<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    basis: B,
+    particles: Particles<f64, D>,
+    material: AnyMaterial,
+    effects: Vec<Box<dyn Effect<f64, D>>>,
+    dt: f64,
+    walls: &[(String, [f64; 2])],
+    body_sizes: &[usize],
+) -> Result<SceneDriver<D, B>, RunError> {
+    let fixes: Vec<Fix> = scene
+        .boundaries
+        .iter()
+        .flat_map(|bc| {
+            bc.fix.iter().filter_map(|c| {
+                c.axis().map(|component| Fix {
+                    tag: bc.tag.clone(),
+                    component,
+                })
+            })
+        })
+        .collect();
+    let mut driver: SceneDriver<D, B> = Driver::new(
+        basis,
+        particles,
+        material,
+        scene.mass.build::<f64>(),
+        &fixes,
+        effects,
+        dt,
+    )
+    .map_err(|e| match e {
+        SetupError::ParticleOutside { particle, position } => {
+            // Name the body the particle belongs to.
+            let mut first = 0;
+            let body = body_sizes
+                .iter()
+                .position(|&n| {
+                    first += n;
+                    particle < first
+                })
+                .unwrap_or(0);
+            RunError::Setup(format!(
+                "body[{body}].max: the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"
+            ))
+        }
+        other => other.into(),
+    })?;
+    driver.estimate_condition = scene.output.condition;
+    for (tag, normal) in walls {
+        let n = SVector::<f64, D>::from_fn(|k, _| normal[k]);
+        driver.add_slip_wall(tag, &n)?;
+    }
+    Ok(driver)
+}
+
+/// The time step, the number of steps and the critical step at the start: a fixed
+/// `dt`, or with `courant` that fraction of the critical step, shortened so that a
+/// whole number of steps ends at `t_end` (a failure of the estimate is the failure
+/// of step 1, reported by the first step itself).
+fn time_steps<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    driver: &mut SceneDriver<D, B>,
+    dt: f64,
+) -> (f64, usize, Option<f64>) {
+    let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
+    match scene.time.courant {
+        Some(c) => {
+            let steps = (scene.time.t_end / (c * dt_critical.unwrap_or(dt / c)))
+                .ceil()
+                .max(1.0) as usize;
+            let dt = scene.time.t_end / steps as f64;
+            driver.set_dt(dt);
+            (dt, steps, dt_critical)
+        }
+        None => (
+            dt,
+            (scene.time.t_end / dt).round().max(1.0) as usize,
+            dt_critical,
+        ),
+    }
+}
+
+/// A point of the scene (`[f64; 2]`, the second entry ignored in 1D) as a vector.
+pub(crate) fn to_vec<const D: usize>(p: [f64; 2]) -> SVector<f64, D> {
+    SVector::<f64, D>::from_fn(|k, _| p[k])
+}
+
+/// A vector as a point of the scene (the second entry 0 in 1D).
+pub(crate) fn from_vec<const D: usize>(v: &SVector<f64, D>) -> [f64; 2] {
+    let mut p = [0.0; 2];
+    for k in 0..D {
+        p[k] = v[k];
+    }
+    p
+}

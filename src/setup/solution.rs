@@ -1,0 +1,94 @@
+//! The scene's reference solution, resolved from its parameters, in the scene's
+//! dimension.
+
+use crate::scene::{Reference, Scene};
+use crate::studies::exact;
+
+/// The scene's reference solution with its parameters resolved.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Solution {
+    Bar(exact::VibratingBar),
+    Column(exact::ColumnSelfWeight),
+    AxisAligned(exact::AxisAligned),
+    Equilibrium {
+        height: f64,
+        density: f64,
+        gravity: f64,
+        young: f64,
+    },
+}
+
+impl Solution {
+    pub(crate) fn new(scene: &Scene) -> Option<Self> {
+        let m = &scene.material;
+        let body = &scene.bodies[0];
+        let d = scene.dim;
+        let gravity = scene.gravity().map_or(0.0, |g| g[d - 1]);
+        Some(match scene.reference? {
+            Reference::VibratingBar { v0 } => Solution::Bar(exact::VibratingBar {
+                length: body.max[0] - body.min[0],
+                young: m.young,
+                density: m.density,
+                v0,
+            }),
+            Reference::ColumnSelfWeight {} => Solution::Column(exact::ColumnSelfWeight {
+                height: body.max[d - 1] - body.min[d - 1],
+                young: m.young,
+                density: m.density,
+                gravity,
+            }),
+            Reference::AxisAligned { u0 } => Solution::AxisAligned(exact::AxisAligned {
+                u0,
+                young: m.young,
+                poisson: m.poisson,
+                density: m.density,
+            }),
+            Reference::ColumnEquilibrium {} => Solution::Equilibrium {
+                height: body.max[d - 1] - body.min[d - 1],
+                density: m.density,
+                gravity,
+                young: m.young,
+            },
+        })
+    }
+
+    /// Exact displacement at reference position `x0` (relative to the body's
+    /// lower corner `origin`) and time `t`, in the scene's dimension.
+    pub(crate) fn displacement(
+        &self,
+        x0: [f64; 2],
+        origin: [f64; 2],
+        dim: usize,
+        t: f64,
+    ) -> [f64; 2] {
+        match self {
+            Solution::Bar(bar) => [bar.displacement(x0[0] - origin[0], t), 0.0],
+            Solution::Column(column) => {
+                let u = column.displacement(x0[dim - 1] - origin[dim - 1], t);
+                if dim == 1 {
+                    [u, 0.0]
+                } else {
+                    [0.0, u]
+                }
+            }
+            Solution::AxisAligned(a) => a.displacement(x0, t),
+            Solution::Equilibrium { .. } => [0.0; 2],
+        }
+    }
+
+    pub(crate) fn velocity(&self, x0: [f64; 2], origin: [f64; 2], dim: usize, t: f64) -> [f64; 2] {
+        match self {
+            Solution::Bar(bar) => [bar.velocity(x0[0] - origin[0], t), 0.0],
+            Solution::AxisAligned(a) => a.velocity(x0, t),
+            Solution::Column(column) => {
+                let v = column.velocity(x0[dim - 1] - origin[dim - 1], t);
+                if dim == 1 {
+                    [v, 0.0]
+                } else {
+                    [0.0, v]
+                }
+            }
+            Solution::Equilibrium { .. } => [0.0; 2],
+        }
+    }
+}
