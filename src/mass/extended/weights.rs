@@ -1,0 +1,185 @@
+//! The rows of the extension matrix `E`: for an under-supported function, the
+//! nearest well-covered functions (rings of neighbours) and the minimum-norm
+//! weights that keep the polynomials the basis reproduces.
+
+use super::{Extended, Role, EXTENSION_RINGS, MAX_EXTENSION_TERMS, MAX_EXTENSION_WEIGHT};
+use crate::sparse::Scalar;
+
+impl<T: Scalar> Extended<T> {
+    /// Collects the solved functions of the next ring around the current search
+    /// front into `candidates`; returns `false` when the front is exhausted.
+    fn next_ring(&mut self) -> bool {
+        std::mem::swap(&mut self.front, &mut self.queue);
+        self.queue.clear();
+        for idx in 0..self.front.len() {
+            let f = self.front[idx];
+            for &g in self.support.neighbours_of(f) {
+                if self.mark[g] == self.stamp {
+                    continue;
+                }
+                self.mark[g] = self.stamp;
+                self.queue.push(g);
+                if self.role[g] == Role::Solved && self.candidates.len() < MAX_EXTENSION_TERMS {
+                    self.candidates.push(g);
+                }
+            }
+        }
+        !self.queue.is_empty()
+    }
+
+    /// Minimum-norm weights expressing function `j` through `candidates` with
+    /// polynomial precision of the first `terms` monomials; `None` when the
+    /// candidates cannot reproduce them or need too large weights.
+    fn weights_for(&mut self, j: usize, terms: usize) -> Option<()> {
+        let facts = &self.support;
+        let nm = facts.exponents.len();
+        let m = self.candidates.len();
+        if m < terms {
+            return None;
+        }
+        // Local monomials q_α = ((ξ − c) / h)^α around X_j, h the farthest candidate.
+        let c = facts.points[j];
+        let h = self
+            .candidates
+            .iter()
+            .map(|&i| {
+                let p = facts.points[i];
+                ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt()
+            })
+            .fold(0.0f64, f64::max);
+        if h <= 0.0 {
+            return None;
+        }
+        // λ(q_α) = Σ_β T_αβ λ(m_β) with the binomial expansion of (ξ − c)^α / h^|α|.
+        let mut t = [0.0f64; 36];
+        for (a, alpha) in facts.exponents[..terms].iter().enumerate() {
+            let scale = h.powi((alpha[0] + alpha[1]) as i32);
+            for r0 in 0..=alpha[0] {
+                for r1 in 0..=alpha[1] {
+                    let beta = facts
+                        .exponents
+                        .iter()
+                        .position(|e| *e == [r0, r1])
+                        .expect("lower monomials are listed");
+                    t[a * 6 + beta] += binomial(alpha[0], r0)
+                        * (-c[0]).powi((alpha[0] - r0) as i32)
+                        * binomial(alpha[1], r1)
+                        * (-c[1]).powi((alpha[1] - r1) as i32)
+                        / scale;
+                }
+            }
+        }
+        let expansion = |a: usize, coeffs: &[f64]| -> f64 {
+            (0..nm).map(|beta| t[a * 6 + beta] * coeffs[beta]).sum()
+        };
+        // A (terms × m) row-major, target (terms).
+        self.local.clear();
+        for a in 0..terms {
+            for &i in &self.candidates {
+                self.local
+                    .push(expansion(a, &facts.coefficients[i * nm..(i + 1) * nm]));
+            }
+        }
+        let mut target = [0.0; 6];
+        for (a, value) in target.iter_mut().enumerate().take(terms) {
+            *value = expansion(a, &facts.coefficients[j * nm..(j + 1) * nm]);
+        }
+        // G = A Aᵀ, Cholesky, y = G⁻¹ t, e = Aᵀ y.
+        let mut g = [0.0; 36];
+        for a in 0..terms {
+            for b in 0..=a {
+                let s: f64 = (0..m)
+                    .map(|k| self.local[a * m + k] * self.local[b * m + k])
+                    .sum();
+                g[a * 6 + b] = s;
+            }
+        }
+        let max_diag = (0..terms).map(|a| g[a * 6 + a]).fold(0.0f64, f64::max);
+        for a in 0..terms {
+            for b in 0..=a {
+                let mut s = g[a * 6 + b];
+                for k in 0..b {
+                    s -= g[a * 6 + k] * g[b * 6 + k];
+                }
+                if a == b {
+                    if s.is_nan() || s <= 1e-12 * max_diag {
+                        return None;
+                    }
+                    g[a * 6 + a] = s.sqrt();
+                } else {
+                    g[a * 6 + b] = s / g[b * 6 + b];
+                }
+            }
+        }
+        let mut y = target;
+        for a in 0..terms {
+            for k in 0..a {
+                y[a] -= g[a * 6 + k] * y[k];
+            }
+            y[a] /= g[a * 6 + a];
+        }
+        for a in (0..terms).rev() {
+            for k in a + 1..terms {
+                y[a] -= g[k * 6 + a] * y[k];
+            }
+            y[a] /= g[a * 6 + a];
+        }
+        self.weights.clear();
+        for k in 0..m {
+            let e: f64 = (0..terms).map(|a| self.local[a * m + k] * y[a]).sum();
+            self.weights.push(e);
+        }
+        let largest = self.weights.iter().fold(0.0f64, |a, w| a.max(w.abs()));
+        (largest <= MAX_EXTENSION_WEIGHT && largest.is_finite()).then_some(())
+    }
+
+    /// Builds the row of `E` for the under-supported function `j`; returns `false`
+    /// when no well-covered function can carry it.
+    pub(super) fn extend(&mut self, j: usize) -> bool {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.mark.iter_mut().for_each(|m| *m = 0);
+            self.stamp = 1;
+        }
+        self.mark[j] = self.stamp;
+        self.queue.clear();
+        self.queue.push(j);
+        self.candidates.clear();
+        let full = self.support.exponents.len();
+        let mut found = false;
+        for _ in 0..EXTENSION_RINGS {
+            if !self.next_ring() && self.candidates.is_empty() {
+                break;
+            }
+            if self.weights_for(j, full).is_some() {
+                found = true;
+                break;
+            }
+        }
+        if !found {
+            // Lower precision with every candidate found: linear, then constant.
+            let lower = [1 + self.support.dim, 1];
+            found = lower
+                .iter()
+                .filter(|&&t| t < full)
+                .any(|&t| self.weights_for(j, t).is_some());
+        }
+        if !found {
+            return false;
+        }
+        for (k, &i) in self.candidates.iter().enumerate() {
+            self.ext_idx.push(i);
+            self.ext_w.push(T::of(self.weights[k]));
+        }
+        true
+    }
+}
+
+fn binomial(n: usize, k: usize) -> f64 {
+    match (n, k) {
+        (_, 0) => 1.0,
+        (n, k) if k == n => 1.0,
+        (2, 1) => 2.0,
+        (n, k) => (1..=k).fold(1.0, |acc, i| acc * (n + 1 - i) as f64 / i as f64),
+    }
+}
