@@ -18,7 +18,8 @@
 //!   `s = ½ |g_t| t²`, `g_t` the gravity's component along the wall; the error is
 //!   `|s_run − s| / s`, `s_run` the mean particle displacement along `g_t`;
 //! - otherwise `energy-growth`: the largest growth of the total energy over the run,
-//!   relative to the energy scale (what the stability verdict bounds by 0.05).
+//!   relative to the energy scale (what the stability verdict bounds by 0.05); none
+//!   for a run that failed in its first step.
 //!
 //! The error of a run that stopped is the one at the step it stopped.
 //!
@@ -345,6 +346,11 @@ fn reason(s: &Summary) -> Option<String> {
     Some(why.join("; "))
 }
 
+/// The energy growth of a run that took a step (nothing to measure before).
+fn growth(s: &Summary) -> Option<f64> {
+    (s.steps > 0).then_some(s.energy_growth)
+}
+
 /// Runs one cell.
 fn run_cell(case: &str, scene: &Scene, on_step: &mut dyn FnMut()) -> Result<Cell, RunError> {
     let (summary, error, measure, roughness) = if scene.dim == 2 {
@@ -354,14 +360,14 @@ fn run_cell(case: &str, scene: &Scene, on_step: &mut dyn FnMut()) -> Result<Cell
         let (error, measure) = match (s.error_measure, slide_normal(scene)) {
             (Some(m), _) => (s.error, m),
             (None, Some(n)) => (slide_error(scene, n, &out.particles, s.t_end), "slide"),
-            (None, None) => (Some(s.energy_growth), "energy-growth"),
+            (None, None) => (growth(&s), "energy-growth"),
         };
         (s, error, measure, roughness)
     } else {
         let s = simulation::run(scene, &mut |_| on_step())?;
         let (error, measure) = match s.error_measure {
             Some(m) => (s.error, m),
-            None => (Some(s.energy_growth), "energy-growth"),
+            None => (growth(&s), "energy-growth"),
         };
         (s, error, measure, None)
     };
