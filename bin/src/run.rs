@@ -96,7 +96,7 @@ pub struct RunArgs {
     /// Mass strategy: default (= extended: under-supported functions expressed
     /// through well-covered neighbours), extended:C (coverage threshold C), consistent,
     /// lumped, partial (lump rows touching empty elements), partial:TAU (lump rows with
-    /// M_ii < TAU·max M_jj), partial-coverage:C, deactivate[:THRESHOLD] or fmpm:K.
+    /// M_ii < TAU·max M_jj), partial-coverage:C, deactivate, deactivate:THRESHOLD or fmpm:K.
     #[arg(long)]
     mass: Option<String>,
     #[command(flatten)]
