@@ -1,6 +1,6 @@
 //! What a step and a run report: energies, momentum, what the mass strategy did,
 //! the condition of the solved system, phase timings, and the stability verdict
-//! of `shared/docs/benchmarks.md`.
+//! of the benchmark definitions of the seeds (paper and thesis, as checked against their tables).
 
 use crate::effect::Effect;
 use crate::mass::MassReport;

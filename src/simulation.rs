@@ -9,7 +9,7 @@
 //! step, and everything measured up to there, so that instabilities are reported as
 //! results. `Err` is for scenes that cannot be set up.
 //!
-//! "Stable" follows `shared/docs/benchmarks.md`: no failure, the total energy
+//! "Stable" follows the benchmark definitions of the seeds (paper and thesis, as checked against their tables): no failure, the total energy
 //! (kinetic + strain + gravitational − work of the non-conservative effects) never
 //! exceeds its initial value by more than [`STABLE_ENERGY_GROWTH`] of the energy
 //! scale, and every condition estimate (when requested) stays below

@@ -1,6 +1,6 @@
 //! Sparse symmetric matrices on a basis, and their Cholesky factorisation.
 //!
-//! The mass matrix `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)` (paper eq. (17)) and the
+//! The mass matrix `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)` (paper eq. (13)) and the
 //! L² Gram matrix share one sparsity pattern: `i` and `j` couple when some element
 //! carries both functions. [`SymmetricPattern`] builds that pattern once per basis,
 //! stores its upper triangle in compressed sparse column form (an `sprs` matrix), and

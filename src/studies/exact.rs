@@ -4,7 +4,7 @@
 //! Sources: the seed paper (de Koster, Tielen, Wobbes, Möller 2020, "Extension of
 //! B-spline Material Point Method for unstructured triangular grids using Powell–Sabin
 //! splines"; equation numbers "(n)") and the thesis (de Koster 2018; "thesis (4.n)"),
-//! as specified in `shared/docs/benchmarks.md`. Symbols are those of the paper:
+//! as specified in the benchmark definitions of the seeds (paper and thesis, as checked against their tables). Symbols are those of the paper:
 //! `E` Young's modulus, `ν` Poisson's ratio, `ρ⁰` reference density, `x⁰` the
 //! reference (initial) position of a material point, `u` its displacement.
 //!

@@ -1,6 +1,6 @@
 //! A 1D updated-Lagrangian finite-element solver (linear elements): the reference
 //! solution of the large-deformation benchmarks B3 (vibrating bar) and B5b (column
-//! under self-weight), see `shared/docs/benchmarks.md`.
+//! under self-weight), see the benchmark definitions of the seeds (paper and thesis, as checked against their tables).
 //!
 //! # The model
 //!
