@@ -7,15 +7,13 @@
 //! of `M_L` (it maps `M 1 = M_L 1` to `1`), so mass and momentum are conserved.
 //! It still divides by the lumped mass of nearly empty functions.
 
-use super::lumped::diagonal_condition;
-use super::{MassError, MassReport, MassSetup, MassStrategy, StepContext};
+use super::{Lumped, MassError, MassReport, MassSetup, MassStrategy, StepContext};
 use crate::sparse::{mul_upper, Scalar, SymmetricPattern};
 
-/// The truncated series of order `K`.
+/// The truncated series of order `K`, on top of the lumped solve.
 pub struct Fmpm<T: Scalar> {
     order: usize,
-    fixed: Vec<Vec<bool>>,
-    lumped: Vec<T>,
+    lumped: Lumped<T>,
     values: Vec<T>,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -28,25 +26,12 @@ impl<T: Scalar> Fmpm<T> {
     pub fn new(order: usize) -> Self {
         Fmpm {
             order,
-            fixed: Vec::new(),
-            lumped: Vec::new(),
+            lumped: Lumped::default(),
             values: Vec::new(),
             col_ptr: Vec::new(),
             row_idx: Vec::new(),
             term: Vec::new(),
             product: Vec::new(),
-        }
-    }
-
-    /// `y ← M_L⁻¹ y`, zero at fixed and inactive functions.
-    fn lumped_solve(&self, k: usize, y: &mut [T]) {
-        for (i, r) in y.iter_mut().enumerate() {
-            let m = self.lumped[i];
-            *r = if self.fixed[k][i] || m <= T::zero() {
-                T::zero()
-            } else {
-                *r / m
-            };
         }
     }
 }
@@ -57,8 +42,7 @@ impl<T: Scalar> MassStrategy<T> for Fmpm<T> {
     }
     fn prepare(&mut self, setup: &MassSetup) {
         let n = setup.pattern.dim();
-        self.fixed = setup.fixed.to_vec();
-        self.lumped = vec![T::zero(); n];
+        self.lumped.prepare(setup);
         self.values = vec![T::zero(); setup.pattern.nnz()];
         self.col_ptr = setup.pattern.col_ptr().to_vec();
         self.row_idx = setup.pattern.row_idx().to_vec();
@@ -69,41 +53,33 @@ impl<T: Scalar> MassStrategy<T> for Fmpm<T> {
         &mut self,
         pattern: &SymmetricPattern,
         values: &[T],
-        _context: StepContext,
+        context: StepContext,
     ) -> Result<MassReport, MassError> {
-        pattern.row_sums(values, &mut self.lumped);
         self.values.copy_from_slice(values);
-        let active = self.lumped.iter().filter(|&&m| m > T::zero()).count();
-        Ok(MassReport {
-            active,
-            lumped_rows: active,
-            ..MassReport::default()
-        })
+        self.lumped.factorize(pattern, values, context)
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         // y₀ = M_L⁻¹ F; t_j = t_{j−1} − M_L⁻¹ M t_{j−1}; y = Σ t_j.
-        self.lumped_solve(k, rhs);
+        self.lumped.solve(k, rhs)?;
         self.term.copy_from_slice(rhs);
         for _ in 0..self.order {
-            let mut product = std::mem::take(&mut self.product);
             mul_upper(
                 &self.col_ptr,
                 &self.row_idx,
                 &self.values,
                 &self.term,
-                &mut product,
+                &mut self.product,
             );
-            self.lumped_solve(k, &mut product);
-            for ((t, p), y) in self.term.iter_mut().zip(&product).zip(rhs.iter_mut()) {
+            self.lumped.solve(k, &mut self.product)?;
+            for ((t, p), y) in self.term.iter_mut().zip(&self.product).zip(rhs.iter_mut()) {
                 *t -= *p;
                 *y += *t;
             }
-            self.product = product;
         }
         Ok(())
     }
     /// The system divided by is `M_L`: `max M_ii^L / min M_ii^L`.
-    fn condition_estimate(&mut self, _pattern: &SymmetricPattern) -> f64 {
-        diagonal_condition(&self.lumped)
+    fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
+        self.lumped.condition_estimate(pattern)
     }
 }

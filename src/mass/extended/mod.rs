@@ -260,32 +260,6 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         ] {
             v.iter_mut().for_each(|a| *a = T::zero());
         }
-        // Jacobi preconditioner: M_ii + Σ_j e_ji² M_jj.
-        for s in 0..self.fixed.len() {
-            let mut precond = std::mem::take(&mut self.precond[s]);
-            {
-                let op = self.reduced(s);
-                for i in 0..n {
-                    precond[i] = if op.free(i) {
-                        values[pattern.diagonal_position(i)]
-                    } else {
-                        T::one()
-                    };
-                }
-                for j in 0..n {
-                    if self.role[j] == Role::Extended && !op.fixed[j] {
-                        let mjj = values[pattern.diagonal_position(j)];
-                        for t in self.ext_ptr[j]..self.ext_ptr[j + 1] {
-                            let i = self.ext_idx[t];
-                            if op.free(i) {
-                                precond[i] += self.ext_w[t] * self.ext_w[t] * mjj;
-                            }
-                        }
-                    }
-                }
-            }
-            self.precond[s] = precond;
-        }
         // Nothing extended: `E = I`, the consistent system, solved as the
         // consistent strategy solves it (bit for bit).
         self.direct = false;
@@ -295,6 +269,35 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 self.cholesky.lumped[i] = false;
             }
             self.direct = self.cholesky.factorize(pattern, values).is_ok();
+        }
+        // Jacobi preconditioner of the CG, M_ii + Σ_j e_ji² M_jj (not needed when
+        // the step is solved directly).
+        if !self.direct {
+            for s in 0..self.fixed.len() {
+                let mut precond = std::mem::take(&mut self.precond[s]);
+                {
+                    let op = self.reduced(s);
+                    for i in 0..n {
+                        precond[i] = if op.free(i) {
+                            values[pattern.diagonal_position(i)]
+                        } else {
+                            T::one()
+                        };
+                    }
+                    for j in 0..n {
+                        if self.role[j] == Role::Extended && !op.fixed[j] {
+                            let mjj = values[pattern.diagonal_position(j)];
+                            for t in self.ext_ptr[j]..self.ext_ptr[j + 1] {
+                                let i = self.ext_idx[t];
+                                if op.free(i) {
+                                    precond[i] += self.ext_w[t] * self.ext_w[t] * mjj;
+                                }
+                            }
+                        }
+                    }
+                }
+                self.precond[s] = precond;
+            }
         }
         Ok(report)
     }
