@@ -15,9 +15,9 @@
 //! scale, and every condition estimate (when requested) stays below
 //! [`STABLE_CONDITION`].
 
-use crate::driver::{PhaseTimes, SetupError, StepError, StepReport};
+use crate::driver::{PhaseTimes, StepError, StepReport};
 use crate::particles::Particles;
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneError};
 use crate::setup::{self, from_vec, Basis1d, Basis2d, Domain, Prepared, Solution};
 use crate::studies::exact;
 use psmpm_basis::Basis;
@@ -30,24 +30,21 @@ pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
 /// Condition-number estimate above which a run is unstable.
 pub const STABLE_CONDITION: f64 = 1e8;
 
-/// Why a scene could not be run.
+/// Why a scene could not be run: typed, so that a caller can locate the field in
+/// the scene file without reading it back out of the message.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RunError {
-    /// Bad parameters or set-up (the message names the field).
+    /// A scene value the set-up cannot use: its field, the kind of problem and
+    /// what is wrong.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The reference solution of a study could not be computed.
     #[error("{0}")]
-    Setup(String),
-}
-
-impl From<SetupError> for RunError {
-    fn from(e: SetupError) -> Self {
-        RunError::Setup(e.to_string())
-    }
-}
-
-impl From<crate::scene::SceneError> for RunError {
-    fn from(e: crate::scene::SceneError) -> Self {
-        RunError::Setup(e.to_string())
-    }
+    Reference(String),
+    /// A name that is neither a built-in scene nor a study (the message lists the
+    /// known ones).
+    #[error("{0}")]
+    UnknownName(String),
 }
 
 /// What a run produced.

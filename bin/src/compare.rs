@@ -79,7 +79,7 @@ pub fn variants(
 }
 
 /// Runs `scenes` on up to `jobs` threads; results in the order of `scenes`.
-pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, RunError>> {
+pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, CliError>> {
     let next = AtomicUsize::new(0);
     let progress =
         crate::progress::Progress::new(scenes.iter().map(|s| s.steps() as u64).sum(), "steps");
@@ -102,7 +102,10 @@ pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, RunError>> 
         .into_inner()
         .unwrap_or_default()
         .into_iter()
-        .map(|r| r.unwrap_or_else(|| Err(RunError::Setup("a run did not finish".into()))))
+        .map(|r| match r {
+            Some(r) => r.map_err(|e| CliError::Input(e.to_string())),
+            None => Err(CliError::Input("a run did not finish".into())),
+        })
         .collect()
 }
 
@@ -133,7 +136,7 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
     let results = run_all(&scenes, jobs);
     let mut summaries = Vec::new();
     for r in results {
-        summaries.push(r.map_err(|RunError::Setup(m)| CliError::Input(m))?);
+        summaries.push(r?);
     }
     print_summaries(&summaries, args.format);
     match summaries.iter().find_map(|s| s.failure.clone()) {

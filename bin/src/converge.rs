@@ -91,7 +91,7 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::Input(format!("level {level}: {e}")))?;
             let h = s.mesh_size().unwrap_or(f64::NAN);
             let summary = simulation::run(&s, &mut |_| {})
-                .map_err(|RunError::Setup(m)| CliError::Input(m))?;
+                .map_err(|e: RunError| CliError::Input(e.to_string()))?;
             let order = match (previous, summary.error) {
                 (Some((h0, e0)), Some(e)) if e > 0.0 && e0 > 0.0 => {
                     Some((e0 / e).ln() / (h0 / h).ln())

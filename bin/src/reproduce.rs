@@ -68,7 +68,7 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
     for name in &names {
         let clock = std::time::Instant::now();
         let report = reproduce(name, effort, cache.as_deref())
-            .map_err(|RunError::Setup(m)| CliError::Input(m))?;
+            .map_err(|e: RunError| CliError::Input(e.to_string()))?;
         let mut files = Vec::new();
         for figure in &report.figures {
             let path = args.out.join(&figure.file);

@@ -9,7 +9,7 @@ use psmpm::bases::BasisKind;
 use psmpm::driver::StepReport;
 use psmpm::mass::MassKind;
 use psmpm::particles::Particles;
-use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene};
+use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
 use std::path::PathBuf;
@@ -127,13 +127,22 @@ pub fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
 }
 
 /// A set-up error of a scene file, located in the file when it names a field.
-pub fn locate(scene: &str, message: &str) -> String {
+pub fn locate(scene: &str, e: &SceneError) -> String {
     if !scene.ends_with(".toml") {
-        return message.to_string();
+        return e.to_string();
     }
     match std::fs::read_to_string(scene) {
-        Ok(text) => psmpm::scene::locate_message(&text, scene, message),
-        Err(_) => message.to_string(),
+        Ok(text) => e.in_file(&text, scene).to_string(),
+        Err(_) => e.to_string(),
+    }
+}
+
+/// A run that could not be set up, as the user sees it: a scene error located in
+/// the scene file `scene` when it is one.
+pub fn run_error(scene: &str, e: RunError) -> CliError {
+    match e {
+        RunError::Scene(e) => CliError::Input(locate(scene, &e)),
+        other => CliError::Input(other.to_string()),
     }
 }
 
@@ -280,9 +289,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             }
         }
     };
-    let setup = |e: RunError| match e {
-        RunError::Setup(m) => CliError::Input(locate(&args.scene, &m)),
-    };
+    let setup = |e: RunError| run_error(&args.scene, e);
     let (summary, tracked, last) = match s.dim {
         2 => {
             let o = simulation::observe_2d(&s, &mut observer).map_err(setup)?;

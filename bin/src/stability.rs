@@ -435,9 +435,7 @@ pub fn run_matrix(
     for (r, (name, _)) in results.into_iter().zip(&cells) {
         match r {
             Some(Ok(cell)) => out.push(cell),
-            Some(Err(RunError::Setup(m))) => {
-                return Err(CliError::Input(format!("case {name}: {m}")))
-            }
+            Some(Err(e)) => return Err(CliError::Input(format!("case {name}: {e}"))),
             None => {
                 return Err(CliError::Input(format!(
                     "case {name}: the run did not finish"

@@ -1,7 +1,7 @@
 //! Changes to a scene made by the command line, comparisons (a basis with its own
 //! resolution) and refinement studies.
 
-use super::{bad, BlockLayout, MeshSpec, Scene, SceneError};
+use super::{bad, conflict, BlockLayout, MeshSpec, Scene, SceneError};
 use crate::bases::BasisKind;
 
 impl Scene {
@@ -11,7 +11,7 @@ impl Scene {
         match &mut self.mesh {
             MeshSpec::Blocks { blocks, .. } => *blocks = [nx, ny],
             MeshSpec::Interval { elements, .. } => *elements = nx,
-            _ => return Err(bad("mesh.blocks", "the scene's mesh has no blocks")),
+            _ => return Err(conflict("mesh.blocks", "the scene's mesh has no blocks")),
         }
         Ok(())
     }
@@ -20,7 +20,7 @@ impl Scene {
     pub fn set_layout(&mut self, new: BlockLayout) -> Result<(), SceneError> {
         match &mut self.mesh {
             MeshSpec::Blocks { layout, .. } => *layout = new,
-            _ => return Err(bad("mesh.layout", "the scene's mesh has no blocks")),
+            _ => return Err(conflict("mesh.layout", "the scene's mesh has no blocks")),
         }
         Ok(())
     }
@@ -51,7 +51,12 @@ impl Scene {
             if let Some(h) = r.edge_length {
                 match &mut s.mesh {
                     MeshSpec::Polygon { edge_length, .. } => *edge_length = h,
-                    _ => return Err(bad("resolution.edge_length", "the mesh is not a polygon")),
+                    _ => {
+                        return Err(conflict(
+                            "resolution.edge_length",
+                            "the mesh is not a polygon",
+                        ))
+                    }
                 }
             }
             if let Some(p) = &r.per_block {
@@ -93,7 +98,10 @@ impl Scene {
                 }
             }
             MeshSpec::Gmsh { .. } => {
-                return Err(bad("mesh.kind", "a Gmsh mesh cannot be refined by a study"))
+                return Err(conflict(
+                    "mesh.kind",
+                    "a Gmsh mesh cannot be refined by a study",
+                ))
             }
         }
         s.validate()?;

@@ -191,27 +191,10 @@ pub(super) fn field_offset(text: &str, path: &str) -> usize {
     table_start.unwrap_or(0)
 }
 
-/// `message` located in the scene file `text` (named `file`) when it starts with a
-/// field path (`body[0].max: ...`, `boundary[1].tag: ...`): `file:line:column: message`.
-/// For errors found while a run is built, after the file parsed.
-pub fn locate_message(text: &str, file: &str, message: &str) -> String {
-    let Some((field, _)) = message.split_once(':') else {
-        return message.to_string();
-    };
-    let is_path = !field.is_empty()
-        && field
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "_[].".contains(c));
-    if !is_path {
-        return message.to_string();
-    }
-    let (line, column) = line_column(text, field_offset(text, field));
-    format!("{file}:{line}:{column}: {message}")
-}
-
-/// Where a TOML parse error `e` in `text` belongs (a byte offset) and its message,
-/// prefixed with the field when the error is about a key or a value.
-pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, String) {
+/// Where a TOML parse error `e` in `text` belongs (a byte offset), the field it is
+/// about (when it is about a key or a value, not about the syntax between them) and
+/// its message, prefixed with that field.
+pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<String>, String) {
     let mut at = e.span().map_or(0, |s| s.start);
     let message = e.message().trim().to_string();
     // An unknown field is reported at its table's header: find its line.
@@ -248,11 +231,15 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, String) {
         text[line_start..at.min(text.len())].contains('=')
     };
     let about_key = message.starts_with("unknown field") || message.starts_with("duplicate key");
-    let message = match field_at(text, at) {
-        Some(field) if (about_value || about_key) && !message.starts_with(&field) => {
-            format!("{field}: {message}")
+    match field_at(text, at) {
+        Some(field) if about_value || about_key => {
+            let message = if message.starts_with(&field) {
+                message
+            } else {
+                format!("{field}: {message}")
+            };
+            (at, Some(field), message)
         }
-        _ => message,
-    };
-    (at, message)
+        _ => (at, None, message),
+    }
 }

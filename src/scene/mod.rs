@@ -73,7 +73,6 @@ mod names;
 mod validate;
 
 pub use builtin::BUILTIN;
-pub use locate::locate_message;
 pub use names::{parse_split, split_to_str};
 pub use validate::{MAX_BLOCKS, MAX_PARTICLES};
 
@@ -488,46 +487,93 @@ pub struct SceneFileError {
     pub line: usize,
     /// 1-based column.
     pub column: usize,
+    /// The field the error is about, when it is about one (a syntax error is not).
+    pub field: Option<String>,
+    /// What kind of error, when the scene parsed and a value was found wrong.
+    pub kind: Option<ErrorKind>,
     /// What is wrong, starting with the field.
     pub message: String,
 }
 
-/// A scene that is inconsistent: the field and what is wrong.
+/// What kind of problem a scene value has; the message says it in words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ErrorKind {
+    /// A value outside its range, not finite, or of the wrong shape.
+    Value,
+    /// A name the scene, the mesh or the program does not define (a boundary tag,
+    /// a built-in scene, a benchmark).
+    Unknown,
+    /// Values that cannot hold together (a body outside the mesh, a wall that
+    /// bends, an effect whose reference is missing).
+    Conflict,
+    /// A file the field names that cannot be read or is not valid.
+    File,
+}
+
+/// A scene that is inconsistent: the field, the kind of problem and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{field}: {message}")]
 pub struct SceneError {
     /// Dotted path of the field (`time.dt`, `body[0].per_block`).
     pub field: String,
+    /// What kind of problem.
+    pub kind: ErrorKind,
     /// What is wrong.
     pub message: String,
 }
 
-fn bad(field: impl Into<String>, message: impl Into<String>) -> SceneError {
-    SceneError {
-        field: field.into(),
-        message: message.into(),
+impl SceneError {
+    /// An error of `kind` about `field`.
+    pub fn new(field: impl Into<String>, kind: ErrorKind, message: impl Into<String>) -> Self {
+        SceneError {
+            field: field.into(),
+            kind,
+            message: message.into(),
+        }
     }
+
+    /// The error located in the scene file `text` (named `file`): the line and
+    /// column of its field.
+    pub fn in_file(&self, text: &str, file: &str) -> SceneFileError {
+        let (line, column) = locate::line_column(text, locate::field_offset(text, &self.field));
+        SceneFileError {
+            file: file.to_string(),
+            line,
+            column,
+            field: Some(self.field.clone()),
+            kind: Some(self.kind),
+            message: self.to_string(),
+        }
+    }
+}
+
+/// A value out of its range ([`ErrorKind::Value`]), the most common scene error.
+fn bad(field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::new(field, ErrorKind::Value, message)
+}
+
+/// Values that cannot hold together ([`ErrorKind::Conflict`]).
+fn conflict(field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::new(field, ErrorKind::Conflict, message)
 }
 
 impl Scene {
     /// Parses and validates a scene file (`file` names it in errors).
     pub fn from_toml(text: &str, file: &str) -> Result<Self, SceneFileError> {
-        let locate = |at: usize, message: String| {
+        let scene: Scene = toml::from_str(text).map_err(|e| {
+            let (at, field, message) = locate::parse_error(text, &e);
             let (line, column) = locate::line_column(text, at);
             SceneFileError {
                 file: file.to_string(),
                 line,
                 column,
+                field,
+                kind: None,
                 message,
             }
-        };
-        let scene: Scene = toml::from_str(text).map_err(|e| {
-            let (at, message) = locate::parse_error(text, &e);
-            locate(at, message)
         })?;
-        scene
-            .validate()
-            .map_err(|e| locate(locate::field_offset(text, &e.field), e.to_string()))?;
+        scene.validate().map_err(|e| e.in_file(text, file))?;
         Ok(scene)
     }
 

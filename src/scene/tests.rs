@@ -56,3 +56,49 @@ fn errors_name_line_column_and_field() {
     assert_eq!((e.file.as_str(), e.line), ("c.toml", line), "{e}");
     assert!(e.message.starts_with("time.t_end: must be positive"), "{e}");
 }
+
+#[test]
+fn errors_are_typed_values_with_field_and_kind() {
+    let text = Scene::builtin("column-small").unwrap().to_toml();
+    // A value out of range: its field and kind, not read back from the message.
+    let e = Scene::from_toml(&text.replace("t_end = 1.0", "t_end = -1.0"), "c.toml").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("time.t_end"));
+    assert_eq!(e.kind, Some(ErrorKind::Value));
+    // Fields that cannot hold together.
+    let mut scene = Scene::builtin("column-small").unwrap();
+    scene.reference = None;
+    scene.initial_velocity = InitialVelocity::Exact {};
+    let e = scene.validate().unwrap_err();
+    assert_eq!(
+        (e.field.as_str(), e.kind),
+        ("initial_velocity.kind", ErrorKind::Conflict)
+    );
+    // Located in the file where the field is written.
+    let located = e.in_file(&scene.to_toml(), "s.toml");
+    let line = scene
+        .to_toml()
+        .lines()
+        .position(|l| l.starts_with("[initial_velocity]"))
+        .unwrap();
+    assert!(located.line >= line + 1, "{located}");
+    assert_eq!(located.field.as_deref(), Some("initial_velocity.kind"));
+    // A syntax error has a location but no field.
+    let e = Scene::from_toml("[time\n", "x.toml").unwrap_err();
+    assert_eq!((e.field, e.kind), (None, None));
+}
+
+#[test]
+fn set_up_errors_keep_their_field_and_kind() {
+    let mut scene = Scene::builtin("column-small").unwrap();
+    scene.boundaries[0].tag = "nowhere".into();
+    match crate::simulation::run(&scene, &mut |_| {}) {
+        Err(crate::simulation::RunError::Scene(e)) => {
+            assert_eq!(
+                (e.field.as_str(), e.kind),
+                ("boundary[0].tag", ErrorKind::Unknown)
+            );
+            assert!(e.message.contains("nowhere"), "{e}");
+        }
+        other => panic!("expected a scene error, got {other:?}"),
+    }
+}

@@ -1,8 +1,8 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::{
-    bad, Body, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference, Scene,
-    SceneError,
+    bad, conflict, Body, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec,
+    Reference, Scene, SceneError,
 };
 
 /// Most blocks a `blocks` mesh may have.
@@ -18,7 +18,7 @@ impl Scene {
             return Err(bad("dim", format!("must be 1 or 2, got {d}")));
         }
         if self.basis.dim() != d {
-            return Err(bad(
+            return Err(conflict(
                 "basis",
                 format!(
                     "`{}` is a {}D basis but the scene is {d}D (2D: ps, pl; 1D: bspline, pl1d)",
@@ -62,7 +62,7 @@ impl Scene {
         match &self.mesh {
             MeshSpec::Blocks { x, y, blocks, .. } => {
                 if d != 2 {
-                    return Err(bad(
+                    return Err(conflict(
                         "mesh.kind",
                         "`blocks` is a 2D mesh; use `interval` in 1D",
                     ));
@@ -92,7 +92,7 @@ impl Scene {
                 ..
             } => {
                 if d != 2 {
-                    return Err(bad("mesh.kind", "`polygon` is a 2D mesh"));
+                    return Err(conflict("mesh.kind", "`polygon` is a 2D mesh"));
                 }
                 if outline.len() < 3 {
                     return Err(bad("mesh.outline", "needs at least 3 corners"));
@@ -111,7 +111,7 @@ impl Scene {
             }
             MeshSpec::Gmsh { file } => {
                 if d != 2 {
-                    return Err(bad("mesh.kind", "`gmsh` meshes are 2D"));
+                    return Err(conflict("mesh.kind", "`gmsh` meshes are 2D"));
                 }
                 if file.is_empty() {
                     return Err(bad("mesh.file", "is empty"));
@@ -119,7 +119,7 @@ impl Scene {
             }
             MeshSpec::Interval { x, elements } => {
                 if d != 1 {
-                    return Err(bad(
+                    return Err(conflict(
                         "mesh.kind",
                         "`interval` is a 1D mesh; use `blocks` in 2D",
                     ));
@@ -185,7 +185,7 @@ impl Scene {
                         self.mesh,
                         MeshSpec::Blocks { .. } | MeshSpec::Interval { .. }
                     ) {
-                        return Err(bad(
+                        return Err(conflict(
                             field("per_block"),
                             "needs a `blocks` or `interval` mesh; use `count` on other meshes",
                         ));
@@ -200,7 +200,7 @@ impl Scene {
                     }
                 }
                 _ => {
-                    return Err(bad(
+                    return Err(conflict(
                         field("per_block"),
                         "give exactly one of `per_block` and `count`",
                     ))
@@ -224,7 +224,7 @@ impl Scene {
             InitialVelocity::Uniform { value } => vector("initial_velocity.value", value)?,
             InitialVelocity::SineMode { v0 } => finite("initial_velocity.v0", *v0)?,
             InitialVelocity::Exact {} if self.reference.is_none() => {
-                return Err(bad(
+                return Err(conflict(
                     "initial_velocity.kind",
                     "`exact` needs a [reference] solution",
                 ))
@@ -236,13 +236,13 @@ impl Scene {
                 return Err(bad(format!("boundary[{i}].fix"), "lists no component"));
             }
             if bc.fix.contains(&Component::Normal) && bc.fix.len() > 1 {
-                return Err(bad(
+                return Err(conflict(
                     format!("boundary[{i}].fix"),
                     "`normal` fixes the normal component alone; list it on its own",
                 ));
             }
             if let Some(c) = bc.fix.iter().find(|c| c.axis().is_some_and(|a| a >= d)) {
-                return Err(bad(
+                return Err(conflict(
                     format!("boundary[{i}].fix"),
                     format!(
                         "component `{}` does not exist in {d}D",
@@ -282,7 +282,7 @@ impl Scene {
                 EffectSpec::BodyForce { value } => vector(&field("value"), value)?,
                 EffectSpec::ManufacturedBodyForce {} => {
                     if !matches!(self.reference, Some(Reference::AxisAligned { .. })) {
-                        return Err(bad(
+                        return Err(conflict(
                             field("kind"),
                             "`manufactured-body-force` needs reference kind `axis-aligned`",
                         ));
@@ -292,7 +292,7 @@ impl Scene {
                     finite(&field("surface"), *surface)?;
                     finite(&field("k0"), *k0)?;
                     if gravity.is_none() {
-                        return Err(bad(
+                        return Err(conflict(
                             field("kind"),
                             "geostatic stress needs a gravity effect",
                         ));
@@ -303,7 +303,12 @@ impl Scene {
         match (self.time.dt, self.time.courant) {
             (Some(dt), None) => positive("time.dt", dt)?,
             (None, Some(c)) => positive("time.courant", c)?,
-            _ => return Err(bad("time.dt", "give exactly one of `dt` and `courant`")),
+            _ => {
+                return Err(conflict(
+                    "time.dt",
+                    "give exactly one of `dt` and `courant`",
+                ))
+            }
         }
         positive("time.t_end", self.time.t_end)?;
         if self.study.refine.contains(&Component::Normal) {
@@ -317,7 +322,7 @@ impl Scene {
             Some(Reference::ColumnSelfWeight {}) | Some(Reference::ColumnEquilibrium {})
                 if gravity.is_none() =>
             {
-                return Err(bad(
+                return Err(conflict(
                     "reference.kind",
                     "a column reference needs a gravity effect",
                 ));
@@ -325,7 +330,7 @@ impl Scene {
             Some(Reference::AxisAligned { u0 }) => {
                 finite("reference.u0", u0)?;
                 if d != 2 || self.material.model != MaterialModel::NeoHookean {
-                    return Err(bad(
+                    return Err(conflict(
                         "reference.kind",
                         "`axis-aligned` is a 2D neo-Hookean solution",
                     ));
@@ -334,7 +339,7 @@ impl Scene {
             _ => {}
         }
         if self.steps() == 0 {
-            return Err(bad("time.t_end", "is shorter than one time step"));
+            return Err(conflict("time.t_end", "is shorter than one time step"));
         }
         Ok(())
     }

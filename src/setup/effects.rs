@@ -3,7 +3,7 @@
 use super::Solution;
 use crate::effect::{BodyForce, Effect, Gravity, LocalDamping, Traction};
 use crate::particles::Particles;
-use crate::scene::{EffectSpec, Scene};
+use crate::scene::{EffectSpec, ErrorKind, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SVector;
 
@@ -32,9 +32,12 @@ pub fn build_effects<const D: usize>(
                     .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
                     .collect();
                 if selected.is_empty() {
-                    return Err(RunError::Setup(format!(
-                        "effect[{i}].min: the traction box selects no particle"
-                    )));
+                    return Err(SceneError::new(
+                        format!("effect[{i}].min"),
+                        ErrorKind::Conflict,
+                        "the traction box selects no particle",
+                    )
+                    .into());
                 }
                 let share = length / selected.len() as f64;
                 effects.push(Box::new(Traction {
@@ -48,9 +51,12 @@ pub fn build_effects<const D: usize>(
             ))),
             EffectSpec::ManufacturedBodyForce {} => {
                 let Some(Solution::AxisAligned(a)) = solution else {
-                    return Err(RunError::Setup(format!(
-                        "effect[{i}].kind: `manufactured-body-force` needs reference kind `axis-aligned`"
-                    )));
+                    return Err(SceneError::new(
+                        format!("effect[{i}].kind"),
+                        ErrorKind::Conflict,
+                        "`manufactured-body-force` needs reference kind `axis-aligned`",
+                    )
+                    .into());
                 };
                 effects.push(Box::new(BodyForce::Manufactured(a)));
             }

@@ -4,13 +4,14 @@
 
 use super::Domain;
 use crate::bases::BasisKind;
-use crate::scene::{BlockLayout, Component, MeshSpec, Scene};
+use crate::scene::{BlockLayout, Component, ErrorKind, MeshSpec, Scene, SceneError};
 use crate::simulation::RunError;
 use psmpm_basis::basis::bspline1d::QuadraticBSpline;
 use psmpm_basis::basis::linear::Linear;
 use psmpm_basis::basis::linear1d::Linear1d;
 use psmpm_basis::basis::powell_sabin::PowellSabin;
 use psmpm_basis::mesh::generators::{self, PolygonDomain};
+use psmpm_basis::mesh::MeshError;
 use psmpm_basis::{Mesh1d, TriMesh, Vec2};
 
 /// The basis of a 2D scene, as the scene chose it.
@@ -33,7 +34,7 @@ pub(crate) enum Basis1d {
 pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     scene.validate()?;
     if scene.dim != 2 {
-        return Err(RunError::Setup(format!("dim: the scene is {}D", scene.dim)));
+        return Err(conflict("dim", format!("the scene is {}D", scene.dim)).into());
     }
     let mesh = triangulation(scene)?;
     let h = smallest_edge(&mesh);
@@ -41,8 +42,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let walls = wall_normals(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
-            PowellSabin::<f64>::new(mesh, scene.split)
-                .map_err(|e| RunError::Setup(format!("basis: {e}")))?,
+            PowellSabin::<f64>::new(mesh, scene.split).map_err(|e| conflict("basis", e))?,
         ),
         _ => Basis2d::Linear(Linear::<f64>::new(mesh)),
     };
@@ -53,12 +53,9 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
 pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
     scene.validate()?;
     let MeshSpec::Interval { x, elements } = scene.mesh else {
-        return Err(RunError::Setup(
-            "mesh.kind: a 1D scene needs an `interval` mesh".into(),
-        ));
+        return Err(conflict("mesh.kind", "a 1D scene needs an `interval` mesh").into());
     };
-    let mesh =
-        Mesh1d::uniform(x[0], x[1], elements).map_err(|e| RunError::Setup(format!("mesh: {e}")))?;
+    let mesh = Mesh1d::uniform(x[0], x[1], elements).map_err(|e| value("mesh", e))?;
     let h = (x[1] - x[0]) / elements as f64;
     // In 1D the normal of a wall is the axis.
     check_tags(scene, &mesh.tags().map(String::from))?;
@@ -91,7 +88,7 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
                 generators::block_delaunay(x[0], x[1], y[0], y[1], blocks[0], blocks[1])
             }
         }
-        .map_err(|e| RunError::Setup(format!("mesh: {e}")))?,
+        .map_err(|e| value("mesh", e))?,
         MeshSpec::Polygon {
             outline,
             tags,
@@ -111,20 +108,15 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
                     .map(|h| (points(&h.outline), h.tag.clone()))
                     .collect(),
             };
-            generators::polygon_mesh(&domain, *edge_length).map_err(|e| {
-                let e = e.to_string();
-                let field = if e.contains("edge_length") {
-                    "mesh.edge_length"
-                } else {
-                    "mesh.outline"
-                };
-                RunError::Setup(format!("{field}: {e}"))
+            generators::polygon_mesh(&domain, *edge_length).map_err(|e| match e {
+                MeshError::EdgeLength(_) => value("mesh.edge_length", e),
+                _ => value("mesh.outline", e),
             })?
         }
         MeshSpec::Gmsh { file } => psmpm_basis::mesh::gmsh::read_msh(std::path::Path::new(file))
-            .map_err(|e| RunError::Setup(format!("mesh.file: {e}")))?,
+            .map_err(|e| SceneError::new("mesh.file", ErrorKind::File, e.to_string()))?,
         MeshSpec::Interval { .. } => {
-            return Err(RunError::Setup("mesh.kind: `interval` is a 1D mesh".into()))
+            return Err(conflict("mesh.kind", "`interval` is a 1D mesh").into())
         }
     };
     Ok(mesh)
@@ -134,10 +126,15 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
 fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
     for (b, bc) in scene.boundaries.iter().enumerate() {
         if !tags.contains(&bc.tag) {
-            return Err(RunError::Setup(format!(
-                "boundary[{b}].tag: unknown boundary tag `{}`; the mesh has tags {tags:?}",
-                bc.tag
-            )));
+            return Err(SceneError::new(
+                format!("boundary[{b}].tag"),
+                ErrorKind::Unknown,
+                format!(
+                    "unknown boundary tag `{}`; the mesh has tags {tags:?}",
+                    bc.tag
+                ),
+            )
+            .into());
         }
     }
     Ok(())
@@ -151,9 +148,13 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
         if !bc.fix.contains(&Component::Normal) {
             continue;
         }
-        let id = mesh
-            .tag_id(&bc.tag)
-            .map_err(|e| RunError::Setup(format!("boundary[{b}].tag: {e}")))?;
+        let id = mesh.tag_id(&bc.tag).map_err(|e| {
+            SceneError::new(
+                format!("boundary[{b}].tag"),
+                ErrorKind::Unknown,
+                e.to_string(),
+            )
+        })?;
         let mut normal: Option<Vec2> = None;
         for e in mesh.edges().iter().filter(|e| e.tag == Some(id)) {
             let d = mesh.vertices()[e.vertices[1]] - mesh.vertices()[e.vertices[0]];
@@ -161,19 +162,20 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
             match normal {
                 None => normal = Some(n),
                 Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > 1e-9 => {
-                    return Err(RunError::Setup(format!(
-                        "boundary[{b}].fix: `normal` needs a straight wall, but `{}` bends",
-                        bc.tag
-                    )))
+                    return Err(conflict(
+                        format!("boundary[{b}].fix"),
+                        format!("`normal` needs a straight wall, but `{}` bends", bc.tag),
+                    )
+                    .into())
                 }
                 Some(_) => {}
             }
         }
         let n = normal.ok_or_else(|| {
-            RunError::Setup(format!(
-                "boundary[{b}].tag: `{}` has no boundary edge",
-                bc.tag
-            ))
+            conflict(
+                format!("boundary[{b}].tag"),
+                format!("`{}` has no boundary edge", bc.tag),
+            )
         })?;
         walls.push((bc.tag.clone(), [n[0], n[1]]));
     }
@@ -185,4 +187,14 @@ fn smallest_edge(mesh: &TriMesh) -> f64 {
         .iter()
         .map(|e| (mesh.vertices()[e.vertices[0]] - mesh.vertices()[e.vertices[1]]).norm())
         .fold(f64::INFINITY, f64::min)
+}
+
+/// A value the mesh or basis cannot be built from.
+fn value(field: &str, e: impl ToString) -> SceneError {
+    SceneError::new(field, ErrorKind::Value, e.to_string())
+}
+
+/// Values of the scene that do not fit together.
+fn conflict(field: impl Into<String>, message: impl ToString) -> SceneError {
+    SceneError::new(field, ErrorKind::Conflict, message.to_string())
 }

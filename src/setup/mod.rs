@@ -24,7 +24,7 @@ use crate::effect::Effect;
 use crate::mass::MassStrategy;
 use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
 use crate::particles::Particles;
-use crate::scene::{MaterialModel, Scene};
+use crate::scene::{ErrorKind, MaterialModel, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SVector;
 use psmpm_basis::Basis;
@@ -85,9 +85,12 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     // one (a mesh-based guess) only sets the driver up.
     let dt = scene.dt(h);
     if !(dt > 0.0 && dt.is_finite()) {
-        return Err(RunError::Setup(format!(
-            "time: the time step {dt} is not positive"
-        )));
+        return Err(SceneError::new(
+            "time",
+            ErrorKind::Value,
+            format!("the time step {dt} is not positive"),
+        )
+        .into());
     }
     let mut driver = driver(
         scene,
@@ -116,7 +119,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
 fn material<const D: usize>(scene: &Scene) -> Result<(AnyMaterial, f64), RunError> {
     let m = &scene.material;
     let elastic = Elastic::new(m.young, m.poisson, m.density)
-        .map_err(|e| RunError::Setup(format!("material: {e}")))?;
+        .map_err(|e| SceneError::new("material", ErrorKind::Value, e.to_string()))?;
     let material = match m.model {
         MaterialModel::LinearElastic => AnyMaterial::Linear(LinearElastic::new(elastic, D)),
         MaterialModel::NeoHookean => AnyMaterial::NeoHookean(NeoHookean::new(elastic, D)),
@@ -170,16 +173,29 @@ fn driver<const D: usize, B: Basis<f64, D>>(
                     particle < first
                 })
                 .unwrap_or(0);
-            RunError::Setup(format!(
-                "body[{body}].max: the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"
-            ))
+            SceneError::new(
+                format!("body[{body}].max"),
+                ErrorKind::Conflict,
+                format!("the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"),
+            )
         }
-        other => other.into(),
+        SetupError::Boundary { tag, message } => SceneError::new(
+            boundary_field(scene, &tag),
+            ErrorKind::Conflict,
+            format!("boundary condition on `{tag}`: {message}"),
+        ),
+        SetupError::Basis(e) => SceneError::new("basis", ErrorKind::Conflict, e.to_string()),
     })?;
     driver.estimate_condition = scene.output.condition;
     for (tag, normal) in walls {
         let n = SVector::<f64, D>::from_fn(|k, _| normal[k]);
-        driver.add_slip_wall(tag, &n)?;
+        driver.add_slip_wall(tag, &n).map_err(|e| {
+            SceneError::new(
+                boundary_field(scene, tag),
+                ErrorKind::Conflict,
+                e.to_string(),
+            )
+        })?;
     }
     Ok(driver)
 }
@@ -223,4 +239,12 @@ pub(crate) fn from_vec<const D: usize>(v: &SVector<f64, D>) -> [f64; 2] {
         p[k] = v[k];
     }
     p
+}
+
+/// The field of the first boundary condition on `tag` (`boundary[i].tag`).
+fn boundary_field(scene: &Scene, tag: &str) -> String {
+    match scene.boundaries.iter().position(|bc| bc.tag == tag) {
+        Some(i) => format!("boundary[{i}].tag"),
+        None => "boundary".to_string(),
+    }
 }

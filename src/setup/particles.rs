@@ -4,7 +4,7 @@
 use super::{to_vec, Solution};
 use crate::effect::{Geostatic, InitialStress};
 use crate::particles::Particles;
-use crate::scene::{EffectSpec, InitialVelocity, Scene};
+use crate::scene::{EffectSpec, ErrorKind, InitialVelocity, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SMatrix;
 use std::f64::consts::PI;
@@ -24,14 +24,21 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
         for k in 0..d {
             let extent = body.max[k] - body.min[k];
             let h = scene.lattice_spacing(body, k).ok_or_else(|| {
-                RunError::Setup(format!("body[{b}].per_block: the mesh has no blocks"))
+                SceneError::new(
+                    format!("body[{b}].per_block"),
+                    ErrorKind::Conflict,
+                    "the mesh has no blocks",
+                )
             })?;
             let n = if let Some(per) = &body.per_block {
                 let n = extent / h;
                 if (n - n.round()).abs() > 1e-6 * n.max(1.0) || n.round() < 1.0 {
-                    return Err(RunError::Setup(format!(
-                        "body[{b}].max: the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h}"
-                    )));
+                    return Err(SceneError::new(
+                        format!("body[{b}].max"),
+                        ErrorKind::Conflict,
+                        format!("the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h}"),
+                    )
+                    .into());
                 }
                 group[k] = per[k];
                 n.round() as usize

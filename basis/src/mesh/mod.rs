@@ -76,6 +76,10 @@ pub enum MeshError {
     InvalidParameter(String),
     #[error("mesher failed: {0}")]
     Mesher(String),
+    /// The target edge length of a generated mesh cannot be used: too small for
+    /// the domain, or asking for more points than the mesher may add.
+    #[error("{0}")]
+    EdgeLength(String),
 }
 
 /// One edge of the mesh: its two vertices (in the orientation of its first

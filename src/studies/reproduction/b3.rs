@@ -38,7 +38,7 @@ pub(super) fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErro
         20,
         t_end,
     )
-    .map_err(|e| RunError::Setup(format!("UL-FEM reference: {e}")))?;
+    .map_err(|e| RunError::Reference(format!("UL-FEM reference: {e}")))?;
     // Per unit thickness: the 1D energies are per unit cross-section.
     let ref_energy: Vec<(f64, f64, f64)> = reference
         .records

@@ -4,16 +4,19 @@ use super::{builtin, log_log, opt, order, sci, setup, Effort, Figure, Report, Ta
 use crate::bases::BasisKind;
 use crate::mass::MassKind;
 use crate::output::chart::{LinePlot, Series};
-use crate::scene::{MeshSpec, Scene};
+use crate::scene::{ErrorKind, MeshSpec, Scene, SceneError};
 use crate::simulation::{self, RunError, Summary};
 
 fn set_polygon(scene: &mut Scene, edge: f64, count: usize) -> Result<(), RunError> {
     match &mut scene.mesh {
         MeshSpec::Polygon { edge_length, .. } => *edge_length = edge,
         _ => {
-            return Err(RunError::Setup(
-                "b4: the scene's mesh is not a polygon".into(),
-            ))
+            return Err(SceneError::new(
+                "mesh.kind",
+                ErrorKind::Conflict,
+                "b4 refines a `polygon` mesh; the scene has another kind",
+            )
+            .into())
         }
     }
     for body in &mut scene.bodies {

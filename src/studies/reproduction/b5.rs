@@ -64,7 +64,7 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
         100,
         t_end,
     )
-    .map_err(|e| RunError::Setup(format!("UL-FEM reference: {e}")))?;
+    .map_err(|e| RunError::Reference(format!("UL-FEM reference: {e}")))?;
     let u_ref = |t: f64| -> f64 {
         let k = reference
             .records

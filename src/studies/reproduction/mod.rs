@@ -93,7 +93,7 @@ pub fn reproduce(name: &str, effort: Effort, cache: Option<&Path>) -> Result<Rep
         "b4" => b4::b4(effort),
         "b5b" => b5::b5b(effort, cache),
         "b5c" => b5::b5c(effort),
-        other => Err(RunError::Setup(format!(
+        other => Err(RunError::UnknownName(format!(
             "unknown study `{other}` (known: {})",
             STUDIES.join(", ")
         ))),
@@ -121,11 +121,11 @@ fn log_log(title: impl Into<String>, x: &str, y: &str) -> LinePlot {
 }
 
 fn builtin(name: &str) -> Result<Scene, RunError> {
-    Scene::builtin(name).map_err(RunError::Setup)
+    Scene::builtin(name).map_err(RunError::UnknownName)
 }
 
 fn setup<T>(r: Result<T, crate::scene::SceneError>) -> Result<T, RunError> {
-    r.map_err(|e| RunError::Setup(e.to_string()))
+    r.map_err(RunError::Scene)
 }
 
 fn order(e0: f64, e1: f64, h0: f64, h1: f64) -> String {

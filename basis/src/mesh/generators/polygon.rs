@@ -225,8 +225,8 @@ impl PolygonDomain {
 pub fn polygon_mesh(domain: &PolygonDomain, target_edge_length: f64) -> Result<TriMesh, MeshError> {
     let size = domain.validate()?;
     if !(target_edge_length.is_finite() && target_edge_length >= size * 1e-4) {
-        return Err(MeshError::InvalidParameter(format!(
-            "target_edge_length must be at least 1e-4 of the domain size {size}, got {target_edge_length}"
+        return Err(MeshError::EdgeLength(format!(
+            "invalid mesh parameter: target_edge_length must be at least 1e-4 of the domain size {size}, got {target_edge_length}"
         )));
     }
     let segments = domain.segments();
@@ -262,8 +262,8 @@ pub fn polygon_mesh(domain: &PolygonDomain, target_edge_length: f64) -> Result<T
         .with_max_additional_vertices(MAX_STEINER_POINTS);
     let result = cdt.refine(params);
     if !result.refinement_complete {
-        return Err(MeshError::Mesher(format!(
-            "refinement needed more than {MAX_STEINER_POINTS} points; increase target_edge_length"
+        return Err(MeshError::EdgeLength(format!(
+            "mesher failed: refinement needed more than {MAX_STEINER_POINTS} points; increase target_edge_length"
         )));
     }
     let excluded: std::collections::HashSet<usize> =
@@ -460,7 +460,10 @@ mod tests {
         assert!(msg(&with_hole(tri(0.1, 0.1, 0.3)[..2].to_vec())).contains("at least 3"));
         // Target edge length.
         for h in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-6] {
-            assert!(invalid_message(polygon_mesh(&square, h)).contains("target_edge_length"));
+            match polygon_mesh(&square, h) {
+                Err(MeshError::EdgeLength(m)) => assert!(m.contains("target_edge_length")),
+                other => panic!("expected EdgeLength, got {other:?}"),
+            }
         }
         // A valid hole still works.
         polygon_mesh(&with_hole(tri(0.2, 0.2, 0.4)), 0.2).unwrap();
