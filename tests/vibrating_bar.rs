@@ -4,6 +4,7 @@ use psmpm::bases::BasisKind;
 use psmpm::mass::MassKind;
 use psmpm::scene::Scene;
 use psmpm::simulation::run;
+use psmpm::studies::published::{thesis_b2_error, THESIS_TABLES_4_2_AND_4_3};
 
 /// The convergence set-up of thesis §4.1: dt = 1e-5, 16 × 14 particles per block
 /// (56 per triangle), `n_x` vertex columns (`n_x − 1` blocks).
@@ -35,20 +36,8 @@ fn order(e: &[f64], n: &[usize]) -> Vec<f64> {
 
 #[test]
 fn thesis_variant_reproduces_tables_4_2_and_4_3() {
-    // (basis, n_x, printed value)
-    let printed = [
-        (BasisKind::Ps, 2, 3.71e-4f64),
-        (BasisKind::Ps, 3, 3.14e-5),
-        (BasisKind::Ps, 5, 3.57e-6),
-        (BasisKind::Ps, 9, 4.90e-7),
-        (BasisKind::Ps, 17, 1.77e-7),
-        (BasisKind::Pl, 5, 1.81e-4),
-        (BasisKind::Pl, 9, 4.44e-5),
-        (BasisKind::Pl, 17, 1.08e-5),
-        (BasisKind::Pl, 33, 2.68e-6),
-    ];
     let mut table = String::new();
-    for (basis, n_x, thesis) in printed {
+    for (basis, n_x, thesis) in THESIS_TABLES_4_2_AND_4_3 {
         let ours = bar(basis, n_x, true);
         // The thesis prints three significant digits: ours must round to them.
         let unit = 10f64.powf(thesis.log10().floor() - 2.0);
@@ -78,13 +67,18 @@ fn default_variant_converges_with_orders_3_and_2() {
         "PL orders {pl_order:?}"
     );
     // Within a factor 2 of the printed values.
-    for (ours, thesis) in ps.iter().zip([3.71e-4, 3.14e-5, 3.57e-6, 4.90e-7]) {
+    let printed = |basis, n: &[usize]| -> Vec<f64> {
+        n.iter()
+            .map(|&n| thesis_b2_error(basis, n).expect("printed"))
+            .collect()
+    };
+    for (ours, thesis) in ps.iter().zip(printed(BasisKind::Ps, &ps_n)) {
         assert!(
             (0.5..2.0).contains(&(ours / thesis)),
             "PS {ours:e} vs {thesis:e}"
         );
     }
-    for (ours, thesis) in pl.iter().zip([1.81e-4, 4.44e-5, 1.08e-5]) {
+    for (ours, thesis) in pl.iter().zip(printed(BasisKind::Pl, &pl_n)) {
         assert!(
             (0.5..2.0).contains(&(ours / thesis)),
             "PL {ours:e} vs {thesis:e}"

@@ -8,10 +8,12 @@
 //! - [`ulfem`]: the 1D updated-Lagrangian FEM reference of the large-deformation
 //!   benchmarks B3 and B5b, with its on-disk cache of reference runs;
 //! - [`projection`]: L² projection onto a basis, benchmark B1;
+//! - [`published`]: the seeds' printed numbers the studies and tests compare against;
 //! - [`reproduction`]: the benchmarks B2–B5 as studies, the tables and figures of
 //!   `docs/results.md`.
 
 pub mod exact;
 pub mod projection;
+pub mod published;
 pub mod reproduction;
 pub mod ulfem;

@@ -4,21 +4,12 @@ use super::{builtin, log_log, opt, order, sci, setup, Effort, Figure, Report, Ta
 use crate::bases::BasisKind;
 use crate::output::chart::Series;
 use crate::simulation::{self, RunError};
+use crate::studies::published::THESIS_TABLES_4_2_AND_4_3;
 
 /// B2 (thesis §4.1): E_u of the thesis variant against Tables 4.2–4.3, and orders of
 /// the default variant.
 pub(super) fn b2(effort: Effort) -> Result<Report, RunError> {
-    let printed: &[(BasisKind, usize, f64)] = &[
-        (BasisKind::Ps, 2, 3.71e-4),
-        (BasisKind::Ps, 3, 3.14e-5),
-        (BasisKind::Ps, 5, 3.57e-6),
-        (BasisKind::Ps, 9, 4.90e-7),
-        (BasisKind::Ps, 17, 1.77e-7),
-        (BasisKind::Pl, 5, 1.81e-4),
-        (BasisKind::Pl, 9, 4.44e-5),
-        (BasisKind::Pl, 17, 1.08e-5),
-        (BasisKind::Pl, 33, 2.68e-6),
-    ];
+    let printed = &THESIS_TABLES_4_2_AND_4_3;
     let limit = if effort == Effort::Quick { 5 } else { 33 };
     let mut table = Table {
         title: "B2: E_u at t_end, thesis variant (centroids, Delaunay blocks, 1999 steps) and default variant (incentres, 4-triangle blocks, 2000 steps)".into(),
