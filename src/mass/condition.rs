@@ -5,6 +5,10 @@
 use super::MassError;
 use crate::sparse::Scalar;
 
+/// The Lanczos recurrence stops when the new off-diagonal falls below this
+/// fraction of the diagonal (an invariant subspace was found).
+const LANCZOS_BREAKDOWN: f64 = 1e-14;
+
 /// Number of power and inverse iterations of the condition estimate.
 pub const CONDITION_ITERATIONS: usize = 30;
 
@@ -93,7 +97,7 @@ pub(super) fn lanczos_estimate<T: Scalar>(
         steps = j + 1;
         let b = norm(w);
         beta[j] = b;
-        if b.is_nan() || b <= 1e-14 * a.abs() {
+        if b.is_nan() || b <= LANCZOS_BREAKDOWN * a.abs() {
             break;
         }
         for i in 0..w.len() {

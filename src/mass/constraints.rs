@@ -5,6 +5,10 @@
 use super::{MassError, MassStrategy};
 use crate::sparse::Scalar;
 
+/// A constraint whose Cholesky pivot falls below this fraction of its diagonal is
+/// dependent on the earlier ones (or acts on inactive functions) and is dropped.
+pub const DEPENDENT_CONSTRAINT: f64 = 1e-10;
+
 /// General linear constraints `Σ_e w_e a[k_e][i_e] = 0` on the coefficients (a
 /// wall whose constraint couples several functions or both components of one),
 /// imposed exactly: with the step's mass operator `M` (block-diagonal over
@@ -87,7 +91,7 @@ impl<T: Scalar, const D: usize> Constraints<T, D> {
                     d -= self.s[j * m + k] * self.s[j * m + k];
                 }
             }
-            self.keep[j] = d > 1e-10 * diagonal && diagonal > 0.0;
+            self.keep[j] = d > DEPENDENT_CONSTRAINT * diagonal && diagonal > 0.0;
             if !self.keep[j] {
                 continue;
             }

@@ -44,6 +44,9 @@ pub use support::SupportFacts;
 
 use crate::sparse::{NotPositiveDefinite, Scalar, SymmetricPattern};
 
+/// The thesis' threshold on `M_ii` below which `deactivate` removes a function.
+pub const DEFAULT_DEACTIVATION_THRESHOLD: f64 = 1e-2;
+
 /// Why a strategy could not solve the step's system.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MassError {
@@ -134,7 +137,9 @@ impl MassKind {
             ("partial-coverage", Some(a)) => {
                 Ok(MassKind::Partial(LumpRule::Coverage(fraction(a)?)))
             }
-            ("deactivate", None) => Ok(MassKind::Deactivate { threshold: 1e-2 }),
+            ("deactivate", None) => Ok(MassKind::Deactivate {
+                threshold: DEFAULT_DEACTIVATION_THRESHOLD,
+            }),
             ("deactivate", Some(a)) => Ok(MassKind::Deactivate {
                 threshold: number(a)?,
             }),

@@ -14,6 +14,10 @@ use psmpm_basis::mesh::generators::{self, PolygonDomain};
 use psmpm_basis::mesh::MeshError;
 use psmpm_basis::{Mesh1d, TriMesh, Vec2};
 
+/// A slip wall is straight when the sine of the angle between any two of its edges
+/// is below this.
+const STRAIGHT_WALL: f64 = 1e-9;
+
 /// The basis of a 2D scene, as the scene chose it.
 pub(crate) enum Basis2d {
     /// Powell–Sabin splines.
@@ -161,7 +165,7 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
             let n = Vec2::new(d[1], -d[0]).normalize();
             match normal {
                 None => normal = Some(n),
-                Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > 1e-9 => {
+                Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > STRAIGHT_WALL => {
                     return Err(conflict(
                         format!("boundary[{b}].fix"),
                         format!("`normal` needs a straight wall, but `{}` bends", bc.tag),

@@ -9,6 +9,10 @@ use crate::simulation::RunError;
 use nalgebra::SMatrix;
 use std::f64::consts::PI;
 
+/// A body's extent is a whole number of lattice cells when it is within this
+/// fraction of one.
+const WHOLE_CELLS: f64 = 1e-6;
+
 /// Particle positions and volumes of the scene's bodies, block by block for
 /// `per_block` layouts (the order of the seeds' codes), row by row otherwise; a
 /// body's `jitter` moves each particle inside its cell (deterministic, see
@@ -32,7 +36,7 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
             })?;
             let n = if let Some(per) = &body.per_block {
                 let n = extent / h;
-                if (n - n.round()).abs() > 1e-6 * n.max(1.0) || n.round() < 1.0 {
+                if (n - n.round()).abs() > WHOLE_CELLS * n.max(1.0) || n.round() < 1.0 {
                     return Err(SceneError::new(
                         format!("body[{b}].max"),
                         ErrorKind::Conflict,

@@ -5,6 +5,11 @@
 use super::{Extended, Role, EXTENSION_RINGS, MAX_EXTENSION_TERMS, MAX_EXTENSION_WEIGHT};
 use crate::sparse::Scalar;
 
+/// The moment matrix of a ring is singular (its functions cannot reproduce the
+/// polynomials) when a Cholesky pivot falls below this fraction of its largest
+/// diagonal; the ring is then widened.
+const SINGULAR_MOMENTS: f64 = 1e-12;
+
 impl<T: Scalar> Extended<T> {
     /// Collects the solved functions of the next ring around the current search
     /// front into `candidates`; returns `false` when the front is exhausted.
@@ -102,7 +107,7 @@ impl<T: Scalar> Extended<T> {
                     s -= g[a * 6 + k] * g[b * 6 + k];
                 }
                 if a == b {
-                    if s.is_nan() || s <= 1e-12 * max_diag {
+                    if s.is_nan() || s <= SINGULAR_MOMENTS * max_diag {
                         return None;
                     }
                     g[a * 6 + a] = s.sqrt();

@@ -42,7 +42,9 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
         MassKind::Consistent,
         MassKind::Lumped,
         MassKind::Partial(crate::mass::LumpRule::EmptyElement),
-        MassKind::Deactivate { threshold: 1e-2 },
+        MassKind::Deactivate {
+            threshold: crate::mass::DEFAULT_DEACTIVATION_THRESHOLD,
+        },
     ];
     let sigma0 = 1.0 * 1e3 * 9.81;
     let reference_config = UlFemConfig {
