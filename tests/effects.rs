@@ -39,6 +39,7 @@ fn bar_1d(effects: Vec<EffectSpec>, t_end: f64) -> Scene {
     }];
     s.effects = effects;
     s.time = TimeSpec {
+        allow_above_critical: false,
         dt: Some(1e-3),
         courant: None,
         t_end,

@@ -37,6 +37,10 @@ pub struct Overrides {
     /// End time.
     #[arg(long)]
     pub t_end: Option<f64>,
+    /// Run with a time step above the critical step estimated at the start (an error
+    /// otherwise): to see what an unstable step does.
+    #[arg(long)]
+    pub allow_above_critical: bool,
     /// Estimate the condition number of the solved mass system every step (about 60
     /// extra solves; 30 products for `extended`).
     #[arg(long)]
@@ -72,6 +76,9 @@ impl Overrides {
         }
         if let Some(dt) = self.dt {
             s.set_dt(dt);
+        }
+        if self.allow_above_critical {
+            s.time.allow_above_critical = true;
         }
         if let Some(t) = self.t_end {
             s.time.t_end = t;

@@ -113,3 +113,109 @@ fn stiffness_product<T: Scalar, const D: usize>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::stiffness_product;
+    use crate::driver::Driver;
+    use crate::mass::{MassKind, MassStrategy};
+    use crate::material::{Elastic, LinearElastic};
+    use crate::particles::Particles;
+    use nalgebra::{DMatrix, SVector};
+    use psmpm_basis::basis::linear::Linear;
+    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+    use psmpm_basis::mesh::generators::block_grid;
+    use psmpm_basis::Basis;
+
+    /// `λ_max(M⁻¹K)` computed densely: `M` and `K` assembled column by column from
+    /// the driver's own evaluations, then the symmetric eigenvalues of `L⁻¹ K L⁻ᵀ`.
+    fn dense_critical<B: Basis<f64, 2>>(basis: B) -> (f64, f64) {
+        let (nx, ny) = (12, 12);
+        let mut positions = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                positions.push(SVector::<f64, 2>::new(
+                    (i as f64 + 0.5) / nx as f64 * 2.0,
+                    (j as f64 + 0.5) / ny as f64,
+                ));
+            }
+        }
+        let n_p = positions.len();
+        let volume = 2.0 / n_p as f64;
+        let particles = Particles::new(positions, vec![volume; n_p], 3.0);
+        let material = LinearElastic::new(Elastic::new(100.0, 0.3, 3.0).unwrap(), 2);
+        let mut driver: Driver<f64, 2, B, Box<dyn MassStrategy<f64>>, _> = Driver::new(
+            basis,
+            particles,
+            material,
+            MassKind::Consistent.build(),
+            &[],
+            Vec::new(),
+            1e-3,
+        )
+        .unwrap();
+        let estimate = driver.critical_time_step().unwrap();
+        let n = driver.basis.num_functions();
+        let e = &driver.evals;
+        let mut m = DMatrix::<f64>::zeros(2 * n, 2 * n);
+        for p in 0..n_p {
+            let mass = driver.particles.mass[p];
+            for s in e.range(p) {
+                for r in e.range(p) {
+                    let v = mass * e.phi[s] * e.phi[r];
+                    for k in 0..2 {
+                        m[(k * n + e.index[s], k * n + e.index[r])] += v;
+                    }
+                }
+            }
+        }
+        let (lambda, mu) = Elastic::new(100.0, 0.3, 3.0).unwrap().lame(2);
+        let mut k = DMatrix::<f64>::zeros(2 * n, 2 * n);
+        let mut f = vec![vec![0.0; n]; 2];
+        for col in 0..2 * n {
+            let mut v = vec![vec![0.0; n]; 2];
+            v[col / n][col % n] = 1.0;
+            stiffness_product(
+                &driver.evals,
+                &driver.particles.volume,
+                lambda,
+                mu,
+                &v,
+                &mut f,
+            );
+            for row in 0..2 * n {
+                k[(row, col)] = f[row / n][row % n];
+            }
+        }
+        let l = m
+            .cholesky()
+            .expect("the consistent mass of a filled mesh")
+            .l();
+        let l_inv = l.clone().try_inverse().unwrap();
+        let a = &l_inv * &k * l_inv.transpose();
+        let a = (&a + a.transpose()) * 0.5;
+        let lambda_max = a.symmetric_eigenvalues().max();
+        (estimate, 2.0 / lambda_max.sqrt())
+    }
+
+    #[test]
+    fn the_critical_step_matches_a_dense_eigenvalue_computation() {
+        let mesh = || block_grid(0.0, 2.0, 0.0, 1.0, 4, 2).unwrap();
+        for (name, (estimate, exact)) in [
+            (
+                "PS",
+                dense_critical(PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap()),
+            ),
+            ("PL", dense_critical(Linear::<f64>::new(mesh()))),
+        ] {
+            println!("{name}: power iteration {estimate:.6e}, dense {exact:.6e}");
+            // The estimate is never below the true critical step by more than the
+            // iteration's round-off, and within 5 % of it after 40 iterations.
+            assert!(
+                estimate >= exact * (1.0 - 1e-9),
+                "{name}: {estimate} < {exact}"
+            );
+            assert!(estimate <= exact * 1.05, "{name}: {estimate} vs {exact}");
+        }
+    }
+}

@@ -421,6 +421,10 @@ pub struct TimeSpec {
     pub courant: Option<f64>,
     /// End time.
     pub t_end: f64,
+    /// Run with a fixed `dt` above the critical step estimated at the start (an
+    /// error otherwise, naming both): for studies of what an unstable step does.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub allow_above_critical: bool,
 }
 
 /// The exact or reference solution of a scene, and so its error measure.

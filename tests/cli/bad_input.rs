@@ -420,7 +420,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .at(33, 1).expect("effect[1].beta: unknown field `beta`, expected `alpha`"),
         case("unknown-field-in-time", BAR)
             .edit("dt = 1e-3", "dt = 1e-3\n@@steps = 10")
-            .expect("time.steps: unknown field `steps`, expected one of `dt`, `courant`, `t_end`"),
+            .expect("time.steps: unknown field `steps`, expected one of `dt`, `courant`, `t_end`, `allow_above_critical`"),
         case("unknown-field-in-reference", BAR)
             .edit("[reference]", "@@[reference]")
             .edit("v0 = 0.1", "v0 = 0.1\namplitude = 2.0")
@@ -1205,8 +1205,22 @@ fn unknown_flags_follow_clap_conventions() {
 
 #[test]
 fn a_run_that_fails_numerically_exits_with_1_and_names_the_step() {
+    // A step above the critical one is refused before the run, naming both steps.
     let out = cli()
         .args(["run", "vibrating-bar", "--dt", "100", "--t-end", "1000"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.starts_with("error: time.dt: the time step 100 is above the critical step 4.32"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("--allow-above-critical"), "{stderr}");
+    // Run anyway: it fails at step 1 and says why.
+    let out = cli()
+        .args(["run", "vibrating-bar", "--dt", "100", "--t-end", "1000"])
+        .arg("--allow-above-critical")
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));

@@ -538,6 +538,7 @@ fn a_failed_run_still_writes_its_files() {
             "100",
             "--t-end",
             "1000",
+            "--allow-above-critical",
             "--out",
             key(dir.path()),
         ])
