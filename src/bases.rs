@@ -53,6 +53,16 @@ impl BasisKind {
             })
     }
 
+    /// The length that sets the time step of a Courant-number guess on a mesh with
+    /// smallest edge `h`: the PS refinement splits every edge, so its elements are
+    /// about `h / 2`; the other bases use `h`.
+    pub fn wave_length(self, h: f64) -> f64 {
+        match self {
+            BasisKind::Ps => 0.5 * h,
+            BasisKind::Pl | BasisKind::Bspline | BasisKind::Pl1d => h,
+        }
+    }
+
     /// Spatial dimension of the basis.
     pub fn dim(self) -> usize {
         match self {

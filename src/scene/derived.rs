@@ -2,7 +2,6 @@
 //! mesh size and block counts.
 
 use super::{Body, EffectSpec, MeshSpec, Scene};
-use crate::bases::BasisKind;
 
 impl Scene {
     /// The lattice spacing of `body` along axis `k`: the box extent over `count`, or
@@ -49,12 +48,7 @@ impl Scene {
                     density: m.density,
                 };
                 let speed = (e.p_modulus(self.dim) / m.density).sqrt();
-                let h = if self.basis == BasisKind::Ps {
-                    0.5 * h
-                } else {
-                    h
-                };
-                c * h / speed
+                c * self.basis.wave_length(h) / speed
             }
             (None, None) => f64::NAN,
         }
