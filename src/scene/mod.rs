@@ -11,7 +11,8 @@
 //! The built-in scenes are TOML files under `scenes/` compiled into the library
 //! ([`BUILTIN`], [`Scene::builtin`]); `mpm-cli scene show NAME` prints them and
 //! `mpm-cli run FILE.toml` reads a file back. Every error in a file names the file,
-//! line and column, and the field.
+//! line and column, and the field. `docs/scenes.md` documents every key (a test
+//! checks it against this schema).
 //!
 //! ```toml
 //! name = "column-small"
