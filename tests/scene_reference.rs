@@ -249,6 +249,10 @@ fn every_example_parses_and_validates() {
         scene.time.t_end = 1e-3;
         let summary = psmpm::simulation::run(&scene, &mut |_| {})
             .unwrap_or_else(|e| panic!("example\n{fragment}\ndoes not run: {e}"));
-        assert!(summary.failure.is_none(), "{fragment}: {:?}", summary.failure);
+        assert!(
+            summary.failure.is_none(),
+            "{fragment}: {:?}",
+            summary.failure
+        );
     }
 }

@@ -5,6 +5,7 @@ use crate::error::CliError;
 use crate::run::read_scene;
 use crate::table::Table;
 use crate::Format;
+use psmpm::scene::annotate;
 use psmpm::scene::{Scene, BUILTIN};
 use serde_json::json;
 
@@ -86,8 +87,8 @@ pub fn scene(command: SceneCommand) -> Result<(), CliError> {
     match command {
         SceneCommand::Show { scene } => {
             match BUILTIN.iter().find(|(name, _, _)| *name == scene) {
-                Some((_, _, text)) => print!("{text}"),
-                None => print!("{}", read_scene(&scene)?.to_toml()),
+                Some((_, _, text)) => print!("{}", annotate(text)),
+                None => print!("{}", annotate(&read_scene(&scene)?.to_toml())),
             }
             Ok(())
         }

@@ -66,6 +66,7 @@ use crate::mass::MassKind;
 use psmpm_basis::basis::powell_sabin::SplitPoint;
 use serde::{Deserialize, Serialize};
 
+mod annotate;
 mod builders;
 mod builtin;
 mod derived;
@@ -73,6 +74,7 @@ mod locate;
 mod names;
 mod validate;
 
+pub use annotate::annotate;
 pub use builtin::BUILTIN;
 pub use names::{parse_split, split_to_str};
 pub use validate::{MAX_BLOCKS, MAX_PARTICLES};
