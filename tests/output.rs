@@ -340,8 +340,8 @@ fn binary_and_ascii_frames_read_back_the_same() {
     let dir = TempDir::new("encodings");
     let mesh = block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap();
     let field: Vec<f64> = mesh.vertices().iter().map(|v| v.x - v.y / 7.0).collect();
-    // More than one 32 KiB block per array: 2000 particles × 9 stress components.
-    let n = 2000;
+    // More than one 1 MiB block per array: 20000 particles × 9 stress components.
+    let n = 20000;
     let mut p = Particles::new(
         (0..n)
             .map(|i| Vector2::new(i as f64 / 3.0, (i as f64).sqrt()))
