@@ -24,12 +24,13 @@
 //!   (`output.tracked`): `time, particle, u_x, u_y, v_x, v_y` and, with a reference
 //!   solution, `u_exact_x, u_exact_y`, one row per step and tracked particle; the
 //!   plot shows the displacement against time (computed as markers, or as a line
-//!   without a reference; the reference as a line).
+//!   without a reference; the reference as a line) and below it the velocity
+//!   (computed, in the same style).
 //! - `energy.svg`: kinetic, strain, potential and total energy against time.
 
 use crate::error::CliError;
 use psmpm::driver::StepReport;
-use psmpm::output::chart::{line_plot, LinePlot, Series};
+use psmpm::output::chart::{stacked_line_plots, LinePlot, Series};
 use psmpm::output::dir::{is_frame, prepare_dir, write_file, OutputDir, OutputError};
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::scene::Scene;
@@ -306,11 +307,15 @@ impl Recorder {
         if !tracked.is_empty() {
             self.write_tracked_csv(tracked)?;
             files.push(TRACKED_CSV.to_string());
-            if self.plot(TRACKED_SVG, self.tracked_plot(tracked))? {
+            let panels = vec![
+                self.tracked_plot(tracked),
+                self.tracked_velocity_plot(tracked),
+            ];
+            if self.plots(TRACKED_SVG, panels)? {
                 files.push(TRACKED_SVG.to_string());
             }
         }
-        if self.plot(ENERGY_SVG, self.energy_plot())? {
+        if self.plots(ENERGY_SVG, vec![self.energy_plot()])? {
             files.push(ENERGY_SVG.to_string());
         }
         Ok(files)
@@ -411,6 +416,52 @@ impl Recorder {
         plot
     }
 
+    /// The velocity of the tracked particles against time, the components that
+    /// move, as markers when the scene has a reference (as the displacement), else
+    /// as lines.
+    fn tracked_velocity_plot(&self, tracked: &[Tracked]) -> LinePlot {
+        let mut plot = LinePlot::new(
+            format!("{}: tracked particles, velocity", self.scene),
+            "time (s)",
+            "velocity (m/s)",
+        );
+        let axis = ["x", "y"];
+        for t in tracked {
+            let has_exact =
+                !t.exact_displacement.is_empty() && t.exact_displacement.len() == t.time.len();
+            let amplitude = |c: usize| {
+                t.velocity
+                    .iter()
+                    .map(|v| v[c].abs())
+                    .filter(|a| a.is_finite())
+                    .fold(0.0, f64::max)
+            };
+            let amplitudes = [amplitude(0), amplitude(1)];
+            let largest = amplitudes[0].max(amplitudes[1]);
+            let mut components: Vec<usize> = (0..self.dim)
+                .filter(|&c| amplitudes[c] > 1e-3 * largest)
+                .collect();
+            if components.is_empty() {
+                components.push(self.dim - 1);
+            }
+            for c in components {
+                let name = format!("particle {} v_{} (MPM)", t.particle, axis[c]);
+                let points: Vec<(f64, f64)> = t
+                    .time
+                    .iter()
+                    .zip(&t.velocity)
+                    .map(|(&s, v)| (s, v[c]))
+                    .collect();
+                plot = plot.with_series(if has_exact {
+                    Series::markers(name, thin(points, MAX_MARKERS))
+                } else {
+                    Series::line(name, thin(points, MAX_PLOT_POINTS))
+                });
+            }
+        }
+        plot
+    }
+
     fn energy_plot(&self) -> LinePlot {
         let (per, unit) = if self.dim == 2 {
             ("thickness", "energy (J/m)")
@@ -432,18 +483,22 @@ impl Recorder {
         plot
     }
 
-    /// Draws `plot` into `file` without its non-finite points (an unstable run) and
-    /// empty series; `false` when nothing is left to draw.
-    fn plot(&self, file: &str, mut plot: LinePlot) -> Result<bool, CliError> {
-        for s in &mut plot.series {
-            s.points.retain(|(x, y)| x.is_finite() && y.is_finite());
+    /// Draws `plots` (one below the other) into `file` without their non-finite
+    /// points (an unstable run), empty series and empty plots; `false` when nothing
+    /// is left to draw.
+    fn plots(&self, file: &str, mut plots: Vec<LinePlot>) -> Result<bool, CliError> {
+        for plot in &mut plots {
+            for s in &mut plot.series {
+                s.points.retain(|(x, y)| x.is_finite() && y.is_finite());
+            }
+            plot.series.retain(|s| !s.points.is_empty());
         }
-        plot.series.retain(|s| !s.points.is_empty());
-        if plot.series.is_empty() {
+        plots.retain(|p| !p.series.is_empty());
+        if plots.is_empty() {
             return Ok(false);
         }
         let path = self.dir.file(file);
-        line_plot(&path, &plot).map_err(|e| match e {
+        stacked_line_plots(&path, &plots).map_err(|e| match e {
             psmpm::output::chart::PlotError::Io { .. } => CliError::Input(e.to_string()),
             other => CliError::Input(format!("{}: {other}", path.display())),
         })?;

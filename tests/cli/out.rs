@@ -426,6 +426,14 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
     );
     let texts = json["svg"][key(&files[5])]["texts"].to_string();
     assert!(texts.contains("time (s)") && texts.contains("displacement (m)"));
+    // The second panel: the velocity, computed, as markers (the scene has a reference).
+    assert!(texts.contains("velocity (m/s)"), "{texts}");
+    for p in [p0, p1] {
+        assert!(
+            texts.contains(&format!("particle {p} v_x (MPM)")),
+            "{texts}"
+        );
+    }
 }
 
 #[test]
