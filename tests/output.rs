@@ -4,7 +4,8 @@
 //! These tests need `python3` with `meshio`; they fail (never skip) without them.
 
 use nalgebra::{Matrix1, Matrix2, Vector1, Vector2};
-use psmpm::output::dir::{OutputDir, OutputError};
+use psmpm::output::dir::{is_frame, prepare_dir, OutputDir, OutputError};
+use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
 use psmpm_basis::mesh::generators::block_grid;
 use serde_json::Value;
@@ -332,4 +333,100 @@ fn an_output_directory_that_cannot_be_created_is_an_error() {
         message.starts_with("cannot create output directory"),
         "{message}"
     );
+}
+
+#[test]
+fn binary_and_ascii_frames_read_back_the_same() {
+    let dir = TempDir::new("encodings");
+    let mesh = block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap();
+    let field: Vec<f64> = mesh.vertices().iter().map(|v| v.x - v.y / 7.0).collect();
+    // More than one 1 MiB block per array: 20000 particles × 9 stress components.
+    let n = 20000;
+    let mut p = Particles::new(
+        (0..n)
+            .map(|i| Vector2::new(i as f64 / 3.0, (i as f64).sqrt()))
+            .collect(),
+        vec![1.0 / 3.0; n],
+        1000.0,
+    );
+    for i in 0..n {
+        let a = i as f64;
+        p.v[i] = Vector2::new(a.sin(), -a.cos() / 3.0);
+        p.u[i] = Vector2::new(1e-7 * a, -0.0);
+        p.sigma[i] = Matrix2::new(a, 1.0 / (a + 1.0), -a * 1e5, 2.5);
+    }
+    let mut files = Vec::new();
+    for (name, encoding) in [
+        ("binary", VtuEncoding::Binary),
+        ("ascii", VtuEncoding::Ascii),
+    ] {
+        let mut out = OutputDir::create(dir.0.join(name), 1)
+            .unwrap()
+            .with_encoding(encoding);
+        assert_eq!(out.encoding(), encoding);
+        files.push(out.write_particles(0.0, &p).unwrap());
+        files.push(out.write_mesh(&mesh, Some(("f", &field))).unwrap());
+    }
+    let binary = std::fs::read(&files[0]).unwrap();
+    let ascii = std::fs::read(&files[2]).unwrap();
+    assert!(
+        binary.len() * 3 < ascii.len(),
+        "{} vs {}",
+        binary.len(),
+        ascii.len()
+    );
+    let head = String::from_utf8_lossy(&binary[..400]);
+    assert!(head.contains("header_type=\"UInt64\""), "{head}");
+    assert!(
+        head.contains("compressor=\"vtkZLibDataCompressor\""),
+        "{head}"
+    );
+    assert!(String::from_utf8_lossy(&ascii).contains("format=\"ascii\""));
+
+    let json = read_back(&files);
+    check_particles(vtu(&json, &files[0]), &p);
+    check_particles(vtu(&json, &files[2]), &p);
+    assert_eq!(vtu(&json, &files[0]), vtu(&json, &files[2]));
+    assert_eq!(vtu(&json, &files[1]), vtu(&json, &files[3]));
+}
+
+#[test]
+fn a_directory_is_reused_only_when_it_holds_output_files() {
+    let dir = TempDir::new("reuse");
+    let owned = |name: &str| is_frame(name) || name == "particles.pvd";
+    // A new directory is created; an empty one is used as it is.
+    assert!(prepare_dir(&dir.0, false, owned).unwrap().is_empty());
+    assert!(prepare_dir(&dir.0, false, owned).unwrap().is_empty());
+    for name in [
+        "particles_00000.vtu",
+        "particles_00001.vtu",
+        "particles.pvd",
+    ] {
+        std::fs::write(dir.0.join(name), "x").unwrap();
+    }
+    // Files of an earlier run: refused without overwrite, naming the directory.
+    let err = prepare_dir(&dir.0, false, owned).unwrap_err();
+    assert!(
+        matches!(err, OutputError::NotEmpty { files: 3, .. }),
+        "{err:?}"
+    );
+    let message = err.to_string();
+    assert!(message.contains(dir.0.to_str().unwrap()), "{message}");
+    assert!(message.contains("particles_00000.vtu"), "{message}");
+    // A file of someone else: refused even with overwrite, and nothing removed.
+    std::fs::write(dir.0.join("notes.txt"), "mine").unwrap();
+    let err = prepare_dir(&dir.0, true, owned).unwrap_err();
+    assert!(
+        matches!(err, OutputError::Foreign { files: 1, .. }),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("notes.txt"), "{err}");
+    assert!(dir.0.join("particles_00001.vtu").is_file());
+    // With overwrite and only output files: they are removed.
+    std::fs::remove_file(dir.0.join("notes.txt")).unwrap();
+    let removed = prepare_dir(&dir.0, true, owned).unwrap();
+    assert_eq!(removed.len(), 3);
+    assert_eq!(std::fs::read_dir(&dir.0).unwrap().count(), 0);
+    assert!(is_frame("particles_123456.vtu"));
+    assert!(!is_frame("particles_.vtu") && !is_frame("particles_1a.vtu"));
 }

@@ -155,23 +155,23 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
             println!("{}", serde_json::Value::Array(all));
         }
         Format::Csv => {
-            println!("{}", COLUMNS.join(","));
+            println!("{}", crate::out::csv_record(&COLUMNS));
             let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
             for s in summaries {
-                println!(
-                    "{},{},{},{},{},{},{},{},{},{},{}",
-                    s.basis,
-                    s.mass,
-                    s.functions,
-                    s.particles,
-                    s.steps,
+                let record = [
+                    s.basis.to_string(),
+                    s.mass.clone(),
+                    s.functions.to_string(),
+                    s.particles.to_string(),
+                    s.steps.to_string(),
                     opt(s.error),
                     opt(s.max_condition),
-                    s.max_lumped_rows,
-                    s.energy_drift,
-                    s.stable,
-                    s.seconds
-                );
+                    s.max_lumped_rows.to_string(),
+                    s.energy_drift.to_string(),
+                    s.stable.to_string(),
+                    s.seconds.to_string(),
+                ];
+                println!("{}", crate::out::csv_record(&record));
             }
         }
         Format::Table => {

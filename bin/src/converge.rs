@@ -162,20 +162,31 @@ fn print_levels(rows: &[Level], format: Format) {
 
 fn csv(rows: &[Level]) -> String {
     let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
-    let mut out = String::from("basis,level,h,functions,particles,error,order,seconds,stable\n");
+    let mut out = crate::out::csv_record(&[
+        "basis",
+        "level",
+        "h",
+        "functions",
+        "particles",
+        "error",
+        "order",
+        "seconds",
+        "stable",
+    ]);
+    out.push('\n');
     for r in rows {
-        out += &format!(
-            "{},{},{},{},{},{},{},{},{}\n",
-            r.basis,
-            r.level,
-            r.h,
-            r.functions,
-            r.particles,
+        out += &crate::out::csv_record(&[
+            r.basis.to_string(),
+            r.level.to_string(),
+            r.h.to_string(),
+            r.functions.to_string(),
+            r.particles.to_string(),
             opt(r.error),
             opt(r.order),
-            r.seconds,
-            r.stable
-        );
+            r.seconds.to_string(),
+            r.stable.to_string(),
+        ]);
+        out.push('\n');
     }
     out
 }

@@ -1,13 +1,21 @@
 //! `mpm-cli run --out DIR`: the files of a run.
 //!
+//! `DIR` must be new, empty, or hold only the files of an earlier run (the names
+//! below); with `--overwrite` those files are removed before the run starts, so no
+//! stale frame of a longer earlier run is left. A directory holding anything else
+//! (a file of another name, a sub-directory) is refused even with `--overwrite`:
+//! the tool never removes a file it does not write, nor mixes a run with it.
+//!
 //! - `diagnostics.csv`: one row per step (not the initial state): `step, time,
 //!   kinetic, strain, potential, work, total, mass, momentum_x, momentum_y,
 //!   max_speed, active, lumped_rows, deactivated, condition` (the values of
 //!   `--format json`; floats in Rust's shortest round-trip `{:e}` form, integers as
-//!   integers, `condition` empty unless `--condition`).
+//!   integers, `condition` empty unless `--condition`). All CSV files are written
+//!   with the `csv` crate (RFC 4180 quoting where needed).
 //! - `summary.json`: the summary of `--format json`, pretty-printed.
 //! - `particles_NNNNN.vtu` and `particles.pvd`: particle frames (position,
-//!   velocity, displacement, stress, volume, mass; see `psmpm::output::vtk`) of the
+//!   velocity, displacement, stress, volume, mass; see `psmpm::output::vtk`; binary
+//!   zlib-compressed VTK XML unless `--vtu ascii`) of the
 //!   initial state, every `--out-every` steps and the last step (on a numerical
 //!   failure, the particles as the failed step left them, at the time of the last
 //!   completed step); the `.pvd` collection plays them back in ParaView.
@@ -16,17 +24,19 @@
 //!   (`output.tracked`): `time, particle, u_x, u_y, v_x, v_y` and, with a reference
 //!   solution, `u_exact_x, u_exact_y`, one row per step and tracked particle; the
 //!   plot shows the displacement against time (computed as markers, or as a line
-//!   without a reference; the reference as a line).
+//!   without a reference; the reference as a line) and below it the velocity
+//!   (computed, in the same style).
 //! - `energy.svg`: kinetic, strain, potential and total energy against time.
 
 use crate::error::CliError;
 use psmpm::driver::StepReport;
-use psmpm::output::chart::{line_plot, LinePlot, Series};
-use psmpm::output::dir::{write_file, OutputDir, OutputError};
+use psmpm::output::chart::{stacked_line_plots, LinePlot, Series};
+use psmpm::output::dir::{is_frame, prepare_dir, write_file, OutputDir, OutputError};
+use psmpm::output::vtk::VtuEncoding;
 use psmpm::scene::Scene;
 use psmpm::simulation::{self, ParticlesRef, Summary, Tracked};
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Columns of `diagnostics.csv`.
@@ -71,6 +81,32 @@ fn output_error(e: OutputError) -> CliError {
     CliError::Input(e.to_string())
 }
 
+/// Whether `name` is a file `run --out` writes (and so may remove with `--overwrite`).
+pub fn is_output_file(name: &str) -> bool {
+    is_frame(name)
+        || [
+            DIAGNOSTICS_FILE,
+            SUMMARY_FILE,
+            TRACKED_CSV,
+            TRACKED_SVG,
+            ENERGY_SVG,
+            OutputDir::MESH_FILE,
+            OutputDir::PVD_FILE,
+        ]
+        .contains(&name)
+}
+
+/// How `run --out` writes its directory.
+#[derive(Debug, Clone, Copy)]
+pub struct OutOptions {
+    /// `--out-every`, or `None` for the default.
+    pub every: Option<usize>,
+    /// `--overwrite`: replace the files of an earlier run.
+    pub overwrite: bool,
+    /// `--vtu`.
+    pub encoding: VtuEncoding,
+}
+
 fn write_error(path: &Path, e: std::io::Error) -> CliError {
     output_error(OutputError::Write {
         path: path.to_path_buf(),
@@ -89,7 +125,7 @@ pub struct Recorder {
     /// End time and steps of the run (the steps are known at step 1).
     t_end: f64,
     total: usize,
-    diagnostics: Option<BufWriter<File>>,
+    diagnostics: Option<csv::Writer<File>>,
     diagnostics_path: PathBuf,
     /// `(time, kinetic, strain, potential, total)` of the initial state and every step.
     energy: Vec<[f64; 5]>,
@@ -102,10 +138,26 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Creates `dir`, writes the mesh (2D) and the header of `diagnostics.csv`, so
-    /// that a directory that cannot be written is reported before the run.
-    pub fn create(dir: &Path, every: Option<usize>, scene: &Scene) -> Result<Self, CliError> {
-        let out = OutputDir::create(dir, 0).map_err(output_error)?;
+    /// Prepares `dir` (see the module documentation), writes the mesh (2D) and the
+    /// header of `diagnostics.csv`, so that a directory that cannot be written is
+    /// reported before the run.
+    pub fn create(dir: &Path, options: OutOptions, scene: &Scene) -> Result<Self, CliError> {
+        prepare_dir(dir, options.overwrite, is_output_file).map_err(|e| {
+            let hint = match e {
+                OutputError::NotEmpty { .. } => {
+                    "; pass --overwrite to replace them, or choose another --out"
+                }
+                OutputError::Foreign { .. } => {
+                    "; choose another --out (--overwrite only replaces the files of a run)"
+                }
+                _ => "",
+            };
+            CliError::Input(format!("{e}{hint}"))
+        })?;
+        let every = options.every;
+        let out = OutputDir::create(dir, 0)
+            .map_err(output_error)?
+            .with_encoding(options.encoding);
         let mesh = scene.dim == 2;
         if mesh {
             let triangulation =
@@ -113,8 +165,10 @@ impl Recorder {
             out.write_mesh(&triangulation, None).map_err(output_error)?;
         }
         let path = out.file(DIAGNOSTICS_FILE);
-        let mut w = BufWriter::new(File::create(&path).map_err(|e| write_error(&path, e))?);
-        writeln!(w, "{}", DIAGNOSTICS_COLUMNS.join(",")).map_err(|e| write_error(&path, e))?;
+        let mut w =
+            csv::Writer::from_writer(File::create(&path).map_err(|e| write_error(&path, e))?);
+        w.write_record(DIAGNOSTICS_COLUMNS)
+            .map_err(|e| write_error(&path, e.into()))?;
         Ok(Recorder {
             dir: out,
             scene: scene.name.clone(),
@@ -177,27 +231,26 @@ impl Recorder {
         let Some(w) = self.diagnostics.as_mut() else {
             return Ok(());
         };
-        let condition = r.condition.map_or_else(String::new, |c| format!("{c:e}"));
-        writeln!(
-            w,
-            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{}",
-            r.step,
-            r.time,
-            r.kinetic,
-            r.strain,
-            r.potential,
-            r.work,
-            r.total_energy(),
-            r.mass,
-            r.momentum[0],
-            r.momentum[1],
-            r.max_speed,
-            r.mass_report.active,
-            r.mass_report.lumped_rows,
-            r.mass_report.deactivated,
-            condition
-        )
-        .map_err(|e| write_error(path, e))
+        let float = |x: f64| format!("{x:e}");
+        let record = [
+            r.step.to_string(),
+            float(r.time),
+            float(r.kinetic),
+            float(r.strain),
+            float(r.potential),
+            float(r.work),
+            float(r.total_energy()),
+            float(r.mass),
+            float(r.momentum[0]),
+            float(r.momentum[1]),
+            float(r.max_speed),
+            r.mass_report.active.to_string(),
+            r.mass_report.lumped_rows.to_string(),
+            r.mass_report.deactivated.to_string(),
+            r.condition.map_or_else(String::new, float),
+        ];
+        w.write_record(&record)
+            .map_err(|e| write_error(path, e.into()))
     }
 
     fn frame(
@@ -230,7 +283,7 @@ impl Recorder {
         let path = self.dir.file(DIAGNOSTICS_FILE);
         if let Some(w) = self.diagnostics.take() {
             w.into_inner()
-                .map_err(|e| write_error(&path, e.into_error()))?
+                .map_err(|e| write_error(&path, std::io::Error::other(e.error().to_string())))?
                 .sync_all()
                 .map_err(|e| write_error(&path, e))?;
         }
@@ -254,11 +307,15 @@ impl Recorder {
         if !tracked.is_empty() {
             self.write_tracked_csv(tracked)?;
             files.push(TRACKED_CSV.to_string());
-            if self.plot(TRACKED_SVG, self.tracked_plot(tracked))? {
+            let panels = vec![
+                self.tracked_plot(tracked),
+                self.tracked_velocity_plot(tracked),
+            ];
+            if self.plots(TRACKED_SVG, panels)? {
                 files.push(TRACKED_SVG.to_string());
             }
         }
-        if self.plot(ENERGY_SVG, self.energy_plot())? {
+        if self.plots(ENERGY_SVG, vec![self.energy_plot()])? {
             files.push(ENERGY_SVG.to_string());
         }
         Ok(files)
@@ -271,27 +328,32 @@ impl Recorder {
         let path = self.dir.file(TRACKED_CSV);
         let steps = tracked.iter().map(|t| t.time.len()).min().unwrap_or(0);
         write_file(&path, |w| {
-            w.write_all(b"time,particle,u_x,u_y,v_x,v_y")?;
+            let mut csv = csv::Writer::from_writer(w);
+            let mut header = vec!["time", "particle", "u_x", "u_y", "v_x", "v_y"];
             if exact {
-                w.write_all(b",u_exact_x,u_exact_y")?;
+                header.extend(["u_exact_x", "u_exact_y"]);
             }
-            w.write_all(b"\n")?;
+            csv.write_record(&header)?;
+            let float = |x: f64| format!("{x:e}");
             for i in 0..steps {
                 for t in tracked {
                     let (u, v) = (t.displacement[i], t.velocity[i]);
-                    write!(
-                        w,
-                        "{:e},{},{:e},{:e},{:e},{:e}",
-                        t.time[i], t.particle, u[0], u[1], v[0], v[1]
-                    )?;
+                    let mut record = vec![
+                        float(t.time[i]),
+                        t.particle.to_string(),
+                        float(u[0]),
+                        float(u[1]),
+                        float(v[0]),
+                        float(v[1]),
+                    ];
                     if exact {
                         let e = t.exact_displacement[i];
-                        write!(w, ",{:e},{:e}", e[0], e[1])?;
+                        record.extend([float(e[0]), float(e[1])]);
                     }
-                    w.write_all(b"\n")?;
+                    csv.write_record(&record)?;
                 }
             }
-            Ok(())
+            csv.flush()
         })
         .map_err(output_error)
     }
@@ -354,6 +416,52 @@ impl Recorder {
         plot
     }
 
+    /// The velocity of the tracked particles against time, the components that
+    /// move, as markers when the scene has a reference (as the displacement), else
+    /// as lines.
+    fn tracked_velocity_plot(&self, tracked: &[Tracked]) -> LinePlot {
+        let mut plot = LinePlot::new(
+            format!("{}: tracked particles, velocity", self.scene),
+            "time (s)",
+            "velocity (m/s)",
+        );
+        let axis = ["x", "y"];
+        for t in tracked {
+            let has_exact =
+                !t.exact_displacement.is_empty() && t.exact_displacement.len() == t.time.len();
+            let amplitude = |c: usize| {
+                t.velocity
+                    .iter()
+                    .map(|v| v[c].abs())
+                    .filter(|a| a.is_finite())
+                    .fold(0.0, f64::max)
+            };
+            let amplitudes = [amplitude(0), amplitude(1)];
+            let largest = amplitudes[0].max(amplitudes[1]);
+            let mut components: Vec<usize> = (0..self.dim)
+                .filter(|&c| amplitudes[c] > 1e-3 * largest)
+                .collect();
+            if components.is_empty() {
+                components.push(self.dim - 1);
+            }
+            for c in components {
+                let name = format!("particle {} v_{} (MPM)", t.particle, axis[c]);
+                let points: Vec<(f64, f64)> = t
+                    .time
+                    .iter()
+                    .zip(&t.velocity)
+                    .map(|(&s, v)| (s, v[c]))
+                    .collect();
+                plot = plot.with_series(if has_exact {
+                    Series::markers(name, thin(points, MAX_MARKERS))
+                } else {
+                    Series::line(name, thin(points, MAX_PLOT_POINTS))
+                });
+            }
+        }
+        plot
+    }
+
     fn energy_plot(&self) -> LinePlot {
         let (per, unit) = if self.dim == 2 {
             ("thickness", "energy (J/m)")
@@ -375,18 +483,22 @@ impl Recorder {
         plot
     }
 
-    /// Draws `plot` into `file` without its non-finite points (an unstable run) and
-    /// empty series; `false` when nothing is left to draw.
-    fn plot(&self, file: &str, mut plot: LinePlot) -> Result<bool, CliError> {
-        for s in &mut plot.series {
-            s.points.retain(|(x, y)| x.is_finite() && y.is_finite());
+    /// Draws `plots` (one below the other) into `file` without their non-finite
+    /// points (an unstable run), empty series and empty plots; `false` when nothing
+    /// is left to draw.
+    fn plots(&self, file: &str, mut plots: Vec<LinePlot>) -> Result<bool, CliError> {
+        for plot in &mut plots {
+            for s in &mut plot.series {
+                s.points.retain(|(x, y)| x.is_finite() && y.is_finite());
+            }
+            plot.series.retain(|s| !s.points.is_empty());
         }
-        plot.series.retain(|s| !s.points.is_empty());
-        if plot.series.is_empty() {
+        plots.retain(|p| !p.series.is_empty());
+        if plots.is_empty() {
             return Ok(false);
         }
         let path = self.dir.file(file);
-        line_plot(&path, &plot).map_err(|e| match e {
+        stacked_line_plots(&path, &plots).map_err(|e| match e {
             psmpm::output::chart::PlotError::Io { .. } => CliError::Input(e.to_string()),
             other => CliError::Input(format!("{}: {other}", path.display())),
         })?;
@@ -413,6 +525,19 @@ fn thin(points: Vec<(f64, f64)>, max: usize) -> Vec<(f64, f64)> {
     out
 }
 
+/// One CSV record (no line break), quoted as RFC 4180 needs (the `csv` crate).
+pub fn csv_record<S: AsRef<[u8]>>(fields: &[S]) -> String {
+    let mut w = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(Vec::new());
+    // Writing into a Vec cannot fail.
+    let _ = w.write_record(fields);
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8_lossy(&bytes)
+        .trim_end_matches('\n')
+        .to_string()
+}
+
 /// `DIR: files` for the one line `run` prints.
 pub fn files_line(dir: &Path, files: &[String]) -> String {
     format!("output written to {}: {}", dir.display(), files.join(", "))
@@ -432,5 +557,25 @@ mod tests {
         assert_eq!(thin(points[..10].to_vec(), 120).len(), 10);
         assert_eq!(steps_from_dt(5.0, 1e-3), 5000);
         assert_eq!(steps_from_dt(1e-9, 1.0), 1);
+    }
+
+    #[test]
+    fn csv_records_are_quoted_where_needed_and_output_files_are_known() {
+        assert_eq!(csv_record(&["a", "b c", "1e0"]), "a,b c,1e0");
+        assert_eq!(
+            csv_record(&["x, y", "say \"hi\"", ""]),
+            "\"x, y\",\"say \"\"hi\"\"\","
+        );
+        for name in [
+            "particles_00012.vtu",
+            "summary.json",
+            "mesh.vtu",
+            "energy.svg",
+        ] {
+            assert!(is_output_file(name), "{name}");
+        }
+        for name in ["notes.txt", "particles_a.vtu", "mesh.vtu.bak"] {
+            assert!(!is_output_file(name), "{name}");
+        }
     }
 }

@@ -104,18 +104,18 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
             println!("basis,mass,n,functions,error,order,error_dx,order_dx,seconds");
             let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
             for r in &rows {
-                println!(
-                    "{},{},{},{},{},{},{},{},{}",
-                    r.basis,
-                    r.mass,
+                let record = [
+                    r.basis.to_string(),
+                    r.mass.to_string(),
                     r.n.map_or_else(String::new, |n| n.to_string()),
-                    r.functions,
-                    r.error,
+                    r.functions.to_string(),
+                    r.error.to_string(),
                     opt(r.order),
-                    r.error_dx,
+                    r.error_dx.to_string(),
                     opt(r.order_dx),
-                    r.seconds
-                );
+                    r.seconds.to_string(),
+                ];
+                println!("{}", crate::out::csv_record(&record));
             }
         }
         Format::Table => {

@@ -1,5 +1,12 @@
 //! `mpm-cli reproduce`: the seeds' benchmarks B2–B5 as studies, printed as the
-//! markdown tables of `docs/results.md`, with their SVG figures.
+//! markdown tables of `docs/results.md`, with their SVG figures written into
+//! `--out DIR` (no figures without it: `--out docs/figures` regenerates those of the
+//! write-up).
+//!
+//! `--format json` prints one object per study whose table cells are JSON values:
+//! the unrounded number behind a number cell, `null` for `-`, booleans, integers,
+//! and text otherwise. `--format csv` prints one block per table (a `# study: title`
+//! line, the header, the rows as shown), quoted as RFC 4180 needs.
 //!
 //! The UL-FEM reference runs of `b3` and `b5b` are cached in [`cache_dir`], chosen
 //! here from the environment; the library takes the directory as an argument.
@@ -9,6 +16,7 @@ use crate::Format;
 use psmpm::output::chart::line_plot;
 use psmpm::simulation::RunError;
 use psmpm::studies::reproduction::{reproduce, Effort, STUDIES};
+use std::io::Write;
 use std::path::PathBuf;
 
 /// The cache directory of the UL-FEM reference runs
@@ -33,9 +41,10 @@ pub struct ReproduceArgs {
     /// studies (minutes).
     #[arg(long)]
     quick: bool,
-    /// Directory for the SVG figures.
-    #[arg(long, default_value = "docs/figures")]
-    out: PathBuf,
+    /// Write the SVG figures into DIR (created if needed; none are written without
+    /// it). `--out docs/figures` regenerates the figures of docs/results.md.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
     /// Output format: table (markdown, as in docs/results.md), json (one object per
     /// study with its tables) or csv (one block per table).
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -57,8 +66,10 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
             )));
         }
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError::Input(format!("{}: cannot create: {e}", args.out.display())))?;
+    if let Some(out) = &args.out {
+        std::fs::create_dir_all(out)
+            .map_err(|e| CliError::Input(format!("{}: cannot create: {e}", out.display())))?;
+    }
     let effort = if args.quick {
         Effort::Quick
     } else {
@@ -70,8 +81,13 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
         let report = reproduce(name, effort, cache.as_deref())
             .map_err(|e: RunError| CliError::Input(e.to_string()))?;
         let mut files = Vec::new();
-        for figure in &report.figures {
-            let path = args.out.join(&figure.file);
+        for figure in args.out.iter().flat_map(|out| {
+            report
+                .figures
+                .iter()
+                .map(move |figure| (out.join(&figure.file), figure))
+        }) {
+            let (path, figure) = figure;
             line_plot(&path, &figure.plot)
                 .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
             files.push(path.display().to_string());
@@ -85,7 +101,7 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
                         serde_json::json!({
                             "title": t.title,
                             "columns": t.columns,
-                            "rows": t.rows,
+                            "rows": t.rows.iter().map(|row| row.iter().map(|c| c.json()).collect::<Vec<_>>()).collect::<Vec<_>>(),
                         })
                     })
                     .collect();
@@ -101,16 +117,24 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
                 continue;
             }
             Format::Csv => {
+                let stdout = std::io::stdout();
+                let mut lock = stdout.lock();
                 for table in &report.tables {
-                    println!("# {}: {}", report.benchmark, table.title);
-                    println!("{}", table.columns.join(","));
-                    for row in &table.rows {
-                        let cells: Vec<String> = row
+                    writeln!(lock, "# {}: {}", report.benchmark, table.title)
+                        .map_err(|e| CliError::Input(format!("stdout: {e}")))?;
+                    let mut w = csv::Writer::from_writer(&mut lock);
+                    let rows = std::iter::once(table.columns.clone()).chain(
+                        table
+                            .rows
                             .iter()
-                            .map(|c| format!("\"{}\"", c.replace('"', "\"\"")))
-                            .collect();
-                        println!("{}", cells.join(","));
+                            .map(|row| row.iter().map(|c| c.text.as_str()).collect()),
+                    );
+                    for row in rows {
+                        w.write_record(&row)
+                            .map_err(|e| CliError::Input(format!("stdout: {e}")))?;
                     }
+                    w.flush()
+                        .map_err(|e| CliError::Input(format!("stdout: {e}")))?;
                 }
                 continue;
             }

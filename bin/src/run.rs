@@ -8,6 +8,7 @@ use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::driver::StepReport;
 use psmpm::mass::MassKind;
+use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
 use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
@@ -124,6 +125,24 @@ pub struct RunArgs {
     /// first and last state only, which are always written).
     #[arg(long, value_name = "N", requires = "out")]
     out_every: Option<usize>,
+    /// With --out: replace the files of an earlier run in DIR (frames, particles.pvd,
+    /// summary.json, the CSV and SVG files a run writes). Without it a DIR that is not
+    /// empty is refused; a DIR holding other files is refused even with it.
+    #[arg(long, requires = "out")]
+    overwrite: bool,
+    /// With --out: encoding of the .vtu files: binary (zlib-compressed, the default)
+    /// or ascii (text).
+    #[arg(long, value_enum, value_name = "ENCODING", default_value_t = Vtu::Binary, requires = "out")]
+    vtu: Vtu,
+}
+
+/// `--vtu`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Vtu {
+    /// Raw binary, zlib-compressed (small, fast to read).
+    Binary,
+    /// Text, one value per point and component.
+    Ascii,
 }
 
 /// Parses `AxB`.
@@ -222,7 +241,7 @@ const COLUMNS: [&str; 10] = [
 ];
 
 fn row_csv(r: &StepReport) -> String {
-    [
+    out::csv_record(&[
         r.step.to_string(),
         r.time.to_string(),
         r.kinetic.to_string(),
@@ -233,8 +252,7 @@ fn row_csv(r: &StepReport) -> String {
         r.mass_report.active.to_string(),
         r.mass_report.lumped_rows.to_string(),
         r.condition.map_or_else(String::new, |c| c.to_string()),
-    ]
-    .join(",")
+    ])
 }
 
 fn row_cells(r: &StepReport) -> Vec<String> {
@@ -264,7 +282,17 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             (s.steps() / 20).max(1)
         });
     let mut recorder = match &args.out {
-        Some(dir) => Some(Recorder::create(dir, args.out_every, &s)?),
+        Some(dir) => {
+            let options = out::OutOptions {
+                every: args.out_every,
+                overwrite: args.overwrite,
+                encoding: match args.vtu {
+                    Vtu::Binary => VtuEncoding::Binary,
+                    Vtu::Ascii => VtuEncoding::Ascii,
+                },
+            };
+            Some(Recorder::create(dir, options, &s)?)
+        }
         None => None,
     };
     let progress = Progress::new(s.steps() as u64, "steps");
@@ -288,7 +316,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
                 Format::Json => println!("{}", row_json(r)),
                 Format::Csv => {
                     if std::mem::take(&mut csv_header) {
-                        println!("{}", COLUMNS.join(","));
+                        println!("{}", out::csv_record(&COLUMNS));
                     }
                     println!("{}", row_csv(r));
                 }
@@ -315,7 +343,8 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     });
     match format {
         Format::Json => println!("{}", summary_json(&summary)),
-        Format::Csv => {}
+        // stdout stays CSV: the summary goes to stderr as `# key=value` lines.
+        Format::Csv => eprint!("{}", summary_comments(&summary)),
         Format::Table => {
             if every > 0 {
                 print!("{}", table.render());
@@ -356,6 +385,23 @@ impl Last {
 /// The summary as one JSON object.
 pub fn summary_json(summary: &Summary) -> serde_json::Value {
     serde_json::to_value(summary).unwrap_or_else(|e| json!({ "error": e.to_string() }))
+}
+
+/// The summary as `# key=value` lines, one per key of [`summary_json`] in its order
+/// (strings bare, `null` as an empty value, numbers as JSON writes them).
+pub fn summary_comments(summary: &Summary) -> String {
+    let mut out = String::new();
+    if let serde_json::Value::Object(map) = summary_json(summary) {
+        for (key, value) in map {
+            let value = match value {
+                serde_json::Value::String(s) => s,
+                serde_json::Value::Null => String::new(),
+                other => other.to_string(),
+            };
+            out += &format!("# {key}={value}\n");
+        }
+    }
+    out
 }
 
 /// The summary for reading at a glance.

@@ -55,14 +55,14 @@ pub fn list(args: ScenesArgs) -> Result<(), CliError> {
         Format::Csv => {
             println!("name,dim,basis,error,description");
             for (s, line) in &rows {
-                println!(
-                    "{},{},{},{},\"{}\"",
-                    s.name,
-                    s.dim,
-                    s.basis.name(),
-                    reference(s),
-                    line.replace('"', "\"\"")
-                );
+                let record = [
+                    s.name.to_string(),
+                    s.dim.to_string(),
+                    s.basis.name().to_string(),
+                    reference(s).to_string(),
+                    line.to_string(),
+                ];
+                println!("{}", crate::out::csv_record(&record));
             }
         }
         Format::Table => {

@@ -479,28 +479,28 @@ pub fn print(cells: &[Cell], format: Format, jobs: usize) {
             );
             let o = |x: Option<f64>| x.map_or_else(String::new, |v| v.to_string());
             for c in cells {
-                let reason = c.reason.as_deref().unwrap_or("").replace('"', "'");
-                println!(
-                    "{},{},{},{},\"{reason}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                    c.case,
-                    c.mass,
-                    c.stable,
-                    c.completed,
-                    c.measure,
+                let record = [
+                    c.case.clone(),
+                    c.mass.clone(),
+                    c.stable.to_string(),
+                    c.completed.to_string(),
+                    c.reason.clone().unwrap_or_default(),
+                    c.measure.to_string(),
                     o(c.error),
                     o(c.roughness),
                     o(c.max_condition),
-                    c.lumped_rows,
-                    c.deactivated,
-                    c.functions,
-                    c.particles,
-                    c.steps,
-                    c.dt,
-                    c.t_end,
-                    c.energy_growth,
-                    c.us_per_step,
-                    c.seconds
-                );
+                    c.lumped_rows.to_string(),
+                    c.deactivated.to_string(),
+                    c.functions.to_string(),
+                    c.particles.to_string(),
+                    c.steps.to_string(),
+                    c.dt.to_string(),
+                    c.t_end.to_string(),
+                    c.energy_growth.to_string(),
+                    c.us_per_step.to_string(),
+                    c.seconds.to_string(),
+                ];
+                println!("{}", crate::out::csv_record(&record));
             }
         }
         Format::Table => {

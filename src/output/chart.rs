@@ -487,9 +487,39 @@ pub(crate) fn line_swatch(area: &Area, x: i32, y: i32, style: ShapeStyle) -> Res
 
 /// Renders a line plot to an SVG string.
 fn render_line_plot(plot: &LinePlot) -> Result<String, PlotError> {
-    let (width, height) = plot.size;
+    render_stacked(std::slice::from_ref(plot))
+}
+
+/// Renders plots one below the other (each at its own size) to an SVG string.
+fn render_stacked(plots: &[LinePlot]) -> Result<String, PlotError> {
+    if plots.is_empty() {
+        return Err(PlotError::Empty("no panel to draw".into()));
+    }
+    for plot in plots {
+        check_size(plot.size.0, plot.size.1)?;
+        check_series(plot)?;
+    }
+    let width = plots.iter().map(|p| p.size.0).max().unwrap_or(0);
+    let height: u32 = plots.iter().map(|p| p.size.1).sum();
     check_size(width, height)?;
-    check_series(plot)?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        let mut rest = root.clone();
+        for plot in plots {
+            let (panel, below) = rest.split_vertically(plot.size.1);
+            draw_line_plot(&panel, plot)?;
+            rest = below;
+        }
+        root.present().map_err(draw_err)?;
+    }
+    Ok(svg)
+}
+
+/// Draws `plot` (checked) into `root`, which is `plot.size.1` pixels high.
+fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), PlotError> {
+    let width = root.dim_in_pixel().0;
     let x = axis_range(plot, 0)?;
     let y = axis_range(plot, 1)?;
     let legend_width = plot
@@ -500,10 +530,7 @@ fn render_line_plot(plot: &LinePlot) -> Result<String, PlotError> {
         .unwrap_or(0)
         .max(120)
         .min(width / 2);
-    let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(draw_err)?;
         let (main, legend) = root.split_horizontally(width - legend_width);
         let mut chart = ChartBuilder::on(&main)
             .caption(&plot.title, ("sans-serif", TITLE_FONT))
@@ -563,9 +590,8 @@ fn render_line_plot(plot: &LinePlot) -> Result<String, PlotError> {
                 .draw(&Text::new(s.name.as_str(), (44, y), legend_text_style()))
                 .map_err(draw_err)?;
         }
-        root.present().map_err(draw_err)?;
     }
-    Ok(svg)
+    Ok(())
 }
 
 /// Draws `plot` into the SVG file `path` (see the [module docs](self)).
@@ -576,5 +602,14 @@ fn render_line_plot(plot: &LinePlot) -> Result<String, PlotError> {
 /// image size; the file cannot be written ([`PlotError::Io`]).
 pub fn line_plot(path: &Path, plot: &LinePlot) -> Result<(), PlotError> {
     let svg = render_line_plot(plot)?;
+    write_svg(path, &svg)
+}
+
+/// Draws `plots` one below the other into the SVG file `path`: panels sharing one
+/// picture (e.g. displacement and velocity against time), each at its own size
+/// and with its own axes and legend. Errors as [`line_plot`], for any panel
+/// ([`PlotError::Empty`] for no panel).
+pub fn stacked_line_plots(path: &Path, plots: &[LinePlot]) -> Result<(), PlotError> {
+    let svg = render_stacked(plots)?;
     write_svg(path, &svg)
 }

@@ -1,46 +1,44 @@
-//! CSV time series: a header row of column names (quoted as in RFC 4180 when they
-//! contain `,`, `"` or line breaks) and rows of numbers separated by `,`, with `\n`
-//! line endings. Numbers are written as the [module `output`](super#format) says.
+//! CSV time series, written with the `csv` crate: a header row of column names
+//! (quoted as in RFC 4180 when they contain `,`, `"` or line breaks) and rows of
+//! numbers separated by `,`, with `\n` line endings. Numbers are written as the [module `output`](super#format) says.
 //!
 //! [`CsvWriter`] streams rows to any [`Write`]; [`write_csv_columns`] writes named
 //! columns at once (and [`OutputDir::write_csv`](super::dir::OutputDir::write_csv)
 //! writes them to a file of an output directory).
 
-use super::{invalid, write_f64};
+use super::invalid;
+use std::fmt::Write as _;
 use std::io::{self, Write};
 
-/// Writes a CSV field, quoted when it contains `,`, `"` or a line break.
-fn write_csv_field<W: Write>(w: &mut W, s: &str) -> io::Result<()> {
-    if s.contains([',', '"', '\n', '\r']) {
-        w.write_all(b"\"")?;
-        w.write_all(s.replace('"', "\"\"").as_bytes())?;
-        w.write_all(b"\"")
-    } else {
-        w.write_all(s.as_bytes())
+/// A CSV error as an io error (the writer's own errors are io errors).
+fn io_error(e: ::csv::Error) -> io::Error {
+    match e.into_kind() {
+        ::csv::ErrorKind::Io(e) => e,
+        other => io::Error::other(format!("{other:?}")),
     }
 }
 
-/// A CSV time-series writer: the header row on creation, then one row of `f64` per
-/// call to [`CsvWriter::row`], written straight through (no allocation per row).
+/// A CSV time-series writer (the `csv` crate's, quoting as RFC 4180 needs): the
+/// header row on creation, then one row of `f64` per call to [`CsvWriter::row`],
+/// written straight through (no allocation per row once the first is written).
 #[derive(Debug)]
 pub struct CsvWriter<W: Write> {
-    w: W,
+    w: ::csv::Writer<W>,
     columns: usize,
+    /// One formatted value (reused).
+    field: String,
 }
 
 impl<W: Write> CsvWriter<W> {
     /// Writes the header row `columns` to `w` and returns the writer.
-    pub fn new<S: AsRef<str>>(mut w: W, columns: &[S]) -> io::Result<Self> {
-        for (k, name) in columns.iter().enumerate() {
-            if k > 0 {
-                w.write_all(b",")?;
-            }
-            write_csv_field(&mut w, name.as_ref())?;
-        }
-        w.write_all(b"\n")?;
+    pub fn new<S: AsRef<str>>(w: W, columns: &[S]) -> io::Result<Self> {
+        let mut w = ::csv::Writer::from_writer(w);
+        w.write_record(columns.iter().map(|c| c.as_ref()))
+            .map_err(io_error)?;
         Ok(CsvWriter {
             w,
             columns: columns.len(),
+            field: String::new(),
         })
     }
 
@@ -53,13 +51,12 @@ impl<W: Write> CsvWriter<W> {
                 self.columns
             )));
         }
-        for (k, &x) in values.iter().enumerate() {
-            if k > 0 {
-                self.w.write_all(b",")?;
-            }
-            write_f64(&mut self.w, x)?;
+        for &x in values {
+            self.field.clear();
+            write!(self.field, "{x:e}").expect("formatting into a String");
+            self.w.write_field(&self.field).map_err(io_error)?;
         }
-        self.w.write_all(b"\n")
+        self.w.write_record(None::<&[u8]>).map_err(io_error)
     }
 
     /// Number of columns.
@@ -68,9 +65,13 @@ impl<W: Write> CsvWriter<W> {
     }
 
     /// Flushes and returns the underlying writer.
-    pub fn finish(mut self) -> io::Result<W> {
-        self.w.flush()?;
-        Ok(self.w)
+    pub fn finish(self) -> io::Result<W> {
+        let mut w = self.w.into_inner().map_err(|e| {
+            let kind = e.error().kind();
+            io::Error::new(kind, e.error().to_string())
+        })?;
+        w.flush()?;
+        Ok(w)
     }
 }
 

@@ -4,10 +4,17 @@
 //! directory, writes `mesh.vtu` once, `particles_NNNNN.vtu` every `every` steps
 //! (`NNNNN` is the frame number, 0, 1, 2, …) and `particles.pvd` at the end, so that
 //! opening `particles.pvd` in ParaView plays the simulation back with the right
-//! times. The files are written by the writers of [`vtk`](super::vtk) and [`csv`](super::csv).
+//! times. The files are written by the writers of [`vtk`](super::vtk) and [`csv`](super::csv),
+//! the `.vtu` files in the directory's [`VtuEncoding`] (binary unless
+//! [`OutputDir::with_encoding`] says otherwise).
+//!
+//! [`prepare_dir`] applies the rules of a directory that is written again: an
+//! existing directory must be empty, or hold only files of an earlier run (which
+//! it then removes, when allowed to overwrite); files the caller did not write are
+//! never removed nor mixed with a new run.
 
 use super::csv::write_csv_columns;
-use super::vtk::{write_mesh_vtu, write_particles_vtu, write_pvd};
+use super::vtk::{write_mesh_vtu, write_particles_vtu, write_pvd, VtuEncoding};
 use crate::particles::Particles;
 use crate::sparse::Scalar;
 use psmpm_basis::TriMesh;
@@ -26,6 +33,40 @@ pub enum OutputError {
         /// What the operating system said.
         source: io::Error,
     },
+    /// The directory holds files of an earlier run and overwriting was not asked for.
+    #[error(
+        "output directory `{}` is not empty: it holds {} of an earlier run ({})",
+        path.display(), count(*files), listing(names)
+    )]
+    NotEmpty {
+        /// The directory.
+        path: PathBuf,
+        /// How many files it holds.
+        files: usize,
+        /// The first few of them, sorted.
+        names: Vec<String>,
+    },
+    /// The directory holds entries that are not output files (never removed).
+    #[error(
+        "output directory `{}` holds {} that this tool does not write ({}); they are never removed or mixed with a run's files",
+        path.display(), count(*files), listing(names)
+    )]
+    Foreign {
+        /// The directory.
+        path: PathBuf,
+        /// How many such entries it holds.
+        files: usize,
+        /// The first few of them, sorted.
+        names: Vec<String>,
+    },
+    /// An entry of the directory could not be listed or removed.
+    #[error("cannot clear output directory `{}`: {source}", path.display())]
+    Clear {
+        /// The directory or file.
+        path: PathBuf,
+        /// What the operating system said.
+        source: io::Error,
+    },
     /// A file could not be created or written.
     #[error("cannot write `{}`: {source}", path.display())]
     Write {
@@ -34,6 +75,87 @@ pub enum OutputError {
         /// What the operating system (or the writer, for inconsistent data) said.
         source: io::Error,
     },
+}
+
+/// How many names [`OutputError::NotEmpty`] and [`OutputError::Foreign`] list.
+const LISTED: usize = 5;
+
+fn count(n: usize) -> String {
+    if n == 1 {
+        "1 file".to_string()
+    } else {
+        format!("{n} files")
+    }
+}
+
+fn listing(names: &[String]) -> String {
+    names.join(", ")
+}
+
+/// Makes `path` ready for a new run: creates it if needed; an empty directory is
+/// used as it is. A directory holding only files `owned` recognises (the files of an
+/// earlier run) is an [`OutputError::NotEmpty`] unless `overwrite`, when those files
+/// are removed first (so no stale frame of a longer earlier run is left). A
+/// directory holding anything else (a file `owned` does not recognise, a
+/// sub-directory) is an [`OutputError::Foreign`], with or without `overwrite`:
+/// nothing is removed then. Returns the names of the files removed, sorted.
+pub fn prepare_dir(
+    path: &Path,
+    overwrite: bool,
+    owned: impl Fn(&str) -> bool,
+) -> Result<Vec<String>, OutputError> {
+    let clear = |p: &Path| {
+        let p = p.to_path_buf();
+        move |source| OutputError::Clear { path: p, source }
+    };
+    if path.is_dir() {
+        let mut ours = Vec::new();
+        let mut foreign = Vec::new();
+        for entry in std::fs::read_dir(path).map_err(clear(path))? {
+            let entry = entry.map_err(clear(path))?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let is_file = entry.file_type().map_err(clear(path))?.is_file();
+            if is_file && owned(&name) {
+                ours.push(name);
+            } else {
+                foreign.push(name);
+            }
+        }
+        ours.sort();
+        foreign.sort();
+        let first = |names: &[String]| names.iter().take(LISTED).cloned().collect::<Vec<_>>();
+        if !foreign.is_empty() {
+            return Err(OutputError::Foreign {
+                path: path.to_path_buf(),
+                files: foreign.len(),
+                names: first(&foreign),
+            });
+        }
+        if !ours.is_empty() && !overwrite {
+            return Err(OutputError::NotEmpty {
+                path: path.to_path_buf(),
+                files: ours.len(),
+                names: first(&ours),
+            });
+        }
+        for name in &ours {
+            let file = path.join(name);
+            std::fs::remove_file(&file).map_err(clear(&file))?;
+        }
+        return Ok(ours);
+    }
+    std::fs::create_dir_all(path).map_err(|source| OutputError::CreateDir {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(Vec::new())
+}
+
+/// Whether `name` is a particle frame `particles_NNNNN.vtu` (any number of digits).
+pub fn is_frame(name: &str) -> bool {
+    name.strip_prefix("particles_")
+        .and_then(|rest| rest.strip_suffix(".vtu"))
+        .is_some_and(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()))
 }
 
 /// Creates (truncates) the file at `path`, hands a buffered writer to `write`, and
@@ -58,6 +180,7 @@ pub struct OutputDir {
     path: PathBuf,
     every: usize,
     frames: Vec<(f64, String)>,
+    encoding: VtuEncoding,
 }
 
 impl OutputDir {
@@ -78,7 +201,19 @@ impl OutputDir {
             path,
             every,
             frames: Vec::new(),
+            encoding: VtuEncoding::default(),
         })
+    }
+
+    /// The directory writing its `.vtu` files in `encoding`.
+    pub fn with_encoding(mut self, encoding: VtuEncoding) -> Self {
+        self.encoding = encoding;
+        self
+    }
+
+    /// The encoding of the `.vtu` files.
+    pub fn encoding(&self) -> VtuEncoding {
+        self.encoding
     }
 
     /// The directory.
@@ -108,7 +243,9 @@ impl OutputDir {
         point_field: Option<(&str, &[f64])>,
     ) -> Result<PathBuf, OutputError> {
         let path = self.file(Self::MESH_FILE);
-        write_file(&path, |w| write_mesh_vtu(w, mesh, point_field))?;
+        write_file(&path, |w| {
+            write_mesh_vtu(w, mesh, point_field, self.encoding)
+        })?;
         Ok(path)
     }
 
@@ -136,7 +273,7 @@ impl OutputDir {
     ) -> Result<PathBuf, OutputError> {
         let name = format!("particles_{:05}.vtu", self.frames.len());
         let path = self.file(&name);
-        write_file(&path, |w| write_particles_vtu(w, particles))?;
+        write_file(&path, |w| write_particles_vtu(w, particles, self.encoding))?;
         self.frames.push((time, name));
         Ok(path)
     }

@@ -8,8 +8,13 @@
 //!
 //! # Format
 //!
-//! - `.vtu` files are VTK XML `UnstructuredGrid`s in the `ascii` format, one point
-//!   or cell per line. Points are 3D: `z = 0`, and `y = 0` in 1D.
+//! - `.vtu` files are VTK XML `UnstructuredGrid`s, in one of two encodings
+//!   ([`VtuEncoding`]): `binary` (the default: the XML header, then the arrays as
+//!   raw little-endian bytes in one `<AppendedData encoding="raw">` block,
+//!   each array compressed with zlib in blocks of 1 MiB as VTK's
+//!   `vtkZLibDataCompressor` does, `header_type="UInt64"`, file version 1.0), or
+//!   `ascii` (one point or cell per line). Both hold the same arrays with the same
+//!   values, bit for bit. Points are 3D: `z = 0`, and `y = 0` in 1D.
 //! - Particle files hold one `VTK_VERTEX` cell per particle and the point data
 //!   `velocity` and `displacement` (3 components, padded with zeros), `stress`
 //!   (the Cauchy stress σ as a full 3 × 3 tensor of 9 components in row-major order
@@ -50,91 +55,233 @@ fn write_xml_escaped<W: Write>(w: &mut W, s: &str) -> io::Result<()> {
     w.write_all(rest.as_bytes())
 }
 
-const VTU_HEADER: &str = concat!(
-    "<?xml version=\"1.0\"?>\n",
-    "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
-    "  <UnstructuredGrid>\n",
-);
-const VTU_FOOTER: &str = "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+/// How the arrays of a `.vtu` file are stored.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum VtuEncoding {
+    /// Raw little-endian binary in one `<AppendedData>` block after the XML, each
+    /// array compressed with zlib in blocks of [`BLOCK_SIZE`] bytes
+    /// (`compressor="vtkZLibDataCompressor"`, `header_type="UInt64"`): small and
+    /// fast to read (the default).
+    #[default]
+    Binary,
+    /// Text, one point or cell per line: readable and diffable, about 4–5 times
+    /// larger and much slower to read.
+    Ascii,
+}
 
-/// Opens a `<DataArray>` of `vtk_type` (with `Name` when given, and
-/// `NumberOfComponents` when `components > 1`), writes `n` lines of `per_line`
-/// values `value(i, k)`, and closes it.
-#[allow(clippy::too_many_arguments)]
-fn data_array<W: Write, V: std::fmt::Display>(
-    w: &mut W,
-    vtk_type: &str,
-    name: Option<&str>,
-    components: usize,
-    per_line: usize,
-    n: usize,
-    mut value: impl FnMut(usize, usize) -> V,
-) -> io::Result<()> {
-    write!(w, "        <DataArray type=\"{vtk_type}\"")?;
-    if let Some(name) = name {
-        w.write_all(b" Name=\"")?;
-        write_xml_escaped(w, name)?;
-        w.write_all(b"\"")?;
+/// Uncompressed size of the zlib blocks of a binary `.vtu`: 1 MiB (VTK writes 32 KiB
+/// blocks and reads any size; readers that join the blocks by copying, as meshio
+/// does, slow down with the square of the number of blocks of an array).
+pub const BLOCK_SIZE: usize = 1 << 20;
+
+/// zlib level of the binary `.vtu`: the fastest; the floats of a simulation barely
+/// compress at any level, the zero padding (`z`, the stress' third row and column)
+/// compresses at all of them.
+const LEVEL: u32 = 1;
+
+const VTU_FOOTER_ASCII: &str = "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+
+/// A value of a data array: its VTK type name, its text and its bytes.
+trait VtkValue: Copy {
+    const TYPE: &'static str;
+    fn write_text<W: Write>(self, w: &mut W) -> io::Result<()>;
+    fn push_bytes(self, out: &mut Vec<u8>);
+}
+
+impl VtkValue for f64 {
+    const TYPE: &'static str = "Float64";
+    fn write_text<W: Write>(self, w: &mut W) -> io::Result<()> {
+        write_f64(w, self)
     }
-    if components > 1 {
-        write!(w, " NumberOfComponents=\"{components}\"")?;
+    fn push_bytes(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
     }
-    w.write_all(b" format=\"ascii\">\n")?;
-    for i in 0..n {
-        w.write_all(b"          ")?;
-        for k in 0..per_line {
-            if k > 0 {
-                w.write_all(b" ")?;
+}
+
+impl VtkValue for usize {
+    const TYPE: &'static str = "Int64";
+    fn write_text<W: Write>(self, w: &mut W) -> io::Result<()> {
+        write!(w, "{self}")
+    }
+    fn push_bytes(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&(self as i64).to_le_bytes());
+    }
+}
+
+impl VtkValue for u8 {
+    const TYPE: &'static str = "UInt8";
+    fn write_text<W: Write>(self, w: &mut W) -> io::Result<()> {
+        write!(w, "{self}")
+    }
+    fn push_bytes(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+}
+
+/// Writes the XML of one `.vtu` file and, for [`VtuEncoding::Binary`], gathers the
+/// compressed arrays that [`Vtu::finish`] appends after it.
+struct Vtu<W: Write> {
+    w: W,
+    encoding: VtuEncoding,
+    /// The `<AppendedData>` bytes so far (binary).
+    appended: Vec<u8>,
+    /// One array's raw bytes (binary; reused).
+    raw: Vec<u8>,
+}
+
+impl<W: Write> Vtu<W> {
+    /// Writes the XML declaration and opens the `UnstructuredGrid`.
+    fn new(mut w: W, encoding: VtuEncoding) -> io::Result<Self> {
+        w.write_all(b"<?xml version=\"1.0\"?>\n")?;
+        match encoding {
+            VtuEncoding::Ascii => w.write_all(
+                b"<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
+            )?,
+            VtuEncoding::Binary => w.write_all(concat!(
+                "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\"",
+                " header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n"
+            ).as_bytes())?,
+        }
+        w.write_all(b"  <UnstructuredGrid>\n")?;
+        Ok(Vtu {
+            w,
+            encoding,
+            appended: Vec::new(),
+            raw: Vec::new(),
+        })
+    }
+
+    /// One `<DataArray>` (with `Name` when given, and `NumberOfComponents` when
+    /// `components > 1`) of `n` lines of `per_line` values `value(i, k)`: the values
+    /// inline (ascii) or its offset into the appended data (binary).
+    fn data_array<V: VtkValue>(
+        &mut self,
+        name: Option<&str>,
+        components: usize,
+        per_line: usize,
+        n: usize,
+        mut value: impl FnMut(usize, usize) -> V,
+    ) -> io::Result<()> {
+        let w = &mut self.w;
+        write!(w, "        <DataArray type=\"{}\"", V::TYPE)?;
+        if let Some(name) = name {
+            w.write_all(b" Name=\"")?;
+            write_xml_escaped(w, name)?;
+            w.write_all(b"\"")?;
+        }
+        if components > 1 {
+            write!(w, " NumberOfComponents=\"{components}\"")?;
+        }
+        match self.encoding {
+            VtuEncoding::Ascii => {
+                w.write_all(b" format=\"ascii\">\n")?;
+                for i in 0..n {
+                    w.write_all(b"          ")?;
+                    for k in 0..per_line {
+                        if k > 0 {
+                            w.write_all(b" ")?;
+                        }
+                        value(i, k).write_text(w)?;
+                    }
+                    w.write_all(b"\n")?;
+                }
+                w.write_all(b"        </DataArray>\n")
             }
-            write!(w, "{}", value(i, k))?;
-        }
-        w.write_all(b"\n")?;
-    }
-    w.write_all(b"        </DataArray>\n")
-}
-
-/// A `Float64` data array, each value in the round-trippable format.
-fn f64_array<W: Write>(
-    w: &mut W,
-    name: Option<&str>,
-    components: usize,
-    n: usize,
-    mut value: impl FnMut(usize, usize) -> f64,
-) -> io::Result<()> {
-    // `LowerExp` formatting through a wrapper keeps `data_array` generic.
-    struct Exp(f64);
-    impl std::fmt::Display for Exp {
-        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            write!(f, "{:e}", self.0)
+            VtuEncoding::Binary => {
+                writeln!(
+                    w,
+                    " format=\"appended\" offset=\"{}\"/>",
+                    self.appended.len()
+                )?;
+                self.raw.clear();
+                self.raw.reserve(n * per_line * std::mem::size_of::<V>());
+                for i in 0..n {
+                    for k in 0..per_line {
+                        value(i, k).push_bytes(&mut self.raw);
+                    }
+                }
+                append_compressed(&mut self.appended, &self.raw)
+            }
         }
     }
-    data_array(w, "Float64", name, components, components, n, |i, k| {
-        Exp(value(i, k))
-    })
+
+    /// A `Float64` data array.
+    fn f64_array(
+        &mut self,
+        name: Option<&str>,
+        components: usize,
+        n: usize,
+        value: impl FnMut(usize, usize) -> f64,
+    ) -> io::Result<()> {
+        self.data_array(name, components, components, n, value)
+    }
+
+    /// The `<Cells>` block: connectivity, offsets and types of `n` cells of
+    /// `per_cell` points each, the `j`-th point of cell `i` being `point(i, j)`.
+    fn cells_block(
+        &mut self,
+        n: usize,
+        per_cell: usize,
+        cell_type: u8,
+        point: impl FnMut(usize, usize) -> usize,
+    ) -> io::Result<()> {
+        self.w.write_all(b"      <Cells>\n")?;
+        self.data_array(Some("connectivity"), 1, per_cell, n, point)?;
+        self.data_array(Some("offsets"), 1, 1, n, |i, _| (i + 1) * per_cell)?;
+        self.data_array(Some("types"), 1, 1, n, |_, _| cell_type)?;
+        self.w.write_all(b"      </Cells>\n")
+    }
+
+    /// Closes the piece and the grid, appends the data (binary) and flushes.
+    fn finish(mut self) -> io::Result<()> {
+        match self.encoding {
+            VtuEncoding::Ascii => self.w.write_all(VTU_FOOTER_ASCII.as_bytes())?,
+            VtuEncoding::Binary => {
+                self.w.write_all(
+                    b"    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _",
+                )?;
+                self.w.write_all(&self.appended)?;
+                self.w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")?;
+            }
+        }
+        self.w.flush()
+    }
 }
 
-/// The `<Cells>` block: connectivity, offsets and types of `n` cells of
-/// `per_cell` points each, the `j`-th point of cell `i` being `point(i, j)`.
-fn cells_block<W: Write>(
-    w: &mut W,
-    n: usize,
-    per_cell: usize,
-    cell_type: u8,
-    point: impl FnMut(usize, usize) -> usize,
-) -> io::Result<()> {
-    w.write_all(b"      <Cells>\n")?;
-    data_array(w, "Int64", Some("connectivity"), 1, per_cell, n, point)?;
-    data_array(w, "Int64", Some("offsets"), 1, 1, n, |i, _| {
-        (i + 1) * per_cell
-    })?;
-    data_array(w, "UInt8", Some("types"), 1, 1, n, |_, _| cell_type)?;
-    w.write_all(b"      </Cells>\n")
+/// Appends `raw` compressed as VTK's zlib compressor does: the `UInt64` header
+/// `[blocks, BLOCK_SIZE, size of the last block if partial (else 0), compressed
+/// size of each block]`, then the zlib streams of the blocks.
+fn append_compressed(appended: &mut Vec<u8>, raw: &[u8]) -> io::Result<()> {
+    let blocks: Vec<Vec<u8>> = raw
+        .chunks(BLOCK_SIZE)
+        .map(|chunk| {
+            let mut z = flate2::write::ZlibEncoder::new(
+                Vec::with_capacity(chunk.len() / 2),
+                flate2::Compression::new(LEVEL),
+            );
+            z.write_all(chunk)?;
+            z.finish()
+        })
+        .collect::<io::Result<_>>()?;
+    let mut header = vec![
+        blocks.len() as u64,
+        BLOCK_SIZE as u64,
+        (raw.len() % BLOCK_SIZE) as u64,
+    ];
+    header.extend(blocks.iter().map(|b| b.len() as u64));
+    for h in header {
+        appended.extend_from_slice(&h.to_le_bytes());
+    }
+    for b in &blocks {
+        appended.extend_from_slice(b);
+    }
+    Ok(())
 }
 
 // ---------------------------------------------------------------------------
 // Particles and mesh.
 
-/// Writes `particles` as a VTK XML unstructured grid (ascii): 3D points (`z = 0`,
+/// Writes `particles` as a VTK XML unstructured grid (in `encoding`): 3D points (`z = 0`,
 /// `y = 0` in 1D), one `VTK_VERTEX` per particle, and the point data `velocity`,
 /// `displacement` (3 components), `stress` (9-component Cauchy tensor, row-major,
 /// zero-padded), `volume` and `mass`. See the [module documentation](self).
@@ -142,8 +289,9 @@ fn cells_block<W: Write>(
 /// Errors: io errors of `w`, and `InvalidInput` when the particle arrays have
 /// different lengths. `w` is flushed at the end.
 pub fn write_particles_vtu<W: Write, T: Scalar, const D: usize>(
-    mut w: W,
+    w: W,
     particles: &Particles<T, D>,
+    encoding: VtuEncoding,
 ) -> io::Result<()> {
     let n = particles.len();
     let lengths = [
@@ -169,36 +317,27 @@ pub fn write_particles_vtu<W: Write, T: Scalar, const D: usize>(
         }
     };
 
-    w.write_all(VTU_HEADER.as_bytes())?;
+    let mut vtu = Vtu::new(w, encoding)?;
     writeln!(
-        w,
+        vtu.w,
         "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">"
     )?;
-    w.write_all(b"      <PointData Scalars=\"volume\" Vectors=\"velocity\" Tensors=\"stress\">\n")?;
-    f64_array(&mut w, Some("velocity"), 3, n, |i, k| {
-        vec3(&particles.v[i], k)
-    })?;
-    f64_array(&mut w, Some("displacement"), 3, n, |i, k| {
-        vec3(&particles.u[i], k)
-    })?;
-    f64_array(&mut w, Some("stress"), 9, n, |i, k| {
-        tensor(&particles.sigma[i], k)
-    })?;
-    f64_array(&mut w, Some("volume"), 1, n, |i, _| {
-        particles.volume[i].to_f64()
-    })?;
-    f64_array(&mut w, Some("mass"), 1, n, |i, _| {
-        particles.mass[i].to_f64()
-    })?;
-    w.write_all(b"      </PointData>\n      <Points>\n")?;
-    f64_array(&mut w, None, 3, n, |i, k| vec3(&particles.x[i], k))?;
-    w.write_all(b"      </Points>\n")?;
-    cells_block(&mut w, n, 1, VTK_VERTEX, |i, _| i)?;
-    w.write_all(VTU_FOOTER.as_bytes())?;
-    w.flush()
+    vtu.w.write_all(
+        b"      <PointData Scalars=\"volume\" Vectors=\"velocity\" Tensors=\"stress\">\n",
+    )?;
+    vtu.f64_array(Some("velocity"), 3, n, |i, k| vec3(&particles.v[i], k))?;
+    vtu.f64_array(Some("displacement"), 3, n, |i, k| vec3(&particles.u[i], k))?;
+    vtu.f64_array(Some("stress"), 9, n, |i, k| tensor(&particles.sigma[i], k))?;
+    vtu.f64_array(Some("volume"), 1, n, |i, _| particles.volume[i].to_f64())?;
+    vtu.f64_array(Some("mass"), 1, n, |i, _| particles.mass[i].to_f64())?;
+    vtu.w.write_all(b"      </PointData>\n      <Points>\n")?;
+    vtu.f64_array(None, 3, n, |i, k| vec3(&particles.x[i], k))?;
+    vtu.w.write_all(b"      </Points>\n")?;
+    vtu.cells_block(n, 1, VTK_VERTEX, |i, _| i)?;
+    vtu.finish()
 }
 
-/// Writes the triangular `mesh` as a VTK XML unstructured grid (ascii): its vertices
+/// Writes the triangular `mesh` as a VTK XML unstructured grid (in `encoding`): its vertices
 /// (`z = 0`), one `VTK_TRIANGLE` per triangle, the cell data `element` (the triangle
 /// index, `Int64`) and, when `point_field` is `Some((name, values))`, the point-data
 /// scalar `name` with one value per vertex.
@@ -206,9 +345,10 @@ pub fn write_particles_vtu<W: Write, T: Scalar, const D: usize>(
 /// Errors: io errors of `w`, and `InvalidInput` when `values` does not have one
 /// entry per vertex. `w` is flushed at the end.
 pub fn write_mesh_vtu<W: Write>(
-    mut w: W,
+    w: W,
     mesh: &TriMesh,
     point_field: Option<(&str, &[f64])>,
+    encoding: VtuEncoding,
 ) -> io::Result<()> {
     let (nv, nt) = (mesh.num_vertices(), mesh.num_triangles());
     if let Some((name, values)) = point_field {
@@ -222,33 +362,34 @@ pub fn write_mesh_vtu<W: Write>(
     let vertices = mesh.vertices();
     let triangles = mesh.triangles();
 
-    w.write_all(VTU_HEADER.as_bytes())?;
+    let mut vtu = Vtu::new(w, encoding)?;
     writeln!(
-        w,
+        vtu.w,
         "    <Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{nt}\">"
     )?;
     match point_field {
         Some((name, values)) => {
-            w.write_all(b"      <PointData Scalars=\"")?;
-            write_xml_escaped(&mut w, name)?;
-            w.write_all(b"\">\n")?;
-            f64_array(&mut w, Some(name), 1, nv, |i, _| values[i])?;
-            w.write_all(b"      </PointData>\n")?;
+            vtu.w.write_all(b"      <PointData Scalars=\"")?;
+            write_xml_escaped(&mut vtu.w, name)?;
+            vtu.w.write_all(b"\">\n")?;
+            vtu.f64_array(Some(name), 1, nv, |i, _| values[i])?;
+            vtu.w.write_all(b"      </PointData>\n")?;
         }
-        None => w.write_all(b"      <PointData>\n      </PointData>\n")?,
+        None => vtu
+            .w
+            .write_all(b"      <PointData>\n      </PointData>\n")?,
     }
-    w.write_all(b"      <CellData Scalars=\"element\">\n")?;
-    data_array(&mut w, "Int64", Some("element"), 1, 1, nt, |t, _| t)?;
-    w.write_all(b"      </CellData>\n      <Points>\n")?;
-    f64_array(&mut w, None, 3, nv, |i, k| match k {
+    vtu.w.write_all(b"      <CellData Scalars=\"element\">\n")?;
+    vtu.data_array(Some("element"), 1, 1, nt, |t, _| t)?;
+    vtu.w.write_all(b"      </CellData>\n      <Points>\n")?;
+    vtu.f64_array(None, 3, nv, |i, k| match k {
         0 => vertices[i].x,
         1 => vertices[i].y,
         _ => 0.0,
     })?;
-    w.write_all(b"      </Points>\n")?;
-    cells_block(&mut w, nt, 3, VTK_TRIANGLE, |t, j| triangles[t][j])?;
-    w.write_all(VTU_FOOTER.as_bytes())?;
-    w.flush()
+    vtu.w.write_all(b"      </Points>\n")?;
+    vtu.cells_block(nt, 3, VTK_TRIANGLE, |t, j| triangles[t][j])?;
+    vtu.finish()
 }
 
 // ---------------------------------------------------------------------------
@@ -287,17 +428,18 @@ mod tests {
     fn f32_particles_are_widened_and_bad_input_is_an_error() {
         let p = Particles::<f32, 1>::new(vec![Vector1::new(0.1f32)], vec![0.5], 2.0);
         let mut bytes = Vec::new();
-        write_particles_vtu(&mut bytes, &p).unwrap();
+        write_particles_vtu(&mut bytes, &p, VtuEncoding::Ascii).unwrap();
         let text = String::from_utf8(bytes).unwrap();
         assert!(text.contains(&format!("          {:e} 0e0 0e0\n", 0.1f32 as f64)));
 
         let mut broken = particles_2d();
         broken.mass.pop();
-        let err = write_particles_vtu(Vec::new(), &broken).unwrap_err();
+        let err = write_particles_vtu(Vec::new(), &broken, VtuEncoding::Binary).unwrap_err();
         assert!(err.to_string().contains("`mass`"), "{err}");
 
         let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 1.0, 0.0, 1.0, 1, 1).unwrap();
-        let err = write_mesh_vtu(Vec::new(), &mesh, Some(("f", &[1.0]))).unwrap_err();
+        let err =
+            write_mesh_vtu(Vec::new(), &mesh, Some(("f", &[1.0])), VtuEncoding::Ascii).unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
     }
 

@@ -383,3 +383,76 @@ fn reproduce_caches_the_reference_where_the_environment_says() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `reproduce` writes figures only where `--out` says (nothing in the working
+/// directory without it); its JSON cells are numbers, its CSV parses as CSV.
+#[test]
+fn reproduce_writes_figures_only_into_out_with_numbers_in_json_and_quoted_csv() {
+    let dir = temp_dir("reproduce-out");
+    let cwd = dir.join("cwd");
+    std::fs::create_dir_all(&cwd).unwrap();
+    let run = |args: &[&str]| {
+        let out = cli()
+            .current_dir(&cwd)
+            .env("PSMPM_CACHE_DIR", dir.join("cache"))
+            .args(["reproduce", "b3", "--quick"])
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let json: Value = serde_json::from_str(&run(&["--format", "json"])).unwrap();
+    assert_eq!(
+        std::fs::read_dir(&cwd).unwrap().count(),
+        0,
+        "files in the cwd"
+    );
+    assert_eq!(json["figures"], serde_json::json!([]));
+    let table = &json["tables"][0];
+    let row = table["rows"][0].as_array().unwrap();
+    assert_eq!(row.len(), table["columns"].as_array().unwrap().len());
+    assert_eq!(row[0], "ps");
+    assert!(row[1].is_u64() && row[2].is_u64(), "{row:?}");
+    // E_u: the unrounded number, not a string such as "6.63e-2".
+    let e = row[3].as_f64().unwrap_or_else(|| panic!("{row:?}"));
+    assert_ne!(format!("{e:.2e}").parse::<f64>().unwrap(), e);
+    assert!(row[7].is_boolean(), "{row:?}");
+    for row in table["rows"].as_array().unwrap() {
+        for cell in row.as_array().unwrap() {
+            if let Some(s) = cell.as_str() {
+                assert!(s.parse::<f64>().is_err(), "a number as a string: {s}");
+            }
+        }
+    }
+
+    let figures = dir.join("figures");
+    let csv_text = run(&["--format", "csv", "--out", figures.to_str().unwrap()]);
+    assert_eq!(
+        std::fs::read_dir(&cwd).unwrap().count(),
+        0,
+        "files in the cwd"
+    );
+    let svgs = std::fs::read_dir(&figures).unwrap().count();
+    assert!(svgs > 0);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .from_reader(csv_text.as_bytes());
+    let records: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    let columns: Vec<&str> = table["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    assert_eq!(records[0].iter().collect::<Vec<_>>(), columns);
+    assert_eq!(records.len(), 1 + table["rows"].as_array().unwrap().len());
+    assert!(records.iter().all(|r| r.len() == columns.len()));
+    let _ = std::fs::remove_dir_all(&dir);
+}

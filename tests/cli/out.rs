@@ -426,6 +426,14 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
     );
     let texts = json["svg"][key(&files[5])]["texts"].to_string();
     assert!(texts.contains("time (s)") && texts.contains("displacement (m)"));
+    // The second panel: the velocity, computed, as markers (the scene has a reference).
+    assert!(texts.contains("velocity (m/s)"), "{texts}");
+    for p in [p0, p1] {
+        assert!(
+            texts.contains(&format!("particle {p} v_x (MPM)")),
+            "{texts}"
+        );
+    }
 }
 
 #[test]
@@ -578,4 +586,153 @@ fn a_long_run_with_a_captured_stderr_shows_no_progress_bar() {
         assert!(!stdout.contains(mark), "{mark:?} in {stdout}");
     }
     assert!(stdout.contains("10000 steps"), "{stdout}");
+}
+
+/// `run vibrating-bar-1d` for `t_end` into `dir` with extra arguments; the output.
+fn run_1d(t_end: &str, dir: &Path, extra: &[&str]) -> std::process::Output {
+    cli()
+        .args([
+            "run",
+            "vibrating-bar-1d",
+            "--t-end",
+            t_end,
+            "--diag-every",
+            "0",
+            "--out",
+            key(dir),
+        ])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn frames_in(dir: &Path) -> usize {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter(|e| {
+            let name = e.as_ref().unwrap().file_name();
+            let name = name.to_string_lossy();
+            name.starts_with("particles_") && name.ends_with(".vtu")
+        })
+        .count()
+}
+
+#[test]
+fn a_folder_is_reused_only_with_overwrite_and_never_over_other_files() {
+    let dir = TempDir::new("reuse");
+    // 100 steps, a frame each: 101 frames.
+    let out = run_1d("0.1", dir.path(), &["--out-every", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(frames_in(dir.path()), 101);
+
+    // Again: refused, naming the folder and the flag; nothing touched.
+    let out = run_1d("0.1", dir.path(), &["--out-every", "50"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(key(dir.path())), "{stderr}");
+    assert!(stderr.contains("--overwrite"), "{stderr}");
+    assert_eq!(frames_in(dir.path()), 101);
+
+    // With --overwrite: the earlier run's frames are gone, no stale frame is left.
+    let out = run_1d("0.1", dir.path(), &["--out-every", "50", "--overwrite"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(frames_in(dir.path()), 3);
+    let pvd = std::fs::read_to_string(dir.join("particles.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet ").count(), 3);
+
+    // A file the tool does not write: refused even with --overwrite, nothing removed.
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    let out = run_1d("0.1", dir.path(), &["--overwrite"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("notes.txt") && stderr.contains(key(dir.path())),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert_eq!(frames_in(dir.path()), 3);
+    assert!(dir.join("summary.json").is_file());
+}
+
+#[test]
+fn binary_and_ascii_runs_write_the_same_frames() {
+    let dir = TempDir::new("encodings");
+    let (binary, ascii) = (dir.join("binary"), dir.join("ascii"));
+    for (d, extra) in [(&binary, &[][..]), (&ascii, &["--vtu", "ascii"][..])] {
+        let out = run_1d("0.05", d, extra);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let frame = "particles_00050.vtu";
+    let (b, a) = (binary.join(frame), ascii.join(frame));
+    let bytes = std::fs::read(&b).unwrap();
+    assert!(String::from_utf8_lossy(&bytes[..300]).contains("compressor=\"vtkZLibDataCompressor\""));
+    assert!(std::fs::read_to_string(&a)
+        .unwrap()
+        .contains("format=\"ascii\""));
+    let json = read_back(&[b.clone(), a.clone()]);
+    let (vb, va) = (&json["vtu"][key(&b)], &json["vtu"][key(&a)]);
+    assert_eq!(array(&vb["points"]).0, [32, 3]);
+    assert_eq!(vb, va);
+    // --vtu needs --out.
+    input_error(&["run", "vibrating-bar-1d", "--vtu", "ascii"]);
+}
+
+#[test]
+fn csv_format_keeps_the_summary_on_stderr() {
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar-1d",
+            "--t-end",
+            "0.05",
+            "--diag-every",
+            "10",
+            "--format",
+            "csv",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(header[..3], ["step", "time", "kinetic"]);
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 5);
+    assert_eq!(&rows[4][0], "50");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    let comments: Vec<&str> = stderr.lines().collect();
+    assert!(
+        comments
+            .iter()
+            .all(|l| l.starts_with("# ") && l.contains('=')),
+        "{stderr}"
+    );
+    for line in [
+        "# scene=vibrating-bar-1d",
+        "# steps=50",
+        "# stable=true",
+        "# failure=",
+    ] {
+        assert!(comments.contains(&line), "{line} missing in {stderr}");
+    }
+    let error = comments
+        .iter()
+        .find_map(|l| l.strip_prefix("# error="))
+        .unwrap();
+    assert!(error.parse::<f64>().unwrap() > 0.0, "{error}");
 }

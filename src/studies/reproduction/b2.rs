@@ -1,6 +1,6 @@
 //! B2 (thesis §4.1): the vibrating bar, small deformation.
 
-use super::{builtin, log_log, opt, order, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, log_log, opt, order, row, sci, setup, Effort, Figure, Report, Table};
 use crate::bases::BasisKind;
 use crate::output::chart::Series;
 use crate::simulation::{self, RunError};
@@ -34,8 +34,8 @@ pub(super) fn b2(effort: Effort) -> Result<Report, RunError> {
             default.time.t_end = 0.02;
             let default_run = simulation::run(&default, &mut |_| {})?;
             let e = default_run.error.unwrap_or(f64::NAN);
-            table.rows.push(vec![
-                basis.name().into(),
+            table.rows.push(row![
+                basis.name(),
                 n_x.to_string(),
                 thesis_run.functions.to_string(),
                 sci(thesis),

@@ -1,7 +1,7 @@
 //! B3 (paper §4.1): the vibrating bar, large deformation, against the UL-FEM
 //! reference.
 
-use super::{builtin, opt, run_2d, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, opt, row, run_2d, sci, setup, Effort, Figure, Report, Table};
 use crate::bases::BasisKind;
 use crate::output::chart::{LinePlot, Series};
 use crate::scene::Reference;
@@ -112,8 +112,8 @@ pub(super) fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErro
         };
         let (kinetic_off, total_off) = (first_off(0), first_off(1));
         let change = (sum.energy_final - sum.energy_initial) / sum.energy_initial;
-        table.rows.push(vec![
-            basis.name().into(),
+        table.rows.push(row![
+            basis.name(),
             sum.functions.to_string(),
             sum.particles.to_string(),
             opt(sum.error),

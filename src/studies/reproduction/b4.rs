@@ -1,6 +1,6 @@
 //! B4 (paper §4.2): the axis-aligned manufactured solution.
 
-use super::{builtin, log_log, opt, order, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, log_log, opt, order, row, sci, setup, Effort, Figure, Report, Table};
 use crate::bases::BasisKind;
 use crate::mass::MassKind;
 use crate::output::chart::{LinePlot, Series};
@@ -91,8 +91,8 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
                 let triangles = simulation::triangulation(&s)?.num_triangles();
                 let sum = simulation::run(&s, &mut |_| {})?;
                 let e = completed_error(&sum);
-                table.rows.push(vec![
-                    basis.name().into(),
+                table.rows.push(row![
+                    basis.name(),
                     mass.spec(),
                     format!("{edge}"),
                     sum.particles.to_string(),
@@ -172,8 +172,8 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
             let sum = simulation::run(&s, &mut |_| {})?;
             let e = completed_error(&sum);
             let ppe = sum.particles as f64 / triangles as f64;
-            ppe_table.rows.push(vec![
-                basis.name().into(),
+            ppe_table.rows.push(row![
+                basis.name(),
                 sum.particles.to_string(),
                 format!("{ppe:.1}"),
                 opt(e),
@@ -268,8 +268,8 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
             basis.name().to_uppercase(),
             row.iter().map(|r| (r.0, r.1)),
         ));
-        cross_table.rows.push(vec![
-            basis.name().into(),
+        cross_table.rows.push(row![
+            basis.name(),
             out.summary.functions.to_string(),
             opt(out.summary.error),
             sci(roughness(&vx)),

@@ -1,7 +1,7 @@
 //! B5 (paper §4.3, thesis §4.4 and 5): the column under self-weight, large
 //! deformation (B5b, against the UL-FEM reference) and damped to equilibrium (B5c).
 
-use super::{builtin, opt, run_2d, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, opt, row, run_2d, sci, setup, Effort, Figure, Report, Table};
 use crate::mass::MassKind;
 use crate::output::chart::{LinePlot, Scale, Series};
 use crate::simulation::{self, RunError, Summary};
@@ -131,8 +131,8 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
                 .failure
                 .as_ref()
                 .map_or("-".to_string(), |_| format!("t = {:.3}", sum.t_end));
-            table.rows.push(vec![
-                label.into(),
+            table.rows.push(row![
+                label,
                 mass.spec(),
                 sum.stable.to_string(),
                 stopped,
@@ -234,7 +234,7 @@ pub(super) fn b5c(effort: Effort) -> Result<Report, RunError> {
             paper = paper.max((s_yy - e_paper).abs() / sigma0);
             points.push((y, s_yy));
         }
-        table.rows.push(vec![
+        table.rows.push(row![
             mass.spec(),
             sci(linear),
             sci(paper),

@@ -36,6 +36,77 @@ pub enum Effort {
     Full,
 }
 
+/// A cell of a [`Table`]: the text shown, and the number behind it when the cell
+/// shows one (unrounded).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// As shown in the markdown table (`3.71e-4`, `ps`, `-`).
+    pub text: String,
+    /// The value the text rounds, when it is a computed number.
+    pub value: Option<f64>,
+}
+
+impl Cell {
+    /// A number shown as `text`.
+    pub fn number(value: f64, text: String) -> Cell {
+        Cell {
+            text,
+            value: Some(value),
+        }
+    }
+
+    /// The cell as a JSON value: the unrounded number of a number cell (`null` if
+    /// not finite); for a text cell, `null` for `-`, a boolean for `true`/`false`,
+    /// a number for a text that is one (`42`, `4.5`), else the text.
+    pub fn json(&self) -> serde_json::Value {
+        use serde_json::Value;
+        if let Some(v) = self.value {
+            return serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number);
+        }
+        match self.text.as_str() {
+            "-" => Value::Null,
+            "true" => Value::Bool(true),
+            "false" => Value::Bool(false),
+            t => {
+                if let Ok(i) = t.parse::<i64>() {
+                    Value::from(i)
+                } else if let Some(n) = t.parse::<f64>().ok().and_then(serde_json::Number::from_f64)
+                {
+                    Value::Number(n)
+                } else {
+                    Value::String(t.to_string())
+                }
+            }
+        }
+    }
+}
+
+impl From<String> for Cell {
+    fn from(text: String) -> Cell {
+        Cell { text, value: None }
+    }
+}
+
+impl From<&str> for Cell {
+    fn from(text: &str) -> Cell {
+        Cell::from(text.to_string())
+    }
+}
+
+impl std::fmt::Display for Cell {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+/// A row of cells from strings and [`Cell`]s.
+macro_rules! row {
+    ($($cell:expr),* $(,)?) => {
+        vec![$($crate::studies::reproduction::Cell::from($cell)),*]
+    };
+}
+use row;
+
 /// A table of results.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
@@ -43,8 +114,8 @@ pub struct Table {
     pub title: String,
     /// Column names.
     pub columns: Vec<&'static str>,
-    /// Rows of formatted cells.
-    pub rows: Vec<Vec<String>>,
+    /// Rows of cells.
+    pub rows: Vec<Vec<Cell>>,
 }
 
 impl Table {
@@ -54,7 +125,8 @@ impl Table {
         out += &"---|".repeat(self.columns.len());
         out.push('\n');
         for row in &self.rows {
-            out += &format!("| {} |\n", row.join(" | "));
+            let cells: Vec<&str> = row.iter().map(|c| c.text.as_str()).collect();
+            out += &format!("| {} |\n", cells.join(" | "));
         }
         out
     }
@@ -100,16 +172,16 @@ pub fn reproduce(name: &str, effort: Effort, cache: Option<&Path>) -> Result<Rep
     }
 }
 
-/// Three significant digits.
-pub fn sci(x: f64) -> String {
+/// Three significant digits (`-` when not finite), with the value behind them.
+pub fn sci(x: f64) -> Cell {
     if x.is_finite() {
-        format!("{x:.2e}")
+        Cell::number(x, format!("{x:.2e}"))
     } else {
         "-".into()
     }
 }
 
-fn opt(x: Option<f64>) -> String {
+fn opt(x: Option<f64>) -> Cell {
     x.map_or_else(|| "-".into(), sci)
 }
 
@@ -128,8 +200,9 @@ fn setup<T>(r: Result<T, crate::scene::SceneError>) -> Result<T, RunError> {
     r.map_err(RunError::Scene)
 }
 
-fn order(e0: f64, e1: f64, h0: f64, h1: f64) -> String {
-    format!("{:.2}", (e0 / e1).ln() / (h0 / h1).ln())
+fn order(e0: f64, e1: f64, h0: f64, h1: f64) -> Cell {
+    let p = (e0 / e1).ln() / (h0 / h1).ln();
+    Cell::number(p, format!("{p:.2}"))
 }
 
 /// One run with its energy history `(t, kinetic, strain, total)` every `every` steps
