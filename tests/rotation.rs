@@ -5,7 +5,7 @@
 //! strain and gains energy.
 //!
 //! `cargo test --release --test rotation -- --nocapture` prints the table of
-//! docs/tutorial.md (§ "Materials").
+//! docs/tutorial.md (§ 7, "Choose the material law").
 
 use nalgebra::Vector2;
 use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
