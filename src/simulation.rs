@@ -102,9 +102,13 @@ pub struct Summary {
     pub failure: Option<String>,
     /// Largest rotation angle (radians) of the polar factor `R` of any particle's
     /// `F = R U`, sampled every [`ROTATION_EVERY`] steps and at the end (0 in 1D).
+    /// Not in the JSON summary (the warning carries it when it matters).
+    #[serde(skip)]
     pub max_rotation: f64,
     /// Warnings about the run, each once: the paper's non-objective law
     /// (`linear-elastic`) under a rotation above [`crate::material::ROTATION_WARNING`].
+    /// In the JSON summary only when there is one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
     /// Wall time of the time loop.
     pub seconds: f64,
