@@ -1,9 +1,26 @@
 //! Constitutive models: stress from the deformation gradient, and the strain-energy
 //! density for energy diagnostics.
 //!
+//! Every model returns the **Cauchy** stress `σ(F)`: the driver assembles the
+//! internal force with the current particle volume, `F^int_i = Σ_p σ_p ∇φ_i V_p`
+//! with `V_p = J_p V_p⁰` (eqs. (15), (28)). A law derived from an energy `W(F)` per
+//! unit reference volume is energy-consistent with that force when
+//! `σ = (1/J) (∂W/∂F) Fᵀ` (the Kirchhoff stress `τ = J σ` over `J`).
+//!
+//! The laws:
+//! - [`LinearElastic`] (`linear-elastic`, alias `paper-linear`): the paper's law
+//!   (eqs. (25)–(26)) on `sym(F) − I`. It is **not objective**: a rigid rotation
+//!   `F = R(θ)` gives `sym(F) − I = (cos θ − 1) I ≠ 0`, so a rotating body builds
+//!   stress and energy. Kept for the seeds' benchmarks, which use it.
+//! - [`Corotational`] (`corotational`, alias `corotated`; the default of scenes
+//!   that name no model): the same energy on the stretch `U − I` of the polar
+//!   decomposition `F = R U`; objective, equal to the paper's law to first order.
+//! - [`NeoHookean`] (`neo-hookean`, paper eq. (27)): objective and hyperelastic.
+//!
 //! In 2D the models are plane strain (`ε_zz = 0`, so the in-plane formulas are the
 //! 3D ones restricted to the plane); in 1D they are uniaxial (`λ = 0`, `μ = E / 2`,
-//! so that `σ = E ε` for small strain).
+//! so that `σ = E ε` for small strain). In 1D `R = 1` and the co-rotational law is
+//! the paper's law exactly.
 
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
@@ -101,8 +118,14 @@ pub trait Material<T: Scalar, const D: usize> {
     fn elastic(&self) -> &Elastic;
 }
 
-/// Linear elasticity on the symmetric part of `F` (paper eqs. (25)–(26)):
+/// The paper's linear elasticity on the symmetric part of `F` (eqs. (25)–(26)):
 /// `E = ½ (F + Fᵀ) − I`, `σ = λ tr(E) I + 2 μ E`, `W = μ E:E + ½ λ tr(E)²`.
+///
+/// **Not objective**: under a rigid rotation `F = R(θ)` (2D) the strain is
+/// `E = (cos θ − 1) I`, so `σ = 2 (λ + μ)(cos θ − 1) I ≠ 0` and `W > 0`: a body that
+/// rotates builds spurious stress and gains or loses energy. Use [`Corotational`]
+/// (the default) or [`NeoHookean`] for anything that rotates; this law is kept for
+/// the seeds' benchmarks (scene name `linear-elastic`, alias `paper-linear`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearElastic {
     /// Constants.
@@ -183,14 +206,146 @@ impl<T: Scalar, const D: usize> Material<T, D> for NeoHookean {
     }
 }
 
+/// The polar decomposition `F = R U` of a 1×1 or 2×2 matrix with `det F > 0`:
+/// the rotation `R` and the symmetric positive definite stretch `U = Rᵀ F`.
+///
+/// 1D: `R = 1`, `U = F`. 2D, closed form and allocation-free: `R` is the rotation
+/// by `θ = atan2(F₂₁ − F₁₂, F₁₁ + F₂₂)`, i.e. `(cos θ, sin θ) = (F₁₁ + F₂₂,
+/// F₂₁ − F₁₂) / n` with `n = √((F₁₁ + F₂₂)² + (F₂₁ − F₁₂)²)`: that is the one
+/// rotation for which `Rᵀ F` is symmetric with positive trace `n` (and so positive
+/// definite when `det F > 0`; `n > 0` then, since `n = 0` forces `det F ≤ 0`).
+/// `U` is symmetrised against round-off.
+#[inline]
+pub fn polar<T: Scalar, const D: usize>(
+    f: &SMatrix<T, D, D>,
+) -> (SMatrix<T, D, D>, SMatrix<T, D, D>) {
+    match D {
+        1 => (SMatrix::<T, D, D>::identity(), *f),
+        2 => {
+            let (a, b) = (f[(0, 0)] + f[(1, 1)], f[(1, 0)] - f[(0, 1)]);
+            let n = (a * a + b * b).sqrt();
+            let (c, s) = if n > T::zero() {
+                (a / n, b / n)
+            } else {
+                (T::one(), T::zero())
+            };
+            let mut r = SMatrix::<T, D, D>::identity();
+            r[(0, 0)] = c;
+            r[(0, 1)] = -s;
+            r[(1, 0)] = s;
+            r[(1, 1)] = c;
+            let u = r.transpose() * f;
+            let u = (u + u.transpose()) * T::of(0.5);
+            (r, u)
+        }
+        _ => unreachable!("psmpm works in 1D and 2D"),
+    }
+}
+
+/// The angle (radians, in `[0, π]`) of the rotation `R` of the polar decomposition
+/// `F = R U` (0 in 1D): `|atan2(F₂₁ − F₁₂, F₁₁ + F₂₂)|`. One `atan2` per call.
+#[inline]
+pub fn rotation_angle<T: Scalar, const D: usize>(f: &SMatrix<T, D, D>) -> f64 {
+    match D {
+        1 => 0.0,
+        2 => {
+            let (a, b) = (
+                (f[(0, 0)] + f[(1, 1)]).to_f64(),
+                (f[(1, 0)] - f[(0, 1)]).to_f64(),
+            );
+            b.atan2(a).abs()
+        }
+        _ => unreachable!("psmpm works in 1D and 2D"),
+    }
+}
+
+/// The largest [`rotation_angle`] over the deformation gradients `fs` (0 for none).
+pub fn max_rotation<T: Scalar, const D: usize>(fs: &[SMatrix<T, D, D>]) -> f64 {
+    fs.iter().map(rotation_angle).fold(0.0, f64::max)
+}
+
+/// The rotation angle (radians) above which a run with the paper's non-objective
+/// law ([`LinearElastic`]) is warned about: at `θ = 0.05` a rigid rotation already
+/// gives the spurious strain `cos θ − 1 ≈ −1.2e-3` in every direction.
+pub const ROTATION_WARNING: f64 = 0.05;
+
+/// Co-rotational linear elasticity: the paper's law on the stretch of the polar
+/// decomposition `F = R U` (see [`polar`]), objective (a rigid rotation `F = R`
+/// gives `U = I`: zero stress and energy).
+///
+/// With `ε = U − I` and `S = λ tr(ε) I + 2 μ ε` (the paper's law in the rotated
+/// frame), the energy per unit reference volume is
+/// `W = μ ε:ε + ½ λ tr(ε)²`, its first Piola–Kirchhoff stress `∂W/∂F = R S`,
+/// the Kirchhoff stress `τ = R S U Rᵀ` (symmetric: `S` is a polynomial in `U`), and
+/// the Cauchy stress the driver uses (with the current volume `J V⁰`) is
+///
+/// `σ = (1/J) R S U Rᵀ`,  `J = det F = det U`.
+///
+/// So the law is hyperelastic and energy-consistent with the driver's internal force.
+/// For small strain `U / J = I + O(ε)`, so `σ = R S Rᵀ + O(ε²)`, and with `R = I +
+/// O(ε)` (no rotation) `σ = λ tr(sym F − I) I + 2 μ (sym F − I) + O(ε²)`: the
+/// paper's law to first order. In 1D (`R = 1`, `λ = 0`, `μ = E/2`):
+/// `σ = E (F − 1) F / F = E (F − 1)`, the paper's law exactly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corotational {
+    /// Constants.
+    pub constants: Elastic,
+    lambda: f64,
+    mu: f64,
+}
+
+impl Corotational {
+    /// The model in dimension `d`.
+    pub fn new(constants: Elastic, d: usize) -> Self {
+        let (lambda, mu) = constants.lame(d);
+        Corotational {
+            constants,
+            lambda,
+            mu,
+        }
+    }
+}
+
+impl<T: Scalar, const D: usize> Material<T, D> for Corotational {
+    #[inline]
+    fn stress(&self, f: &SMatrix<T, D, D>) -> SMatrix<T, D, D> {
+        let (r, u) = polar(f);
+        let id = SMatrix::<T, D, D>::identity();
+        let e = u - id;
+        let s = id * (T::of(self.lambda) * e.trace()) + e * T::of(2.0 * self.mu);
+        let tau = r * s * u * r.transpose();
+        // Symmetric in exact arithmetic; symmetrised against round-off.
+        (tau + tau.transpose()) * (T::of(0.5) / det(f))
+    }
+    fn energy_density(&self, f: &SMatrix<T, D, D>) -> T {
+        let (_, u) = polar(f);
+        let e = u - SMatrix::<T, D, D>::identity();
+        let tr = e.trace();
+        T::of(self.mu) * e.component_mul(&e).sum() + T::of(0.5 * self.lambda) * tr * tr
+    }
+    fn elastic(&self) -> &Elastic {
+        &self.constants
+    }
+}
+
 /// The model a scene chose, dispatched at run time (one `match` per particle
 /// evaluation, negligible next to the basis work).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AnyMaterial {
-    /// Linear elastic.
+    /// The paper's linear elastic law (not objective).
     Linear(LinearElastic),
+    /// Co-rotational linear elastic.
+    Corotational(Corotational),
     /// Neo-Hookean.
     NeoHookean(NeoHookean),
+}
+
+impl AnyMaterial {
+    /// Whether the law is objective (zero stress under a rigid rotation): all but
+    /// the paper's [`LinearElastic`].
+    pub fn is_objective(&self) -> bool {
+        !matches!(self, AnyMaterial::Linear(_))
+    }
 }
 
 impl<T: Scalar, const D: usize> Material<T, D> for AnyMaterial {
@@ -198,21 +353,34 @@ impl<T: Scalar, const D: usize> Material<T, D> for AnyMaterial {
     fn stress(&self, f: &SMatrix<T, D, D>) -> SMatrix<T, D, D> {
         match self {
             AnyMaterial::Linear(m) => m.stress(f),
+            AnyMaterial::Corotational(m) => m.stress(f),
             AnyMaterial::NeoHookean(m) => m.stress(f),
         }
     }
     fn energy_density(&self, f: &SMatrix<T, D, D>) -> T {
         match self {
             AnyMaterial::Linear(m) => Material::<T, D>::energy_density(m, f),
+            AnyMaterial::Corotational(m) => Material::<T, D>::energy_density(m, f),
             AnyMaterial::NeoHookean(m) => Material::<T, D>::energy_density(m, f),
         }
     }
     fn elastic(&self) -> &Elastic {
         match self {
             AnyMaterial::Linear(m) => &m.constants,
+            AnyMaterial::Corotational(m) => &m.constants,
             AnyMaterial::NeoHookean(m) => &m.constants,
         }
     }
+}
+
+/// The warning for a run with the paper's non-objective law whose particles rotated
+/// by up to `max_rotation` radians: `Some` above [`ROTATION_WARNING`].
+pub fn rotation_warning(max_rotation: f64) -> Option<String> {
+    (max_rotation > ROTATION_WARNING).then(|| {
+        format!(
+            "material `linear-elastic` (the paper's law on sym(F) − I) is not objective and the body rotated by up to {max_rotation:.3} rad (> {ROTATION_WARNING}): the rotation builds spurious stress and energy; use `model = \"corotational\"` (the default) or `\"neo-hookean\"`"
+        )
+    })
 }
 
 #[cfg(test)]
@@ -245,5 +413,166 @@ mod tests {
         let one = nalgebra::Matrix1::new(1.0 + eps);
         let s: nalgebra::Matrix1<f64> = LinearElastic::new(c, 1).stress(&one);
         assert!((s[(0, 0)] - 100.0 * eps).abs() < 1e-12);
+    }
+
+    fn laws(d: usize) -> [(&'static str, AnyMaterial); 3] {
+        let c = Elastic::new(1e6, 0.3, 1e3).unwrap();
+        [
+            (
+                "linear-elastic",
+                AnyMaterial::Linear(LinearElastic::new(c, d)),
+            ),
+            (
+                "corotational",
+                AnyMaterial::Corotational(Corotational::new(c, d)),
+            ),
+            (
+                "neo-hookean",
+                AnyMaterial::NeoHookean(NeoHookean::new(c, d)),
+            ),
+        ]
+    }
+
+    fn rotation(theta: f64) -> Matrix2<f64> {
+        let (s, c) = theta.sin_cos();
+        Matrix2::new(c, -s, s, c)
+    }
+
+    /// A rigid rotation `F = R(θ)`: the objective laws give zero stress and energy
+    /// (to round-off); the paper's law gives `σ = 2 (λ + μ)(cos θ − 1) I`, which is
+    /// why it is not objective.
+    #[test]
+    fn rigid_rotation_stresses_only_the_papers_law() {
+        let young = 1e6;
+        for theta in [
+            1e-3,
+            0.05,
+            0.3,
+            0.7,
+            std::f64::consts::FRAC_PI_4,
+            1.2,
+            std::f64::consts::FRAC_PI_2,
+        ] {
+            for sign in [1.0, -1.0] {
+                let f = rotation(sign * theta);
+                assert!((rotation_angle(&f) - theta).abs() < 1e-12);
+                for (name, law) in laws(2) {
+                    let s: Matrix2<f64> = law.stress(&f);
+                    let w = Material::<f64, 2>::energy_density(&law, &f);
+                    if law.is_objective() {
+                        assert!(s.norm() < 1e-9 * young, "{name} θ = {theta}: σ = {s}");
+                        assert!(w.abs() < 1e-9 * young, "{name} θ = {theta}: W = {w}");
+                    } else {
+                        let (l, m) = Material::<f64, 2>::elastic(&law).lame(2);
+                        let expected = Matrix2::identity() * (2.0 * (l + m) * (theta.cos() - 1.0));
+                        assert!(
+                            (s - expected).norm() < 1e-9 * young,
+                            "{name} θ = {theta}: σ = {s}"
+                        );
+                        assert!(s.norm() > 0.1 * young * (1.0 - theta.cos()));
+                        assert!(w > 0.0);
+                    }
+                }
+            }
+        }
+        // And on top of a stretch: rotating a deformed state rotates the stress
+        // (σ(R F) = R σ(F) Rᵀ) for the objective laws only.
+        let f = Matrix2::new(1.02, 0.01, -0.005, 0.97);
+        let r = rotation(0.6);
+        for (name, law) in laws(2) {
+            let (s, sr): (Matrix2<f64>, Matrix2<f64>) = (law.stress(&f), law.stress(&(r * f)));
+            let gap = (sr - r * s * r.transpose()).norm() / s.norm();
+            if law.is_objective() {
+                assert!(gap < 1e-12, "{name}: {gap}");
+            } else {
+                assert!(gap > 0.1, "{name}: {gap}");
+            }
+        }
+    }
+
+    #[test]
+    fn polar_decomposition_is_a_rotation_times_a_symmetric_stretch() {
+        for f in [
+            Matrix2::new(1.0, 0.0, 0.0, 1.0),
+            Matrix2::new(1.3, 0.4, -0.2, 0.8),
+            Matrix2::new(0.1, -2.0, 1.5, 0.3),
+            rotation(3.0) * Matrix2::new(2.0, 0.3, 0.3, 0.5),
+        ] {
+            let (r, u): (Matrix2<f64>, Matrix2<f64>) = polar(&f);
+            assert!((r * u - f).norm() < 1e-14 * f.norm().max(1.0));
+            assert!((r.transpose() * r - Matrix2::identity()).norm() < 1e-14);
+            assert!((r.determinant() - 1.0).abs() < 1e-14);
+            assert!((u - u.transpose()).norm() < 1e-14);
+            assert!(u.trace() > 0.0 && u.determinant() > 0.0);
+        }
+        assert!(
+            (rotation_angle(&(rotation(3.0) * Matrix2::new(2.0, 0.3, 0.3, 0.5))) - 3.0).abs()
+                < 1e-12
+        );
+        let one = nalgebra::Matrix1::new(1.2);
+        assert_eq!(polar(&one), (nalgebra::Matrix1::new(1.0), one));
+        assert_eq!(rotation_angle(&one), 0.0);
+        assert_eq!(max_rotation::<f64, 2>(&[]), 0.0);
+        assert!((max_rotation(&[rotation(0.2), rotation(-0.4)]) - 0.4).abs() < 1e-12);
+        assert!(rotation_warning(0.04).is_none());
+        assert!(rotation_warning(0.06).unwrap().contains("corotational"));
+    }
+
+    /// The objective law matches the paper's law to first order in the strain: the
+    /// gap is `O(ε²)` (it shrinks 100-fold when ε shrinks 10-fold); in 1D the laws
+    /// are equal.
+    #[test]
+    fn corotational_law_is_the_papers_law_to_first_order() {
+        let c = Elastic::new(1e6, 0.3, 1e3).unwrap();
+        let (lin, co) = (LinearElastic::new(c, 2), Corotational::new(c, 2));
+        let gap = |eps: f64| {
+            let f = Matrix2::new(1.0 + eps, 0.7 * eps, -0.4 * eps, 1.0 - 0.5 * eps);
+            let (a, b): (Matrix2<f64>, Matrix2<f64>) = (lin.stress(&f), co.stress(&f));
+            let (wa, wb) = (
+                Material::<f64, 2>::energy_density(&lin, &f),
+                Material::<f64, 2>::energy_density(&co, &f),
+            );
+            (
+                (a - b).norm() / (1e6 * eps),
+                (wa - wb).abs() / (1e6 * eps * eps),
+            )
+        };
+        let (s1, w1) = gap(1e-3);
+        let (s2, w2) = gap(1e-4);
+        assert!(s1 < 1e-2 && s2 < 1e-3 && s2 < 0.2 * s1, "{s1} {s2}");
+        assert!(w1 < 1e-1 && w2 < 0.2 * w1.max(1e-12) + 1e-6, "{w1} {w2}");
+        let (lin1, co1) = (LinearElastic::new(c, 1), Corotational::new(c, 1));
+        for x in [0.5, 0.9, 1.0, 1.1, 2.0] {
+            let f = nalgebra::Matrix1::new(x);
+            let (a, b): (nalgebra::Matrix1<f64>, nalgebra::Matrix1<f64>) =
+                (lin1.stress(&f), co1.stress(&f));
+            assert!((a - b).norm() < 1e-9, "{x}");
+        }
+    }
+
+    /// The hyperelastic laws are energy-consistent with the driver's Cauchy stress
+    /// on the current volume: `J σ = (∂W/∂F) Fᵀ` (central differences of `W`).
+    #[test]
+    fn objective_laws_are_energy_consistent_with_the_cauchy_stress() {
+        let f = Matrix2::new(1.15, 0.2, -0.1, 0.9);
+        for (name, law) in laws(2) {
+            if !law.is_objective() {
+                continue;
+            }
+            let h = 1e-6;
+            let mut p = Matrix2::zeros();
+            for i in 0..2 {
+                for j in 0..2 {
+                    let mut e = Matrix2::zeros();
+                    e[(i, j)] = h;
+                    p[(i, j)] = (Material::<f64, 2>::energy_density(&law, &(f + e))
+                        - Material::<f64, 2>::energy_density(&law, &(f - e)))
+                        / (2.0 * h);
+                }
+            }
+            let s: Matrix2<f64> = law.stress(&f);
+            let gap = (s * f.determinant() - p * f.transpose()).norm() / s.norm();
+            assert!(gap < 1e-6, "{name}: {gap}");
+        }
     }
 }

@@ -30,6 +30,9 @@ pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
 /// Condition-number estimate above which a run is unstable.
 pub const STABLE_CONDITION: f64 = 1e8;
 
+/// Steps between two samples of [`Summary::max_rotation`].
+pub const ROTATION_EVERY: usize = 10;
+
 /// Why a scene could not be run: typed, so that a caller can locate the field in
 /// the scene file without reading it back out of the message.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -94,6 +97,16 @@ pub struct Summary {
     pub stable: bool,
     /// Why the run stopped early, with the step.
     pub failure: Option<String>,
+    /// Largest rotation angle (radians) of the polar factor `R` of any particle's
+    /// `F = R U`, sampled every [`ROTATION_EVERY`] steps and at the end (0 in 1D).
+    /// Not in the JSON summary (the warning carries it when it matters).
+    #[serde(skip)]
+    pub max_rotation: f64,
+    /// Warnings about the run, each once: the paper's non-objective law
+    /// (`linear-elastic`) under a rotation above [`crate::material::ROTATION_WARNING`].
+    /// In the JSON summary only when there is one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Wall time of the time loop.
     pub seconds: f64,
     /// Wall time per phase, summed over the steps.
@@ -255,6 +268,7 @@ struct Tally {
     rms: exact::RmsPositionError,
     failure: Option<StepError>,
     seconds: f64,
+    max_rotation: f64,
 }
 
 /// The tracked particles: the particle nearest each of the scene's tracked points.
@@ -318,6 +332,7 @@ where
     let mut phases = PhaseTimes::default();
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
+    let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
         let r = match driver.step() {
@@ -344,6 +359,9 @@ where
                 rms.add_sample(a.position(x0, r.time), from_vec(&parts.x[p]));
             }
             rms.finish_step();
+        }
+        if r.step % ROTATION_EVERY == 0 {
+            max_rotation = max_rotation.max(crate::material::max_rotation(&driver.particles.f));
         }
         on_step(&r, driver.particles.view());
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
@@ -374,6 +392,7 @@ where
         rms,
         failure,
         seconds: clock.elapsed().as_secs_f64(),
+        max_rotation,
     }
 }
 
@@ -438,6 +457,15 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
         && energy_growth < STABLE_ENERGY_GROWTH
         && max_condition.is_none_or(|c| c < STABLE_CONDITION);
     let driver = run.driver;
+    let max_rotation = tally
+        .max_rotation
+        .max(crate::material::max_rotation(&driver.particles.f));
+    let warnings = match scene.material.model {
+        crate::scene::MaterialModel::LinearElastic => {
+            crate::material::rotation_warning(max_rotation)
+        }
+        _ => None,
+    };
     Outcome {
         summary: Summary {
             scene: scene.name.clone(),
@@ -461,6 +489,8 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             energy_growth,
             stable,
             failure: failure.as_ref().map(|e| e.to_string()),
+            max_rotation,
+            warnings: warnings.into_iter().collect(),
             seconds: tally.seconds,
             phases: tally.phases,
         },

@@ -336,6 +336,9 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         }
     };
     progress.finish();
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
     let written = recorder.map(|r| {
         let dir = r.path().to_path_buf();
         r.finish(&summary, &tracked, last.view())

@@ -27,7 +27,7 @@
 //! blocks = [1, 8]
 //!
 //! [material]
-//! model = "linear-elastic"   # or neo-hookean
+//! model = "linear-elastic"   # the paper's law (not objective); corotational (the default), neo-hookean
 //! young = 5e4
 //! poisson = 0.0
 //! density = 1.0
@@ -235,7 +235,8 @@ pub enum BlockLayout {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    /// Model.
+    /// Model; absent means [`MaterialModel::default`] (co-rotational, objective).
+    #[serde(default)]
     pub model: MaterialModel,
     /// Young's modulus `E > 0`.
     pub young: f64,
@@ -246,12 +247,21 @@ pub struct MaterialSpec {
     pub density: f64,
 }
 
-/// Constitutive models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// Constitutive models (see [`crate::material`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum MaterialModel {
-    /// Linear elasticity on `F` (paper eqs. (25)–(26)).
+    /// The paper's linear elasticity on `sym(F) − I` (eqs. (25)–(26)), the law of
+    /// the seeds' benchmarks: **not objective** (a rotating body builds spurious
+    /// stress). `linear-elastic`, or `paper-linear`.
+    #[serde(alias = "paper-linear")]
     LinearElastic,
+    /// Co-rotational linear elasticity on the stretch `U − I` of `F = R U`:
+    /// objective, the paper's law to first order. The default. `corotational`, or
+    /// `corotated`.
+    #[default]
+    #[serde(alias = "corotated")]
+    Corotational,
     /// Compressible neo-Hookean (paper eq. (27)).
     NeoHookean,
 }

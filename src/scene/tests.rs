@@ -102,3 +102,36 @@ fn set_up_errors_keep_their_field_and_kind() {
         other => panic!("expected a scene error, got {other:?}"),
     }
 }
+
+#[test]
+fn the_material_model_defaults_to_the_objective_law_and_the_papers_law_keeps_its_names() {
+    let text = Scene::builtin("column-small").unwrap().to_toml();
+    assert!(text.contains("model = \"linear-elastic\""), "{text}");
+    // The built-in benchmarks name the paper's law explicitly.
+    for (name, _, _) in BUILTIN {
+        let scene = Scene::builtin(name).unwrap();
+        assert_ne!(scene.material.model, MaterialModel::Corotational, "{name}");
+    }
+    let without = text.replace("model = \"linear-elastic\"\n", "");
+    let scene = Scene::from_toml(&without, "m.toml").unwrap();
+    assert_eq!(scene.material.model, MaterialModel::Corotational);
+    assert!(scene.to_toml().contains("model = \"corotational\""));
+    for (name, model) in [
+        ("paper-linear", MaterialModel::LinearElastic),
+        ("linear-elastic", MaterialModel::LinearElastic),
+        ("corotated", MaterialModel::Corotational),
+        ("corotational", MaterialModel::Corotational),
+        ("neo-hookean", MaterialModel::NeoHookean),
+    ] {
+        let named = text.replace("\"linear-elastic\"", &format!("\"{name}\""));
+        assert_eq!(
+            Scene::from_toml(&named, "m.toml").unwrap().material.model,
+            model,
+            "{name}"
+        );
+    }
+    let e =
+        Scene::from_toml(&text.replace("\"linear-elastic\"", "\"plastic\""), "m.toml").unwrap_err();
+    println!("{e}");
+    assert!(e.message.contains("corotational"), "{e}");
+}

@@ -22,7 +22,7 @@ pub(crate) use solution::Solution;
 use crate::driver::{Driver, Fix, SetupError};
 use crate::effect::Effect;
 use crate::mass::MassStrategy;
-use crate::material::{AnyMaterial, Elastic, LinearElastic, NeoHookean};
+use crate::material::{AnyMaterial, Corotational, Elastic, LinearElastic, NeoHookean};
 use crate::particles::Particles;
 use crate::scene::{ErrorKind, MaterialModel, Scene, SceneError};
 use crate::simulation::RunError;
@@ -132,6 +132,7 @@ fn material<const D: usize>(scene: &Scene) -> Result<(AnyMaterial, f64), RunErro
     let material = match m.model {
         MaterialModel::LinearElastic => AnyMaterial::Linear(LinearElastic::new(elastic, D)),
         MaterialModel::NeoHookean => AnyMaterial::NeoHookean(NeoHookean::new(elastic, D)),
+        MaterialModel::Corotational => AnyMaterial::Corotational(Corotational::new(elastic, D)),
     };
     Ok((material, elastic.density))
 }

@@ -518,7 +518,7 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("initial_velocity.kind: unknown variant `spinning`, expected one of `rest`, `uniform`, `sine-mode`, `exact`"),
         case("unknown-material-model", BAR)
             .edit("model = \"linear-elastic\"", "model = @@\"plastic\"")
-            .expect("material.model: unknown variant `plastic`, expected `linear-elastic` or `neo-hookean`"),
+            .expect("material.model: unknown variant `plastic`, expected one of `linear-elastic`, `paper-linear`, `corotated`, `corotational`, `neo-hookean`"),
         case("unknown-block-layout", BAR)
             .edit("[mesh]", "@@[mesh]")
             .edit("layout = \"four-triangles\"", "layout = \"hexagons\"")
