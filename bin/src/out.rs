@@ -154,6 +154,16 @@ impl Recorder {
             // The library's step count: t_end / dt, rounded (dt = the first step's time).
             // (The scene's own count is 1 for Courant-number scenes.)
             self.total = steps_from_dt(self.t_end, r.time);
+            let limit = psmpm::scene::limits::MAX_FRAMES;
+            if let Some(n) = self.every.filter(|&n| n > 0) {
+                let frames = self.total / n + 2;
+                if frames > limit {
+                    return Err(CliError::Input(format!(
+                        "--out-every {n}: {} steps give {frames} particle frames, above the limit of {limit}",
+                        self.total
+                    )));
+                }
+            }
         }
         if r.step > 0 {
             self.last_step = r.step;

@@ -73,7 +73,7 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
     }
     let mesh = match &args.mesh {
         Some(path) => Some(
-            psmpm::basis::mesh::gmsh::read_msh(path).map_err(|e| CliError::Input(e.to_string()))?,
+            psmpm::scene::limits::read_mesh(&path.to_string_lossy()).map_err(CliError::Input)?,
         ),
         None => None,
     };

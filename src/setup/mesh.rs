@@ -121,7 +121,7 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
                 RunError::Setup(format!("{field}: {e}"))
             })?
         }
-        MeshSpec::Gmsh { file } => psmpm_basis::mesh::gmsh::read_msh(std::path::Path::new(file))
+        MeshSpec::Gmsh { file } => crate::scene::limits::read_mesh(file)
             .map_err(|e| RunError::Setup(format!("mesh.file: {e}")))?,
         MeshSpec::Interval { .. } => {
             return Err(RunError::Setup("mesh.kind: `interval` is a 1D mesh".into()))
@@ -136,7 +136,7 @@ fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
         if !tags.contains(&bc.tag) {
             return Err(RunError::Setup(format!(
                 "boundary[{b}].tag: unknown boundary tag `{}`; the mesh has tags {tags:?}",
-                bc.tag
+                crate::scene::limits::echo(&bc.tag)
             )));
         }
     }
