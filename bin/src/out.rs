@@ -5,7 +5,9 @@
 //!   max_speed, active, lumped_rows, deactivated, condition` (the values of
 //!   `--format json`; floats in Rust's shortest round-trip `{:e}` form, integers as
 //!   integers, `condition` empty unless `--condition`).
-//! - `summary.json`: the summary of `--format json`, pretty-printed.
+//! - `summary.json`: the summary of `--format json`, pretty-printed (with
+//!   `"interrupted": true` when SIGINT/SIGTERM or a closed stdout stopped the run;
+//!   the last frame and `particles.pvd` are written then too).
 //! - `particles_NNNNN.vtu` and `particles.pvd`: particle frames (position,
 //!   velocity, displacement, stress, volume, mass; see `psmpm::output::vtk`) of the
 //!   initial state, every `--out-every` steps and the last step (on a numerical
