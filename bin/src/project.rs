@@ -41,7 +41,8 @@ fn parse_mass(name: &str) -> Result<MassOption, String> {
         "consistent" => Ok(MassOption::Consistent),
         "lumped" => Ok(MassOption::Lumped),
         _ => Err(format!(
-            "unknown mass option `{name}` (known: consistent, lumped)"
+            "unknown mass option `{}` (known: consistent, lumped)",
+            psmpm::scene::limits::echo(name)
         )),
     }
 }

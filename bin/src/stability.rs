@@ -200,7 +200,8 @@ fn select(spec: &str, all: &[(String, PathBuf)]) -> Result<Vec<(String, PathBuf)
         if !hit {
             let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
             return Err(CliError::Input(format!(
-                "--cases: unknown case `{w}` (known: quick, all, {})",
+                "--cases: unknown case `{}` (known: quick, all, {})",
+                psmpm::scene::limits::echo(w),
                 names.join(", ")
             )));
         }

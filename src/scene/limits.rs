@@ -47,7 +47,7 @@ pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
         return Err("cannot read: not a regular file (a device, FIFO or socket)".into());
     }
     let too_big = |size: u64| format!("is {size} bytes, above the limit of {limit} bytes");
-    if meta.len() > limit {
+    if meta.is_file() && meta.len() > limit {
         return Err(too_big(meta.len()));
     }
     let file = std::fs::File::open(path).map_err(cannot)?;

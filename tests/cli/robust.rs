@@ -409,6 +409,8 @@ fn command_line_cases() -> Vec<Case> {
         args_case("run-refine-y-in-1d", refine_y, &["run", "@"], "study.refine"),
         args_case("scene-show-file", bar.clone(), &["scene", "show", "nothing\u{1b}"], "nothing\\u{1b}"),
         args_case("project-mesh-dev-zero", None, &["project", "--mesh", "/dev/zero"], "/dev/zero: cannot read: not a regular file"),
+        args_case("reproduce-study-with-escape", None, &["reproduce", "b9\u{1b}[1m"], "unknown study `b9\\u{1b}[1m`"),
+        args_case("stability-case-with-escape", None, &["stability", "--dir", concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/stability"), "--cases", "b2\u{1b}"], "unknown case `b2\\u{1b}`"),
         args_case("project-mesh-directory", None, &["project", "--mesh", "/tmp"], "/tmp: cannot read"),
     ]
 }
