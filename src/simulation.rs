@@ -22,6 +22,7 @@ use crate::setup::{self, from_vec, Basis1d, Basis2d, Domain, Prepared, Solution}
 use crate::studies::exact;
 use psmpm_basis::Basis;
 use serde::Serialize;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 pub use crate::setup::{build_effects, particle_lattice, triangulation, Lattice};
 
@@ -107,6 +108,11 @@ pub struct Summary {
     /// In the JSON summary only when there is one.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// The run was stopped from outside (the stop flag of [`observe_2d_until`])
+    /// before its end time; the rest of the summary covers the steps taken. Not
+    /// serialised when false.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub interrupted: bool,
     /// Wall time of the time loop.
     pub seconds: f64,
     /// Wall time per phase, summed over the steps.
@@ -186,54 +192,89 @@ pub fn observe(scene: &Scene, observer: &mut Observer) -> Result<Summary, RunErr
         }
     };
     match scene.dim {
-        2 => run_2d_observed(scene, &mut steps_only).map(|o| o.summary),
-        _ => run_1d_observed(scene, &mut steps_only).map(|o| o.summary),
+        2 => run_2d_observed(scene, &mut steps_only, None).map(|o| o.summary),
+        _ => run_1d_observed(scene, &mut steps_only, None).map(|o| o.summary),
     }
 }
 
 /// Runs a 2D scene, showing `observer` the initial state (a report with `step == 0`)
 /// and then every step, and returns its particles and tracked histories.
 pub fn observe_2d(scene: &Scene, observer: &mut Observer) -> Result<Outcome<2>, RunError> {
-    run_2d_observed(scene, observer)
+    run_2d_observed(scene, observer, None)
+}
+
+/// [`observe_2d`] that stops after the step during which `stop` became true (checked
+/// between steps); the summary then says `interrupted`.
+pub fn observe_2d_until(
+    scene: &Scene,
+    observer: &mut Observer,
+    stop: &AtomicBool,
+) -> Result<Outcome<2>, RunError> {
+    run_2d_observed(scene, observer, Some(stop))
+}
+
+/// [`observe_1d`] that stops early as [`observe_2d_until`] does.
+pub fn observe_1d_until(
+    scene: &Scene,
+    observer: &mut Observer,
+    stop: &AtomicBool,
+) -> Result<Outcome<1>, RunError> {
+    run_1d_observed(scene, observer, Some(stop))
 }
 
 /// Runs a 1D scene, showing `observer` the initial state (a report with `step == 0`)
 /// and then every step, and returns its particles and tracked histories.
 pub fn observe_1d(scene: &Scene, observer: &mut Observer) -> Result<Outcome<1>, RunError> {
-    run_1d_observed(scene, observer)
+    run_1d_observed(scene, observer, None)
 }
 
 /// Runs a 2D scene and returns its particles too.
 pub fn run_2d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<2>, RunError> {
-    run_2d_observed(scene, &mut |r, _| {
-        if r.step > 0 {
-            on_step(r)
-        }
-    })
+    run_2d_observed(
+        scene,
+        &mut |r, _| {
+            if r.step > 0 {
+                on_step(r)
+            }
+        },
+        None,
+    )
 }
 
 /// Runs a 1D scene and returns its particles too.
 pub fn run_1d(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Outcome<1>, RunError> {
-    run_1d_observed(scene, &mut |r, _| {
-        if r.step > 0 {
-            on_step(r)
-        }
-    })
+    run_1d_observed(
+        scene,
+        &mut |r, _| {
+            if r.step > 0 {
+                on_step(r)
+            }
+        },
+        None,
+    )
 }
 
-fn run_2d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<2>, RunError> {
+fn run_2d_observed(
+    scene: &Scene,
+    on_step: &mut Observer,
+    stop: Option<&AtomicBool>,
+) -> Result<Outcome<2>, RunError> {
     let Domain { basis, h, walls } = setup::domain_2d(scene)?;
     match basis {
-        Basis2d::Ps(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
-        Basis2d::Linear(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
+        Basis2d::Ps(basis) => run_with(scene, Domain { basis, h, walls }, on_step, stop),
+        Basis2d::Linear(basis) => run_with(scene, Domain { basis, h, walls }, on_step, stop),
     }
 }
 
-fn run_1d_observed(scene: &Scene, on_step: &mut Observer) -> Result<Outcome<1>, RunError> {
+fn run_1d_observed(
+    scene: &Scene,
+    on_step: &mut Observer,
+    stop: Option<&AtomicBool>,
+) -> Result<Outcome<1>, RunError> {
     let Domain { basis, h, walls } = setup::domain_1d(scene)?;
     match basis {
-        Basis1d::Bspline(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
-        Basis1d::Linear(basis) => run_with(scene, Domain { basis, h, walls }, on_step),
+        Basis1d::Bspline(basis) => run_with(scene, Domain { basis, h, walls }, on_step, stop),
+        Basis1d::Linear(basis) => run_with(scene, Domain { basis, h, walls }, on_step, stop),
     }
 }
 
@@ -242,12 +283,13 @@ fn run_with<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     domain: Domain<B>,
     on_step: &mut Observer,
+    stop: Option<&AtomicBool>,
 ) -> Result<Outcome<D>, RunError>
 where
     Particles<f64, D>: AsParticlesRef,
 {
     let mut run = setup::set_up::<D, B>(scene, domain)?;
-    let tally = step_loop(scene, &mut run, on_step);
+    let tally = step_loop(scene, &mut run, on_step, stop);
     Ok(summarise(scene, run, tally))
 }
 
@@ -267,6 +309,7 @@ struct Tally {
     phases: PhaseTimes,
     rms: exact::RmsPositionError,
     failure: Option<StepError>,
+    interrupted: bool,
     seconds: f64,
     max_rotation: f64,
 }
@@ -309,6 +352,7 @@ fn step_loop<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     run: &mut Prepared<D, B>,
     on_step: &mut Observer,
+    stop: Option<&AtomicBool>,
 ) -> Tally
 where
     Particles<f64, D>: AsParticlesRef,
@@ -333,8 +377,13 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
+    let mut interrupted = false;
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
+        if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            interrupted = true;
+            break;
+        }
         let r = match driver.step() {
             Ok(r) => r,
             Err(e) => {
@@ -391,6 +440,7 @@ where
         phases,
         rms,
         failure,
+        interrupted,
         seconds: clock.elapsed().as_secs_f64(),
         max_rotation,
     }
@@ -491,6 +541,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             failure: failure.as_ref().map(|e| e.to_string()),
             max_rotation,
             warnings: warnings.into_iter().collect(),
+            interrupted: tally.interrupted,
             seconds: tally.seconds,
             phases: tally.phases,
         },

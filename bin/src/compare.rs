@@ -33,6 +33,10 @@ pub struct CompareArgs {
     jobs: Option<usize>,
     #[command(flatten)]
     overrides: Overrides,
+    /// Exit with status 1 when a variant failed or is unstable (default: 0, the
+    /// table marks it).
+    #[arg(long)]
+    strict: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -139,12 +143,8 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
         summaries.push(r?);
     }
     print_summaries(&summaries, args.format);
-    match summaries.iter().find_map(|s| s.failure.clone()) {
-        Some(reason) => Err(CliError::Numerical(format!(
-            "a variant failed: {reason} (the table shows it as unstable)"
-        ))),
-        None => Ok(()),
-    }
+    let failed = summaries.iter().filter(|s| !s.stable).count();
+    crate::error::study_verdict(args.strict, failed, summaries.len())
 }
 
 /// Prints summaries side by side.

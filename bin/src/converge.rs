@@ -35,6 +35,10 @@ pub struct ConvergeArgs {
     /// error-vs-wall-time plots (SVG) into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Exit with status 1 when a variant failed or is unstable (default: 0, the
+    /// table marks it).
+    #[arg(long)]
+    strict: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -120,7 +124,8 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     if let Some(dir) = &args.out {
         write_outputs(dir, &base.name, &rows)?;
     }
-    Ok(())
+    let failed = rows.iter().filter(|r| !r.stable).count();
+    crate::error::study_verdict(args.strict, failed, rows.len())
 }
 
 fn print_levels(rows: &[Level], format: Format) {

@@ -1,7 +1,7 @@
 //! `mpm-cli`: the command-line face of psmpm.
 //!
-//! Exit status: 0 on success, 2 for usage and input errors (unknown basis, bad
-//! mesh file, value out of range), 1 for a computation that failed numerically.
+//! Exit status: see [`error::EXIT_STATUS`] (0 success, 1 failed or unstable run,
+//! 2 bad input, 130 interrupted, 141 closed standard output).
 
 mod basis_cmd;
 mod compare;
@@ -21,7 +21,7 @@ use std::process::ExitCode;
 
 /// Material Point Method with Powell–Sabin spline bases on triangular grids.
 #[derive(Debug, Parser)]
-#[command(name = "mpm-cli", version, about, long_about = None)]
+#[command(name = "mpm-cli", version, about, long_about = None, after_help = error::EXIT_STATUS)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -51,7 +51,12 @@ enum Command {
     ///
     /// SCENE is a built-in scene (`mpm-cli scenes` lists them) or a scene file
     /// FILE.toml (`mpm-cli scene show NAME` prints one to start from). Energies
-    /// are per unit thickness. Exit status 1 if the run fails numerically.
+    /// are per unit thickness. Exit status 1 if the run fails numerically or is
+    /// judged UNSTABLE; 130 if interrupted (SIGINT/SIGTERM: the current step is
+    /// finished and the files and summary are written; a second signal exits at once).
+    /// With --format json or csv the rows are printed (and flushed) as they are
+    /// computed; the table is aligned and printed at the end.
+    #[command(after_help = error::EXIT_STATUS)]
     Run(run::RunArgs),
     /// List the built-in scenes, one line each.
     Scenes(scenes::ScenesArgs),
@@ -64,12 +69,14 @@ enum Command {
     /// tables), so that the variants have about the same number of functions, as in
     /// the thesis' PS 42 against PL 38 functions. Variants run in parallel; the
     /// results equal those of running them one by one.
+    #[command(after_help = error::EXIT_STATUS)]
     Compare(compare::CompareArgs),
     /// Refinement study: error, observed order and wall time per level and basis.
     ///
     /// Level l refines the scene's blocks by 2^l along the axes its `[study]` names
     /// (polygon meshes: edge length / 2^l). With --out, also writes the log-log
     /// error-vs-h and work-precision (error vs wall time) plots.
+    #[command(after_help = error::EXIT_STATUS)]
     Converge(converge::ConvergeArgs),
     /// Reproduce the seeds' benchmarks B2–B5: tables (markdown) and SVG figures.
     ///
@@ -90,11 +97,22 @@ enum Command {
     /// condition estimate, lumped rows and deactivated functions, and the wall time
     /// per step. Cases run in parallel; every column but the wall time is the same
     /// on any number of threads. See docs/stability.md.
+    #[command(after_help = error::EXIT_STATUS)]
     Stability(stability::StabilityArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Run(_)) {
+        // Rust ignores SIGPIPE, so that a closed stdout would make `println!` panic:
+        // the commands other than `run` (which stops itself, see run.rs) end quietly
+        // by SIGPIPE as other Unix tools do.
+        // SAFETY: setting a signal's disposition to the default before any thread
+        // is started.
+        unsafe {
+            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        }
+    }
     let result = match cli.command {
         Command::Project(args) => project::run(args),
         Command::Run(args) => run::run(args),
@@ -109,7 +127,10 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            if !e.quiet() {
+                use std::io::Write as _;
+                let _ = writeln!(std::io::stderr(), "error: {e}");
+            }
             ExitCode::from(e.exit_code())
         }
     }

@@ -12,7 +12,9 @@
 //!   `--format json`; floats in Rust's shortest round-trip `{:e}` form, integers as
 //!   integers, `condition` empty unless `--condition`). All CSV files are written
 //!   with the `csv` crate (RFC 4180 quoting where needed).
-//! - `summary.json`: the summary of `--format json`, pretty-printed.
+//! - `summary.json`: the summary of `--format json`, pretty-printed (with
+//!   `"interrupted": true` when SIGINT/SIGTERM or a closed stdout stopped the run;
+//!   the last frame and `particles.pvd` are written then too).
 //! - `particles_NNNNN.vtu` and `particles.pvd`: particle frames (position,
 //!   velocity, displacement, stress, volume, mass; see `psmpm::output::vtk`; binary
 //!   zlib-compressed VTK XML unless `--vtu ascii`) of the
@@ -208,6 +210,16 @@ impl Recorder {
             // The library's step count: t_end / dt, rounded (dt = the first step's time).
             // (The scene's own count is 1 for Courant-number scenes.)
             self.total = steps_from_dt(self.t_end, r.time);
+            let limit = psmpm::scene::limits::MAX_FRAMES;
+            if let Some(n) = self.every.filter(|&n| n > 0) {
+                let frames = self.total / n + 2;
+                if frames > limit {
+                    return Err(CliError::Input(format!(
+                        "--out-every {n}: {} steps give {frames} particle frames, above the limit of {limit}",
+                        self.total
+                    )));
+                }
+            }
         }
         if r.step > 0 {
             self.last_step = r.step;

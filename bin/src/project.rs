@@ -41,7 +41,8 @@ fn parse_mass(name: &str) -> Result<MassOption, String> {
         "consistent" => Ok(MassOption::Consistent),
         "lumped" => Ok(MassOption::Lumped),
         _ => Err(format!(
-            "unknown mass option `{name}` (known: consistent, lumped)"
+            "unknown mass option `{}` (known: consistent, lumped)",
+            psmpm::scene::limits::echo(name)
         )),
     }
 }
@@ -73,7 +74,7 @@ pub fn run(args: ProjectArgs) -> Result<(), CliError> {
     }
     let mesh = match &args.mesh {
         Some(path) => Some(
-            psmpm::basis::mesh::gmsh::read_msh(path).map_err(|e| CliError::Input(e.to_string()))?,
+            psmpm::scene::limits::read_mesh(&path.to_string_lossy()).map_err(CliError::Input)?,
         ),
         None => None,
     };

@@ -61,7 +61,8 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
     for name in &names {
         if !STUDIES.contains(&name.as_str()) {
             return Err(CliError::Input(format!(
-                "unknown study `{name}` (known: {}, all)",
+                "unknown study `{}` (known: {}, all)",
+                psmpm::scene::limits::echo(name),
                 STUDIES.join(", ")
             )));
         }

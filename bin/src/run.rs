@@ -10,10 +10,14 @@ use psmpm::driver::StepReport;
 use psmpm::mass::MassKind;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
+use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS};
 use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
+use std::io::Write;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// The options that adjust a scene's resolution and time (shared by `run`,
 /// `compare`, `converge`).
@@ -52,12 +56,25 @@ impl Overrides {
     /// Applies the overrides to `s` and validates it.
     pub fn apply(&self, mut s: Scene) -> Result<Scene, CliError> {
         let input = |e: psmpm::scene::SceneError| CliError::Input(e.to_string());
+        let dim = s.dim;
+        let one_d = |flag: &str, text: &str, second: usize| {
+            if dim == 1 && second != 1 {
+                Err(CliError::Input(format!(
+                    "{flag} {}: a 1D scene has one count; the second number must be 1 (e.g. 8x1), got {second}",
+                    echo(text)
+                )))
+            } else {
+                Ok(())
+            }
+        };
         if let Some(b) = &self.blocks {
             let (nx, ny) = pair(b, "--blocks")?;
+            one_d("--blocks", b, ny)?;
             s.set_blocks(nx, ny).map_err(input)?;
         }
         if let Some(p) = &self.particles {
             let (px, py) = pair(p, "--particles")?;
+            one_d("--particles", p, py)?;
             s.set_particles_per_block([px, py]);
         }
         if let Some(split) = &self.split {
@@ -69,7 +86,8 @@ impl Overrides {
                 "delaunay" => BlockLayout::Delaunay,
                 other => {
                     return Err(CliError::Input(format!(
-                        "--layout: unknown layout `{other}` (known: four-triangles, delaunay)"
+                        "--layout: unknown layout `{}` (known: four-triangles, delaunay)",
+                        echo(other)
                     )))
                 }
             };
@@ -87,8 +105,39 @@ impl Overrides {
         if self.condition {
             s.output.condition = true;
         }
-        s.validate().map_err(input)?;
+        s.validate()
+            .map_err(|e| CliError::Input(self.name_flags(&e)))?;
         Ok(s)
+    }
+
+    /// A validation error after the overrides, prefixed by the flags (and values)
+    /// that set the field.
+    fn name_flags(&self, e: &psmpm::scene::SceneError) -> String {
+        let field = e.field.as_str();
+        let mut flags = Vec::new();
+        if field.starts_with("time.") {
+            if let Some(dt) = self.dt {
+                flags.push(format!("--dt {dt:?}"));
+            }
+            if let Some(t) = self.t_end {
+                flags.push(format!("--t-end {t:?}"));
+            }
+        }
+        if field.starts_with("mesh.") {
+            if let Some(b) = &self.blocks {
+                flags.push(format!("--blocks {}", echo(b)));
+            }
+        }
+        if field.starts_with("body") || field == "material.density" {
+            if let Some(p) = &self.particles {
+                flags.push(format!("--particles {}", echo(p)));
+            }
+        }
+        if flags.is_empty() {
+            e.to_string()
+        } else {
+            format!("{}: {e}", flags.join(" "))
+        }
     }
 }
 
@@ -147,7 +196,7 @@ pub enum Vtu {
 
 /// Parses `AxB`.
 pub fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
-    let bad = || CliError::Input(format!("{what} must look like 4x1, got `{text}`"));
+    let bad = || CliError::Input(format!("{what} must look like 4x1, got `{}`", echo(text)));
     let (a, b) = text.split_once('x').ok_or_else(bad)?;
     Ok((a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?))
 }
@@ -176,8 +225,15 @@ pub fn run_error(scene: &str, e: RunError) -> CliError {
 /// taken relative to the file).
 pub fn read_scene(name: &str) -> Result<Scene, CliError> {
     if name.ends_with(".toml") {
-        let text = std::fs::read_to_string(name)
-            .map_err(|e| CliError::Input(format!("{name}: cannot read: {e}")))?;
+        use psmpm::scene::limits::{echo, read_bounded, MAX_SCENE_FILE_BYTES};
+        let bytes = read_bounded(std::path::Path::new(name), MAX_SCENE_FILE_BYTES)
+            .map_err(|e| CliError::Input(format!("{}: {e}", echo(name))))?;
+        let text = String::from_utf8(bytes).map_err(|_| {
+            CliError::Input(format!(
+                "{}: cannot read: stream did not contain valid UTF-8",
+                echo(name)
+            ))
+        })?;
         let mut s = Scene::from_toml(&text, name).map_err(|e| CliError::Input(e.to_string()))?;
         if let MeshSpec::Gmsh { file } = &mut s.mesh {
             let path = std::path::Path::new(file.as_str());
@@ -270,8 +326,62 @@ fn row_cells(r: &StepReport) -> Vec<String> {
     ]
 }
 
+/// Standard output of `run`: every line written and flushed at once; the first
+/// error (the reader went away) closes it and asks the run to stop.
+struct Stdout<'a> {
+    out: std::io::StdoutLock<'static>,
+    /// The error that closed it.
+    error: Option<std::io::Error>,
+    stop: &'a AtomicBool,
+}
+
+impl Stdout<'_> {
+    fn print(&mut self, text: &str) {
+        if self.error.is_some() {
+            return;
+        }
+        if let Err(e) = self
+            .out
+            .write_all(text.as_bytes())
+            .and_then(|()| self.out.flush())
+        {
+            self.error = Some(e);
+            self.stop.store(true, Ordering::Relaxed);
+        }
+    }
+
+    fn line(&mut self, text: &str) {
+        self.print(&format!("{text}\n"));
+    }
+
+    /// The status of a closed stdout: quiet for a broken pipe.
+    fn status(&mut self) -> Result<(), CliError> {
+        match self.error.take() {
+            None => Ok(()),
+            Some(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(CliError::BrokenPipe),
+            Some(e) => Err(CliError::Numerical(format!("standard output: {e}"))),
+        }
+    }
+}
+
+/// The stop flag of a run: the first SIGINT or SIGTERM sets it (the run finishes
+/// its step and ends), a second one exits at once with status 130.
+fn stop_on_signals() -> Result<Arc<AtomicBool>, CliError> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [SIGINT, SIGTERM] {
+        // Registered first, so that it sees the flag as it was before this signal.
+        signal_hook::flag::register_conditional_shutdown(signal, 130, Arc::clone(&stop))
+            .and_then(|_| signal_hook::flag::register(signal, Arc::clone(&stop)))
+            .map_err(|e| CliError::Numerical(format!("cannot handle signals: {e}")))?;
+    }
+    Ok(stop)
+}
+
 /// Runs the scene and prints diagnostics and the summary (and writes the files of
-/// `--out`).
+/// `--out`). JSON and CSV rows are printed as they are computed; the table is
+/// aligned at the end. A closed stdout or a first SIGINT/SIGTERM stops the run after
+/// the current step; the files of `--out` and the summary are still written.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
     let s = scene(&args)?;
     let every = args
@@ -281,6 +391,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         } else {
             (s.steps() / 20).max(1)
         });
+    check_sizes(&s, &args, every)?;
     let mut recorder = match &args.out {
         Some(dir) => {
             let options = out::OutOptions {
@@ -294,6 +405,12 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             Some(Recorder::create(dir, options, &s)?)
         }
         None => None,
+    };
+    let stop = stop_on_signals()?;
+    let mut stdout = Stdout {
+        out: std::io::stdout().lock(),
+        error: None,
+        stop: &stop,
     };
     let progress = Progress::new(s.steps() as u64, "steps");
     let t_end = s.time.t_end;
@@ -313,12 +430,12 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         progress.inc(1);
         if every > 0 && r.step % every == 0 {
             match format {
-                Format::Json => println!("{}", row_json(r)),
+                Format::Json => stdout.line(&row_json(r).to_string()),
                 Format::Csv => {
                     if std::mem::take(&mut csv_header) {
-                        println!("{}", out::csv_record(&COLUMNS));
+                        stdout.line(&out::csv_record(&COLUMNS));
                     }
-                    println!("{}", row_csv(r));
+                    stdout.line(&row_csv(r));
                 }
                 Format::Table => table.push(row_cells(r)),
             }
@@ -327,11 +444,11 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let setup = |e: RunError| run_error(&args.scene, e);
     let (summary, tracked, last) = match s.dim {
         2 => {
-            let o = simulation::observe_2d(&s, &mut observer).map_err(setup)?;
+            let o = simulation::observe_2d_until(&s, &mut observer, &stop).map_err(setup)?;
             (o.summary, o.tracked, Last::Two(o.particles))
         }
         _ => {
-            let o = simulation::observe_1d(&s, &mut observer).map_err(setup)?;
+            let o = simulation::observe_1d_until(&s, &mut observer, &stop).map_err(setup)?;
             (o.summary, o.tracked, Last::One(o.particles))
         }
     };
@@ -345,29 +462,80 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             .map(|files| out::files_line(&dir, &files))
     });
     match format {
-        Format::Json => println!("{}", summary_json(&summary)),
+        Format::Json => stdout.line(&summary_json(&summary).to_string()),
         // stdout stays CSV: the summary goes to stderr as `# key=value` lines.
         Format::Csv => eprint!("{}", summary_comments(&summary)),
         Format::Table => {
             if every > 0 {
-                print!("{}", table.render());
-                println!();
+                stdout.line(&table.render());
             }
-            print!("{}", summary_text(&summary));
+            stdout.print(&summary_text(&summary));
         }
     }
     if let Some(written) = written {
         let line = written?;
         // stdout stays machine-readable for --format json and csv.
         match format {
-            Format::Table => println!("{line}"),
-            Format::Json | Format::Csv => eprintln!("{line}"),
+            Format::Table => stdout.line(&line),
+            Format::Json | Format::Csv => {
+                let _ = writeln!(std::io::stderr(), "{line}");
+            }
         }
+    }
+    stdout.status()?;
+    if summary.interrupted {
+        return Err(CliError::Interrupted);
     }
     match &summary.failure {
         Some(reason) => Err(CliError::Numerical(reason.clone())),
+        None if !summary.stable => Err(CliError::Numerical(format!(
+            "the run is UNSTABLE: {}",
+            unstable_reason(&summary)
+        ))),
         None => Ok(()),
     }
+}
+
+/// Which bound of the verdict an unstable run that did not fail broke.
+fn unstable_reason(summary: &Summary) -> String {
+    match summary.max_condition {
+        Some(c) if c >= simulation::STABLE_CONDITION => format!(
+            "condition estimate {} ≥ {}",
+            sci(c),
+            sci(simulation::STABLE_CONDITION)
+        ),
+        _ => format!(
+            "energy growth {:.2e} of the energy scale ≥ {}",
+            summary.energy_growth,
+            simulation::STABLE_ENERGY_GROWTH
+        ),
+    }
+}
+
+/// The sizes `run`'s options control, checked before the run: frames of `--out`
+/// and rows of the table (the scene's own limits are checked by its validation).
+fn check_sizes(s: &Scene, args: &RunArgs, every: usize) -> Result<(), CliError> {
+    let steps = s.steps();
+    if s.time.dt.is_none() {
+        // Courant-number scenes know their steps only at the start of the run
+        // (the recorder checks the frames then).
+        return Ok(());
+    }
+    if let (Some(_), Some(n)) = (&args.out, args.out_every) {
+        let frames = steps.checked_div(n).unwrap_or(0) + 2;
+        if frames > MAX_FRAMES {
+            return Err(CliError::Input(format!(
+                "--out-every {n}: {steps} steps give {frames} particle frames, above the limit of {MAX_FRAMES}"
+            )));
+        }
+    }
+    if args.format == Format::Table && every > 0 && steps / every > MAX_TABLE_ROWS {
+        return Err(CliError::Input(format!(
+            "--diag-every {every}: {steps} steps give {} table rows, above the limit of {MAX_TABLE_ROWS}; use --format csv or json (which stream) or a larger --diag-every",
+            steps / every
+        )));
+    }
+    Ok(())
 }
 
 /// The particles at the end of a run, in its dimension.
@@ -436,6 +604,12 @@ pub fn summary_text(summary: &Summary) -> String {
     );
     if let Some(reason) = &summary.failure {
         out += &format!("stopped: {reason}\n");
+    }
+    if summary.interrupted {
+        out += &format!(
+            "interrupted after step {} (t = {}): the summary covers the steps taken\n",
+            summary.steps, summary.t_end
+        );
     }
     let p = &summary.phases;
     let total = (p.evaluate + p.assemble + p.solve + p.update).max(f64::MIN_POSITIVE);

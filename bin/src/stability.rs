@@ -76,6 +76,9 @@ pub struct StabilityArgs {
     /// Runs at the same time (default: the number of cores).
     #[arg(long)]
     jobs: Option<usize>,
+    /// Exit with status 1 when a case is unstable (default: 0, the table marks it).
+    #[arg(long)]
+    strict: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -197,7 +200,8 @@ fn select(spec: &str, all: &[(String, PathBuf)]) -> Result<Vec<(String, PathBuf)
         if !hit {
             let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
             return Err(CliError::Input(format!(
-                "--cases: unknown case `{w}` (known: quick, all, {})",
+                "--cases: unknown case `{}` (known: quick, all, {})",
+                psmpm::scene::limits::echo(w),
                 names.join(", ")
             )));
         }
@@ -567,7 +571,8 @@ pub fn stability(args: StabilityArgs) -> Result<(), CliError> {
     }
     let cells = run_matrix(&cases, &masses, jobs)?;
     print(&cells, args.format, jobs);
-    Ok(())
+    let failed = cells.iter().filter(|c| !c.stable).count();
+    crate::error::study_verdict(args.strict, failed, cells.len())
 }
 
 #[cfg(test)]

@@ -112,12 +112,16 @@ impl MassKind {
             Some((h, a)) => (h, Some(a)),
             None => (name, None),
         };
+        let shown = crate::scene::limits::echo(name);
         let number = |a: &str| -> Result<f64, String> {
             a.parse::<f64>()
                 .ok()
                 .filter(|v| *v > 0.0 && v.is_finite())
                 .ok_or_else(|| {
-                    format!("`{name}`: the threshold must be a positive number, got `{a}`")
+                    format!(
+                        "`{shown}`: the threshold must be a positive number, got `{}`",
+                        crate::scene::limits::echo(a)
+                    )
                 })
         };
         let fraction = |a: &str| -> Result<f64, String> {
@@ -125,7 +129,10 @@ impl MassKind {
                 .ok()
                 .filter(|v| *v > 0.0 && *v < 1.0)
                 .ok_or_else(|| {
-                    format!("`{name}`: the coverage must be a number in (0, 1), got `{a}`")
+                    format!(
+                        "`{shown}`: the coverage must be a number in (0, 1), got `{}`",
+                        crate::scene::limits::echo(a)
+                    )
                 })
         };
         match (head, arg) {
@@ -153,10 +160,13 @@ impl MassKind {
                 .filter(|k| *k <= 64)
                 .map(|order| MassKind::Fmpm { order })
                 .ok_or_else(|| {
-                    format!("`{name}`: the order must be an integer in 0..=64, got `{a}`")
+                    format!(
+                        "`{shown}`: the order must be an integer in 0..=64, got `{}`",
+                        crate::scene::limits::echo(a)
+                    )
                 }),
             _ => Err(format!(
-                "unknown mass strategy `{name}` (known: {MASS_NAMES})"
+                "unknown mass strategy `{shown}` (known: {MASS_NAMES})"
             )),
         }
     }

@@ -70,14 +70,15 @@ mod annotate;
 mod builders;
 mod builtin;
 mod derived;
+pub mod limits;
 mod locate;
 mod names;
 mod validate;
 
 pub use annotate::annotate;
 pub use builtin::BUILTIN;
+pub use limits::{MAX_BLOCKS, MAX_PARTICLES};
 pub use names::{parse_split, split_to_str};
-pub use validate::{MAX_BLOCKS, MAX_PARTICLES};
 
 /// A fully declared run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -52,7 +52,8 @@ pub fn parse_split(name: &str) -> Result<SplitPoint, String> {
         "incentre" => Ok(SplitPoint::Incentre),
         "centroid" => Ok(SplitPoint::Centroid),
         other => Err(format!(
-            "unknown split point `{other}` (known: incentre, centroid)"
+            "unknown split point `{}` (known: incentre, centroid)",
+            super::limits::echo(other)
         )),
     }
 }

@@ -1,14 +1,13 @@
 //! Validation: a scene is consistent, or the error names the field.
 
+use super::limits::{
+    MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_PARTICLES,
+    MAX_STEPS, MAX_TRIANGLES,
+};
 use super::{
     bad, conflict, Body, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec,
     Reference, Scene, SceneError,
 };
-
-/// Most blocks a `blocks` mesh may have.
-pub const MAX_BLOCKS: usize = 1_000_000;
-/// Most particles a scene may have.
-pub const MAX_PARTICLES: usize = 10_000_000;
 
 impl Scene {
     /// Checks that the scene is consistent; the error names the field.
@@ -69,33 +68,32 @@ impl Scene {
                 }
                 interval("mesh.x", *x)?;
                 interval("mesh.y", *y)?;
-                if blocks.iter().any(|&n| n == 0 || n > 4096) {
-                    return Err(bad(
-                        "mesh.blocks",
-                        format!("each count must be in 1..=4096, got {blocks:?}"),
-                    ));
-                }
-                if blocks[0] * blocks[1] > MAX_BLOCKS {
-                    return Err(bad(
-                        "mesh.blocks",
-                        format!(
-                            "{} blocks in all is above the limit of {MAX_BLOCKS}",
-                            blocks[0] * blocks[1]
-                        ),
-                    ));
-                }
+                check_blocks("mesh.blocks", *blocks)?;
             }
             MeshSpec::Polygon {
                 outline,
                 tags,
                 edge_length,
-                ..
+                holes,
             } => {
                 if d != 2 {
                     return Err(conflict("mesh.kind", "`polygon` is a 2D mesh"));
                 }
                 if outline.len() < 3 {
                     return Err(bad("mesh.outline", "needs at least 3 corners"));
+                }
+                let corners = outline.len() + holes.iter().map(|h| h.outline.len()).sum::<usize>();
+                if corners > MAX_OUTLINE_CORNERS {
+                    return Err(bad(
+                        "mesh.outline",
+                        format!(
+                            "{corners} corners (outline and holes) is above the limit of {MAX_OUTLINE_CORNERS}"
+                        ),
+                    ));
+                }
+                for (i, p) in outline.iter().enumerate() {
+                    finite(&format!("mesh.outline[{i}]"), p[0])?;
+                    finite(&format!("mesh.outline[{i}]"), p[1])?;
                 }
                 if !tags.is_empty() && tags.len() != outline.len() {
                     return Err(bad(
@@ -108,6 +106,7 @@ impl Scene {
                     ));
                 }
                 positive("mesh.edge_length", *edge_length)?;
+                check_triangles("mesh.edge_length", outline, *edge_length)?;
             }
             MeshSpec::Gmsh { file } => {
                 if d != 2 {
@@ -125,12 +124,7 @@ impl Scene {
                     ));
                 }
                 interval("mesh.x", *x)?;
-                if *elements == 0 || *elements > 1_000_000 {
-                    return Err(bad(
-                        "mesh.elements",
-                        format!("must be in 1..=1000000, got {elements}"),
-                    ));
-                }
+                check_elements("mesh.elements", *elements)?;
             }
         }
         crate::material::Elastic::new(
@@ -219,6 +213,28 @@ impl Scene {
                     "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
                 ),
             ));
+        }
+        for (b, body) in self.bodies.iter().enumerate() {
+            // The particle mass is ρ0 times the lattice cell volume: reject a density
+            // or a lattice so small that the product underflows to zero.
+            let volume: f64 = (0..d)
+                .map(|k| self.lattice_spacing(body, k).unwrap_or(1.0))
+                .product();
+            let mass = self.material.density * volume;
+            if !(mass > 0.0 && mass.is_finite()) {
+                let field = if volume > 0.0 && volume.is_finite() {
+                    "material.density".to_string()
+                } else {
+                    format!("body[{b}].max")
+                };
+                return Err(bad(
+                    field,
+                    format!(
+                        "the particles of body[{b}] would have mass {mass:e} (density {} times particle volume {volume:e}); it must be positive and finite",
+                        self.material.density
+                    ),
+                ));
+            }
         }
         match &self.initial_velocity {
             InitialVelocity::Uniform { value } => vector("initial_velocity.value", value)?,
@@ -311,9 +327,28 @@ impl Scene {
             }
         }
         positive("time.t_end", self.time.t_end)?;
+        if let Some(dt) = self.time.dt {
+            let steps = self.time.t_end / dt;
+            if steps > MAX_STEPS as f64 {
+                return Err(bad(
+                    "time.dt",
+                    format!(
+                        "t_end / dt = {:?} / {dt:?} = {steps:.3e} steps is above the limit of {MAX_STEPS}",
+                        self.time.t_end
+                    ),
+                ));
+            }
+        }
         if self.study.refine.contains(&Component::Normal) {
             return Err(bad("study.refine", "lists axes, `x` or `y`"));
         }
+        if d == 1 && self.study.refine.contains(&Component::Y) {
+            return Err(bad(
+                "study.refine",
+                "`y` does not exist in a 1D scene (refine `x` or leave it out)",
+            ));
+        }
+        self.validate_resolutions()?;
         for (i, t) in self.output.tracked.iter().enumerate() {
             vector(&format!("output.tracked[{i}]"), t)?;
         }
@@ -344,6 +379,72 @@ impl Scene {
         Ok(())
     }
 
+    /// The `[[resolution]]` tables: each names a basis of the scene's dimension and
+    /// changes only what the scene's mesh has, within the limits.
+    fn validate_resolutions(&self) -> Result<(), SceneError> {
+        let d = self.dim;
+        for (i, r) in self.resolutions.iter().enumerate() {
+            let field = |f: &str| format!("resolution[{i}].{f}");
+            if r.basis.dim() != d {
+                return Err(bad(
+                    field("basis"),
+                    format!(
+                        "`{}` is a {}D basis but the scene is {d}D",
+                        r.basis.name(),
+                        r.basis.dim()
+                    ),
+                ));
+            }
+            if let Some(blocks) = r.blocks {
+                match &self.mesh {
+                    MeshSpec::Blocks { .. } => check_blocks(&field("blocks"), blocks)?,
+                    MeshSpec::Interval { .. } => {
+                        if blocks[1] != 1 {
+                            return Err(bad(
+                                field("blocks"),
+                                format!(
+                                    "a 1D scene has one count of elements: the second number must be 1, got {blocks:?}"
+                                ),
+                            ));
+                        }
+                        check_elements(&field("blocks"), blocks[0])?;
+                    }
+                    _ => return Err(bad(field("blocks"), "the scene's mesh has no blocks")),
+                }
+            }
+            if let Some(h) = r.edge_length {
+                let MeshSpec::Polygon { outline, .. } = &self.mesh else {
+                    return Err(bad(
+                        field("edge_length"),
+                        "the scene's mesh is not a polygon",
+                    ));
+                };
+                if !(h > 0.0 && h.is_finite()) {
+                    return Err(bad(
+                        field("edge_length"),
+                        format!("must be positive and finite, got {h}"),
+                    ));
+                }
+                check_triangles(&field("edge_length"), outline, h)?;
+            }
+            if let Some(p) = &r.per_block {
+                if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
+                    return Err(bad(
+                        field("per_block"),
+                        format!("needs {d} counts in 1..=1000, got {p:?}"),
+                    ));
+                }
+                if self.blocks().is_none() {
+                    return Err(bad(
+                        field("per_block"),
+                        "needs a `blocks` or `interval` mesh",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// About how many particles `body` gets (exact for aligned boxes).
     fn estimated_particles(&self, body: &Body) -> f64 {
         (0..self.dim)
@@ -353,4 +454,59 @@ impl Scene {
             })
             .product()
     }
+}
+
+/// Block counts of a `blocks` mesh within [`MAX_BLOCKS_PER_AXIS`] and [`MAX_BLOCKS`].
+fn check_blocks(field: &str, blocks: [usize; 2]) -> Result<(), SceneError> {
+    if blocks.iter().any(|&n| n == 0 || n > MAX_BLOCKS_PER_AXIS) {
+        return Err(bad(
+            field,
+            format!("each count must be in 1..={MAX_BLOCKS_PER_AXIS}, got {blocks:?}"),
+        ));
+    }
+    let all = blocks[0] * blocks[1];
+    if all > MAX_BLOCKS {
+        return Err(bad(
+            field,
+            format!("{all} blocks in all is above the limit of {MAX_BLOCKS}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Elements of an interval within [`MAX_ELEMENTS_1D`].
+fn check_elements(field: &str, elements: usize) -> Result<(), SceneError> {
+    if elements == 0 || elements > MAX_ELEMENTS_1D {
+        return Err(bad(
+            field,
+            format!("must be in 1..={MAX_ELEMENTS_1D}, got {elements}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The triangles of a polygon mesh with edge length `h`, estimated from the area of
+/// the outline's bounding box (an equilateral triangle of side `h` has area
+/// `√3/4 h²`), within [`MAX_TRIANGLES`].
+fn check_triangles(field: &str, outline: &[[f64; 2]], h: f64) -> Result<(), SceneError> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in outline {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    let triangles = area / (0.25 * 3f64.sqrt() * h * h);
+    if triangles.is_nan() || triangles > MAX_TRIANGLES as f64 {
+        return Err(bad(
+            field,
+            format!(
+                "edge length {h} on an outline of extent {} × {} gives about {triangles:.3e} triangles, above the limit of {MAX_TRIANGLES}",
+                hi[0] - lo[0],
+                hi[1] - lo[1]
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -117,7 +117,7 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
                 _ => value("mesh.outline", e),
             })?
         }
-        MeshSpec::Gmsh { file } => psmpm_basis::mesh::gmsh::read_msh(std::path::Path::new(file))
+        MeshSpec::Gmsh { file } => crate::scene::limits::read_mesh(file)
             .map_err(|e| SceneError::new("mesh.file", ErrorKind::File, e.to_string()))?,
         MeshSpec::Interval { .. } => {
             return Err(conflict("mesh.kind", "`interval` is a 1D mesh").into())
@@ -135,7 +135,7 @@ fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
                 ErrorKind::Unknown,
                 format!(
                     "unknown boundary tag `{}`; the mesh has tags {tags:?}",
-                    bc.tag
+                    crate::scene::limits::echo(&bc.tag)
                 ),
             )
             .into());

@@ -102,7 +102,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         &walls,
         &lattice.body_sizes,
     )?;
-    let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt);
+    let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt)?;
     if let (Some(critical), None, false) = (
         dt_critical,
         scene.time.courant,
@@ -218,22 +218,42 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     driver: &mut SceneDriver<D, B>,
     dt: f64,
-) -> (f64, usize, Option<f64>) {
+) -> Result<(f64, usize, Option<f64>), RunError> {
+    use crate::scene::limits::MAX_STEPS;
     let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
     match scene.time.courant {
         Some(c) => {
-            let steps = (scene.time.t_end / (c * dt_critical.unwrap_or(dt / c)))
-                .ceil()
-                .max(1.0) as usize;
-            let dt = scene.time.t_end / steps as f64;
+            let t_end = scene.time.t_end;
+            let step = c * dt_critical.unwrap_or(dt / c);
+            let ratio = t_end / step;
+            // As for a fixed `dt` (whose count is rounded): an end time shorter than
+            // half a step is shorter than one step.
+            if ratio < 0.5 {
+                return Err(SceneError::new(
+                    "time.t_end",
+                    ErrorKind::Conflict,
+                    format!("is shorter than one time step (t_end = {t_end}, courant = {c} gives dt = {step:e})"),
+                )
+                .into());
+            }
+            if ratio.is_nan() || ratio > MAX_STEPS as f64 {
+                return Err(SceneError::new(
+                    "time.t_end",
+                    ErrorKind::Value,
+                    format!("t_end = {t_end} with courant = {c} (dt = {step:e}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}"),
+                )
+                .into());
+            }
+            let steps = ratio.ceil().max(1.0) as usize;
+            let dt = t_end / steps as f64;
             driver.set_dt(dt);
-            (dt, steps, dt_critical)
+            Ok((dt, steps, dt_critical))
         }
-        None => (
+        None => Ok((
             dt,
             (scene.time.t_end / dt).round().max(1.0) as usize,
             dt_critical,
-        ),
+        )),
     }
 }
 

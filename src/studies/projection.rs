@@ -48,7 +48,10 @@ impl MassOption {
 /// Why a projection failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProjectionError {
-    #[error("Gram matrix: {0}")]
+    #[error(
+        "the Gram matrix is not positive definite (non-positive pivot at row {} of the reordered matrix)",
+        .0.row
+    )]
     NotPositiveDefinite(#[from] NotPositiveDefinite),
     #[error("function {function} has zero integral ∫ phi = {integral:e}; cannot lump")]
     ZeroLumpedRow { function: usize, integral: f64 },

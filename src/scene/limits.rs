@@ -1,0 +1,118 @@
+//! Limits on every size that untrusted input (a scene file, a mesh file, the command
+//! line) controls, checked before anything of that size is allocated or computed.
+//!
+//! [`Scene::validate`](super::Scene::validate) checks them, so every command that
+//! reads a scene gets them; the command line checks its overrides against the same
+//! constants. An error names the value and the limit.
+
+use std::io::Read;
+use std::path::Path;
+
+/// Most time steps a run may take (`t_end / dt`, with command-line overrides).
+pub const MAX_STEPS: usize = 10_000_000;
+/// Most particles a scene may have.
+pub const MAX_PARTICLES: usize = 10_000_000;
+/// Most blocks a `blocks` mesh may have in all.
+pub const MAX_BLOCKS: usize = 1_000_000;
+/// Most blocks of a `blocks` mesh along one axis.
+pub const MAX_BLOCKS_PER_AXIS: usize = 4096;
+/// Most elements of a 1D `interval` mesh.
+pub const MAX_ELEMENTS_1D: usize = 1_000_000;
+/// Most triangles a `polygon` mesh may be expected to have (estimated from the area
+/// of the outline's bounding box and the edge length, before meshing).
+pub const MAX_TRIANGLES: usize = 4_000_000;
+/// Most corners of a `polygon` mesh's outline and holes together.
+pub const MAX_OUTLINE_CORNERS: usize = 100_000;
+/// Most particle frames `run --out` writes.
+pub const MAX_FRAMES: usize = 100_000;
+/// Most rows `run --format table` collects (it aligns them at the end); more need
+/// `--format csv` or `json`, which stream.
+pub const MAX_TABLE_ROWS: usize = 100_000;
+/// Largest Gmsh mesh file read, in bytes.
+pub const MAX_MESH_FILE_BYTES: u64 = 256 * 1024 * 1024;
+/// Largest scene file read, in bytes.
+pub const MAX_SCENE_FILE_BYTES: u64 = 4 * 1024 * 1024;
+/// Most characters of user text echoed in a message (longer text is cut).
+pub const MAX_ECHO_CHARS: usize = 80;
+
+/// Reads the regular file `path` of at most `limit` bytes. Devices, FIFOs and
+/// sockets are refused before they are opened (so that `/dev/zero` or a FIFO can
+/// neither exhaust memory nor block), a directory fails to read; the size is checked
+/// again while reading. The error says what is wrong (`cannot read: …`, `is N bytes,
+/// above the limit …`) without the path.
+pub fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+    let cannot = |e: std::io::Error| format!("cannot read: {e}");
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if !meta.is_file() && !meta.is_dir() {
+        return Err("cannot read: not a regular file (a device, FIFO or socket)".into());
+    }
+    let too_big = |size: u64| format!("is {size} bytes, above the limit of {limit} bytes");
+    if meta.is_file() && meta.len() > limit {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let mut bytes = Vec::with_capacity(meta.len().min(limit) as usize);
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// Reads a Gmsh `.msh` file: a regular file of at most [`MAX_MESH_FILE_BYTES`] (the
+/// error names the file).
+pub fn read_mesh(file: &str) -> Result<psmpm_basis::TriMesh, String> {
+    let bytes = read_bounded(Path::new(file), MAX_MESH_FILE_BYTES)
+        .map_err(|e| format!("{}: {e}", echo(file)))?;
+    psmpm_basis::mesh::gmsh::parse_msh(&String::from_utf8_lossy(&bytes), file)
+        .map_err(|e| e.to_string())
+}
+
+/// User text as it is echoed in messages: control characters escaped (`\n`,
+/// `\u{1b}`, …) and cut to [`MAX_ECHO_CHARS`] characters with an ellipsis.
+pub fn echo(text: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in text.chars().enumerate() {
+        if n == MAX_ECHO_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn echo_escapes_and_cuts() {
+        assert_eq!(echo("a\nb\u{1b}[31m"), "a\\nb\\u{1b}[31m");
+        let long = "x".repeat(200);
+        let e = echo(&long);
+        assert_eq!(e.chars().count(), MAX_ECHO_CHARS + 1);
+        assert!(e.ends_with('…'));
+        assert_eq!(echo("ok"), "ok");
+    }
+
+    #[test]
+    fn read_bounded_refuses_directories_and_big_files() {
+        let dir = std::env::temp_dir();
+        assert!(read_bounded(&dir, 10).unwrap_err().contains("cannot read"));
+        assert!(read_bounded(Path::new("/dev/zero"), 10)
+            .unwrap_err()
+            .contains("not a regular file"));
+        let file = dir.join(format!("psmpm-limits-{}", std::process::id()));
+        std::fs::write(&file, b"0123456789ab").unwrap();
+        assert!(read_bounded(&file, 10).unwrap_err().contains("limit of 10"));
+        assert_eq!(read_bounded(&file, 12).unwrap().len(), 12);
+        let _ = std::fs::remove_file(&file);
+    }
+}

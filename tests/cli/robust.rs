@@ -1,0 +1,728 @@
+//! Nothing a user types can crash, hang or be silently changed (issue 13).
+//!
+//! Extreme and malformed inputs (scene files, meshes, command lines) end with the
+//! exit status of the documented rule (`mpm-cli --help`) and a message naming the
+//! value and the limit, before any large allocation; a closed stdout ends `run`
+//! quietly; SIGINT makes `run` write its files and exit with 130.
+
+use assert_cmd::Command;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+use std::time::Duration;
+
+fn cli() -> Command {
+    let mut c = Command::cargo_bin("mpm-cli").unwrap();
+    // A hang is a failure, not a stuck test.
+    c.timeout(Duration::from_secs(120));
+    c
+}
+
+/// A fresh directory for the files of one test.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("psmpm-robust-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A small 2D bar on blocks.
+const BAR: &str = r#"name = "bar"
+dim = 2
+basis = "ps"
+mass = "consistent"
+
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 1.0]
+blocks = [4, 1]
+
+[material]
+model = "linear-elastic"
+young = 100.0
+poisson = 0.25
+density = 1.0
+
+[[body]]
+min = [0.0, 0.0]
+max = [4.0, 1.0]
+per_block = [2, 2]
+
+[[boundary]]
+tag = "left"
+fix = ["x", "y"]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+"#;
+
+/// A small 1D bar.
+const ROD: &str = r#"name = "rod"
+dim = 1
+basis = "bspline"
+mass = "consistent"
+
+[mesh]
+kind = "interval"
+x = [0.0, 4.0]
+elements = 4
+
+[material]
+model = "linear-elastic"
+young = 100.0
+density = 1.0
+
+[[body]]
+min = [0.0]
+max = [4.0]
+per_block = [2]
+
+[[boundary]]
+tag = "left"
+fix = ["x"]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+"#;
+
+/// A square on a polygon mesh.
+const SQUARE: &str = r#"name = "square"
+dim = 2
+basis = "pl"
+mass = "consistent"
+
+[mesh]
+kind = "polygon"
+outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+edge_length = 0.25
+
+[material]
+model = "linear-elastic"
+young = 100.0
+poisson = 0.25
+density = 1.0
+
+[[body]]
+min = [0.1, 0.1]
+max = [0.9, 0.9]
+count = [4, 4]
+
+[[boundary]]
+tag = "boundary"
+fix = ["x", "y"]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+"#;
+
+/// A Gmsh scene whose mesh file is `FILE`.
+const GMSH: &str = r#"name = "gmsh"
+dim = 2
+basis = "pl"
+
+[mesh]
+kind = "gmsh"
+file = "FILE"
+
+[material]
+model = "linear-elastic"
+young = 100.0
+density = 1.0
+
+[[body]]
+min = [0.1, 0.1]
+max = [0.9, 0.9]
+count = [4, 4]
+
+[time]
+dt = 1e-3
+t_end = 0.01
+"#;
+
+/// `base` with each `(from, to)` replaced once (`from` must occur).
+fn edited(base: &str, edits: &[(&str, &str)]) -> String {
+    let mut text = base.to_string();
+    for (from, to) in edits {
+        assert!(text.contains(from), "`{from}` is not in the base scene");
+        text = text.replacen(from, to, 1);
+    }
+    text
+}
+
+/// One malformed or extreme input: a scene file (written as `scene.toml`, the `@`
+/// in `args`) and a command line, with the exit status and a fragment of stderr.
+struct Case {
+    name: &'static str,
+    scene: Option<String>,
+    args: Vec<String>,
+    status: i32,
+    fragment: String,
+}
+
+fn scene_case(name: &'static str, scene: String, fragment: &str) -> Case {
+    Case {
+        name,
+        scene: Some(scene),
+        args: vec!["run".into(), "@".into()],
+        status: 2,
+        fragment: fragment.into(),
+    }
+}
+
+fn args_case(name: &'static str, scene: Option<String>, args: &[&str], fragment: &str) -> Case {
+    Case {
+        name,
+        scene,
+        args: args.iter().map(|a| a.to_string()).collect(),
+        status: 2,
+        fragment: fragment.into(),
+    }
+}
+
+fn scene_cases() -> Vec<Case> {
+    let bar = |edits: &[(&str, &str)]| edited(BAR, edits);
+    let rod = |edits: &[(&str, &str)]| edited(ROD, edits);
+    let square = |edits: &[(&str, &str)]| edited(SQUARE, edits);
+    let many_corners: String = (0..100_001)
+        .map(|i| {
+            let a = i as f64 * 2.0 * std::f64::consts::PI / 100_001.0;
+            format!("[{:.6}, {:.6}]", a.cos(), a.sin())
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    vec![
+        scene_case(
+            "steps-over-the-limit",
+            bar(&[("t_end = 0.01", "t_end = 1e5")]),
+            "steps is above the limit of 10000000",
+        ),
+        scene_case(
+            "tiny-dt",
+            bar(&[("dt = 1e-3", "dt = 1e-300")]),
+            "time.dt: t_end / dt",
+        ),
+        scene_case(
+            "subnormal-dt",
+            bar(&[("dt = 1e-3", "dt = 5e-324")]),
+            "above the limit of 10000000",
+        ),
+        scene_case(
+            "end-before-one-step",
+            bar(&[("t_end = 0.01", "t_end = 1e-4")]),
+            "time.t_end: is shorter than one time step",
+        ),
+        scene_case(
+            "courant-end-before-one-step",
+            bar(&[
+                ("dt = 1e-3", "courant = 0.5"),
+                ("t_end = 0.01", "t_end = 1e-9"),
+            ]),
+            "time.t_end: is shorter than one time step",
+        ),
+        scene_case(
+            "courant-too-many-steps",
+            bar(&[
+                ("dt = 1e-3", "courant = 1e-9"),
+                ("t_end = 0.01", "t_end = 1e3"),
+            ]),
+            "above the limit of 10000000",
+        ),
+        scene_case(
+            "blocks-per-axis",
+            bar(&[("blocks = [4, 1]", "blocks = [5000, 1]")]),
+            "mesh.blocks: each count must be in 1..=4096",
+        ),
+        scene_case(
+            "blocks-in-all",
+            bar(&[("blocks = [4, 1]", "blocks = [4096, 4096]")]),
+            "blocks in all is above the limit of 1000000",
+        ),
+        scene_case(
+            "no-blocks",
+            bar(&[("blocks = [4, 1]", "blocks = [0, 1]")]),
+            "mesh.blocks",
+        ),
+        scene_case(
+            "interval-elements",
+            rod(&[("elements = 4", "elements = 2000000")]),
+            "mesh.elements: must be in 1..=1000000",
+        ),
+        scene_case(
+            "particles-per-block",
+            bar(&[
+                ("blocks = [4, 1]", "blocks = [64, 64]"),
+                ("per_block = [2, 2]", "per_block = [1000, 1000]"),
+            ]),
+            "above the limit of 10000000",
+        ),
+        scene_case(
+            "particle-count",
+            square(&[("count = [4, 4]", "count = [100000, 100000]")]),
+            "particles, above the limit of 10000000",
+        ),
+        scene_case(
+            "polygon-edge-length",
+            square(&[("edge_length = 0.25", "edge_length = 1e-6")]),
+            "mesh.edge_length: edge length 0.000001",
+        ),
+        scene_case(
+            "polygon-edge-length-tiny",
+            square(&[("edge_length = 0.25", "edge_length = 1e-300")]),
+            "triangles, above the limit of 4000000",
+        ),
+        scene_case(
+            "polygon-corners",
+            square(&[(
+                "outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]",
+                &format!("outline = [{many_corners}]"),
+            )]),
+            "100001 corners (outline and holes) is above the limit of 100000",
+        ),
+        scene_case(
+            "polygon-nan-corner",
+            square(&[("[1.0, 1.0]", "[1.0, nan]")]),
+            "mesh.outline[2]: must be finite",
+        ),
+        scene_case(
+            "density-underflows",
+            bar(&[("density = 1.0", "density = 5e-324")]),
+            "material.density: the particles of body[0] would have mass 0e0",
+        ),
+        scene_case(
+            "body-volume-underflows",
+            square(&[
+                ("max = [0.9, 0.9]", "max = [1e-200, 1e-200]"),
+                ("min = [0.1, 0.1]", "min = [0.0, 0.0]"),
+            ]),
+            "body[0].max: the particles of body[0] would have mass 0e0",
+        ),
+        scene_case(
+            "resolution-basis-of-another-dimension",
+            format!("{BAR}\n[[resolution]]\nbasis = \"bspline\"\nblocks = [4, 1]\n"),
+            "resolution[0].basis: `bspline` is a 1D basis but the scene is 2D",
+        ),
+        scene_case(
+            "resolution-blocks-on-polygon",
+            format!("{SQUARE}\n[[resolution]]\nbasis = \"ps\"\nblocks = [4, 4]\n"),
+            "resolution[0].blocks: the scene's mesh has no blocks",
+        ),
+        scene_case(
+            "resolution-edge-length-on-blocks",
+            format!("{BAR}\n[[resolution]]\nbasis = \"pl\"\nedge_length = 0.1\n"),
+            "resolution[0].edge_length: the scene's mesh is not a polygon",
+        ),
+        scene_case(
+            "resolution-blocks-over-the-limit",
+            format!("{BAR}\n[[resolution]]\nbasis = \"pl\"\nblocks = [5000, 1]\n"),
+            "resolution[0].blocks: each count must be in 1..=4096",
+        ),
+        scene_case(
+            "resolution-per-block-length",
+            format!("{BAR}\n[[resolution]]\nbasis = \"pl\"\nper_block = [4]\n"),
+            "resolution[0].per_block: needs 2 counts",
+        ),
+        scene_case(
+            "resolution-negative-edge-length",
+            format!("{SQUARE}\n[[resolution]]\nbasis = \"ps\"\nedge_length = -1.0\n"),
+            "resolution[0].edge_length: must be positive and finite",
+        ),
+        scene_case(
+            "resolution-tiny-edge-length",
+            format!("{SQUARE}\n[[resolution]]\nbasis = \"ps\"\nedge_length = 1e-9\n"),
+            "resolution[0].edge_length: edge length",
+        ),
+        scene_case(
+            "resolution-1d-second-number",
+            format!("{ROD}\n[[resolution]]\nbasis = \"pl1d\"\nblocks = [9, 3]\n"),
+            "resolution[0].blocks: a 1D scene has one count of elements",
+        ),
+        scene_case(
+            "study-refine-y-in-1d",
+            format!("{ROD}\n[study]\nrefine = [\"y\"]\n"),
+            "study.refine: `y` does not exist in a 1D scene",
+        ),
+        scene_case(
+            "study-refine-normal",
+            format!("{BAR}\n[study]\nrefine = [\"normal\"]\n"),
+            "study.refine: lists axes",
+        ),
+        scene_case(
+            "boundary-tag-with-control-characters",
+            bar(&[("tag = \"left\"", "tag = \"left\\nx\\u001b[31m\"")]),
+            "unknown boundary tag `left\\nx\\u{1b}[31m`",
+        ),
+        scene_case(
+            "long-boundary-tag",
+            bar(&[("tag = \"left\"", &format!("tag = \"{}\"", "t".repeat(5000)))]),
+            &format!("`{}…`", "t".repeat(80)),
+        ),
+    ]
+}
+
+fn command_line_cases() -> Vec<Case> {
+    let rod = Some(ROD.to_string());
+    let bar = Some(BAR.to_string());
+    let long_bar = Some(edited(BAR, &[("t_end = 0.01", "t_end = 200.0")]));
+    let bad_resolution = Some(format!(
+        "{BAR}\n[[resolution]]\nbasis = \"pl\"\nblocks = [5000, 1]\n"
+    ));
+    let refine_y = Some(format!("{ROD}\n[study]\nrefine = [\"y\"]\n"));
+    let long = "m".repeat(1000);
+    vec![
+        args_case("1d-blocks-second-number", rod.clone(), &["run", "@", "--blocks", "8x3"], "--blocks 8x3: a 1D scene has one count; the second number must be 1"),
+        args_case("1d-particles-second-number", rod.clone(), &["run", "@", "--particles", "4x2"], "--particles 4x2: a 1D scene has one count"),
+        args_case("1d-builtin-blocks", None, &["run", "vibrating-bar-1d", "--blocks", "8x2"], "the second number must be 1"),
+        args_case("compare-1d-blocks", rod.clone(), &["compare", "@", "--blocks", "8x3"], "--blocks 8x3"),
+        args_case("converge-1d-particles", None, &["converge", "vibrating-bar-1d", "--particles", "4x9"], "--particles 4x9"),
+        args_case("blocks-per-axis", None, &["run", "vibrating-bar", "--blocks", "5000x1"], "--blocks 5000x1: mesh.blocks: each count must be in 1..=4096"),
+        args_case("blocks-in-all", None, &["run", "vibrating-bar", "--blocks", "4096x4096"], "above the limit of 1000000"),
+        args_case("blocks-overflow", None, &["run", "vibrating-bar", "--blocks", "99999999999999999999999x1"], "--blocks must look like 4x1"),
+        args_case("blocks-control-characters", None, &["run", "vibrating-bar", "--blocks", "4\u{1b}x1"], "got `4\\u{1b}x1`"),
+        args_case("particles-over-the-limit", None, &["run", "vibrating-bar", "--blocks", "64x64", "--particles", "1000x1000"], "--particles 1000x1000"),
+        args_case("dt-over-the-limit", None, &["run", "vibrating-bar", "--dt", "1e-12"], "--dt 1e-12: time.dt: t_end / dt = 5.0 / 1e-12 = 5.000e12 steps is above the limit of 10000000"),
+        args_case("t-end-over-the-limit", None, &["run", "vibrating-bar", "--t-end", "1e9"], "--t-end 1000000000.0"),
+        args_case("subnormal-dt", None, &["run", "vibrating-bar", "--dt", "5e-324"], "above the limit of 10000000"),
+        args_case("nan-dt", None, &["run", "vibrating-bar", "--dt", "NaN"], "time.dt: must be positive and finite"),
+        args_case("infinite-dt", None, &["run", "vibrating-bar", "--dt", "inf"], "time.dt: must be positive and finite"),
+        args_case("infinite-t-end", None, &["run", "vibrating-bar", "--t-end", "inf"], "time.t_end: must be positive and finite"),
+        args_case("t-end-before-one-step", None, &["run", "vibrating-bar", "--t-end", "1e-9"], "is shorter than one time step"),
+        args_case("compare-dt-over-the-limit", None, &["compare", "vibrating-bar", "--dt", "1e-12"], "--dt 1e-12"),
+        args_case("converge-dt-over-the-limit", None, &["converge", "vibrating-bar", "--dt", "1e-12"], "above the limit of 10000000"),
+        args_case("frames-over-the-limit", long_bar.clone(), &["run", "@", "--out", "OUT", "--out-every", "1"], "--out-every 1: 200000 steps give 200002 particle frames, above the limit of 100000"),
+        args_case("table-rows-over-the-limit", long_bar.clone(), &["run", "@", "--diag-every", "1"], "--diag-every 1: 200000 steps give 200000 table rows, above the limit of 100000"),
+        args_case("long-layout", None, &["run", "vibrating-bar", "--layout", &long], &format!("unknown layout `{}…`", "m".repeat(80))),
+        args_case("mass-with-escape", None, &["run", "vibrating-bar", "--mass", "lumped\u{1b}[2J"], "unknown mass strategy `lumped\\u{1b}[2J`"),
+        args_case("mass-threshold-with-newline", None, &["run", "vibrating-bar", "--mass", "partial:1\n2"], "got `1\\n2`"),
+        args_case("basis-with-bell", None, &["run", "vibrating-bar", "--basis", "ps\u{7}"], "unknown basis `ps\\u{7}`"),
+        args_case("split-with-newline", None, &["run", "vibrating-bar", "--split", "in\ncentre"], "unknown split point `in\\ncentre`"),
+        args_case("scene-name-with-escape", None, &["run", "bar\u{1b}[31m"], "unknown scene `bar\\u{1b}[31m`"),
+        args_case("long-scene-name", None, &["run", &long], &format!("unknown scene `{}…`", "m".repeat(80))),
+        args_case("scene-show-long-name", None, &["scene", "show", &long], "…`"),
+        args_case("run-validates-resolution", bad_resolution.clone(), &["run", "@"], "resolution[0].blocks"),
+        args_case("compare-validates-resolution", bad_resolution.clone(), &["compare", "@"], "resolution[0].blocks"),
+        args_case("converge-validates-resolution", bad_resolution, &["converge", "@"], "resolution[0].blocks"),
+        args_case("converge-refine-y-in-1d", refine_y.clone(), &["converge", "@"], "study.refine"),
+        args_case("run-refine-y-in-1d", refine_y, &["run", "@"], "study.refine"),
+        args_case("scene-show-file", bar.clone(), &["scene", "show", "nothing\u{1b}"], "nothing\\u{1b}"),
+        args_case("project-mesh-dev-zero", None, &["project", "--mesh", "/dev/zero"], "/dev/zero: cannot read: not a regular file"),
+        args_case("reproduce-study-with-escape", None, &["reproduce", "b9\u{1b}[1m"], "unknown study `b9\\u{1b}[1m`"),
+        args_case("stability-case-with-escape", None, &["stability", "--dir", concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/stability"), "--cases", "b2\u{1b}"], "unknown case `b2\\u{1b}`"),
+        args_case("project-mesh-directory", None, &["project", "--mesh", "/tmp"], "/tmp: cannot read"),
+    ]
+}
+
+/// Runs `case` in `dir`: `@` is the scene file, `OUT` an output directory.
+fn run_case(dir: &Path, case: &Case) -> Result<(), String> {
+    let scene = dir.join(format!("{}.toml", case.name));
+    if let Some(text) = &case.scene {
+        std::fs::write(&scene, text).unwrap();
+    }
+    let out_dir = dir.join(format!("{}-out", case.name));
+    let args: Vec<String> = case
+        .args
+        .iter()
+        .map(|a| match a.as_str() {
+            "@" => scene.to_string_lossy().into_owned(),
+            "OUT" => out_dir.to_string_lossy().into_owned(),
+            _ => a.clone(),
+        })
+        .collect();
+    let out = cli().args(&args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let mut problems = Vec::new();
+    if out.status.code() != Some(case.status) {
+        problems.push(format!(
+            "status {:?}, expected {}",
+            out.status.code(),
+            case.status
+        ));
+    }
+    if !stderr.contains(&case.fragment) {
+        problems.push(format!("stderr lacks `{}`", case.fragment));
+    }
+    if stderr.contains("panicked") {
+        problems.push("a panic".into());
+    }
+    if stderr.contains('\u{1b}') || stderr.lines().count() > 3 {
+        problems.push("raw control characters or several lines echoed".into());
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{}: {}\n  stderr: {stderr}",
+            case.name,
+            problems.join("; ")
+        ))
+    }
+}
+
+fn check_all(test: &str, cases: Vec<Case>) {
+    let dir = temp_dir(test);
+    let failures: Vec<String> = cases
+        .iter()
+        .filter_map(|c| run_case(&dir, c).err())
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn extreme_scenes_are_rejected_naming_the_value_and_the_limit() {
+    let cases = scene_cases();
+    assert!(cases.len() >= 30);
+    check_all("scenes", cases);
+}
+
+#[test]
+fn extreme_command_lines_are_rejected_naming_the_flag() {
+    let cases = command_line_cases();
+    assert!(cases.len() >= 30);
+    check_all("args", cases);
+}
+
+#[test]
+fn mesh_and_scene_files_must_be_bounded_regular_files() {
+    let dir = temp_dir("files");
+    let gmsh = |file: &Path| GMSH.replace("FILE", &file.to_string_lossy());
+    let mut cases = Vec::new();
+    // Devices, FIFOs, directories and huge (sparse) files, as the mesh of a scene.
+    let fifo = dir.join("mesh.fifo");
+    let made_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let big = dir.join("big.msh");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(300 * 1024 * 1024)
+        .unwrap();
+    cases.push(scene_case(
+        "mesh-dev-zero",
+        gmsh(Path::new("/dev/zero")),
+        "mesh.file: /dev/zero: cannot read: not a regular file",
+    ));
+    cases.push(scene_case("mesh-directory", gmsh(&dir), "cannot read"));
+    cases.push(scene_case(
+        "mesh-too-big",
+        gmsh(&big),
+        "is 314572800 bytes, above the limit of 268435456 bytes",
+    ));
+    cases.push(scene_case(
+        "mesh-missing",
+        gmsh(&dir.join("none.msh")),
+        "cannot read: No such file",
+    ));
+    if made_fifo {
+        cases.push(scene_case("mesh-fifo", gmsh(&fifo), "not a regular file"));
+    }
+    let failures: Vec<String> = cases
+        .iter()
+        .filter_map(|c| run_case(&dir, c).err())
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // The scene file itself.
+    let big_scene = dir.join("big.toml");
+    std::fs::File::create(&big_scene)
+        .unwrap()
+        .set_len(5 * 1024 * 1024)
+        .unwrap();
+    let zero_scene = dir.join("zero.toml");
+    std::os::unix::fs::symlink("/dev/zero", &zero_scene).unwrap();
+    let mut scenes = vec![
+        (big_scene, "above the limit of 4194304 bytes"),
+        (zero_scene, "cannot read: not a regular file"),
+    ];
+    let fifo_scene = dir.join("fifo.toml");
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo_scene)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        scenes.push((fifo_scene, "not a regular file"));
+    }
+    for (file, fragment) in scenes {
+        let out = cli().arg("run").arg(&file).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{}: {stderr}", file.display());
+        assert!(stderr.contains(fragment), "{}: {stderr}", file.display());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_exit_status_rule_is_in_the_help() {
+    for args in [
+        vec!["--help"],
+        vec!["run", "--help"],
+        vec!["compare", "--help"],
+    ] {
+        let out = cli().args(&args).output().unwrap();
+        assert!(out.status.success());
+        let help = String::from_utf8(out.stdout).unwrap();
+        for fragment in ["Exit status", "130", "--strict", "bad input"] {
+            assert!(
+                help.contains(fragment),
+                "{args:?} lacks {fragment}:\n{help}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_study_with_failed_variants_exits_0_unless_strict() {
+    // A huge time step throws every variant's particles out of the mesh.
+    let args = [
+        "compare",
+        "vibrating-bar",
+        "--dt",
+        "100",
+        "--t-end",
+        "1000",
+        "--jobs",
+        "1",
+    ];
+    let out = cli().args(args).output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("NO"));
+    let out = cli().args(args).arg("--strict").output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--strict: 2 of 2 variants"));
+    // The same run alone is a failed run.
+    let out = cli()
+        .args(["run", "vibrating-bar", "--dt", "100", "--t-end", "1000"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
+
+fn binary() -> std::process::Command {
+    std::process::Command::new(assert_cmd::cargo::cargo_bin("mpm-cli"))
+}
+
+#[test]
+fn a_reader_that_closes_early_ends_the_run_quietly() {
+    let mut child = binary()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--t-end",
+            "50",
+            "--diag-every",
+            "1",
+            "--format",
+            "csv",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    assert!(lines.next().unwrap().unwrap().starts_with("step,"));
+    assert!(lines.next().unwrap().unwrap().starts_with("1,"));
+    drop(lines);
+    let mut stderr = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(141), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!stderr.contains("error"), "{stderr}");
+}
+
+/// Starts a long run, waits for its first rows, sends `signal` and returns the exit
+/// status and stderr.
+fn interrupt(signal: &str, extra: &[&str]) -> (Option<i32>, String) {
+    let mut child = binary()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--t-end",
+            "500",
+            "--diag-every",
+            "10",
+            "--format",
+            "csv",
+        ])
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    lines.next().unwrap().unwrap();
+    lines.next().unwrap().unwrap();
+    let killed = std::process::Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    // Read on until the run ends.
+    for line in lines {
+        line.unwrap();
+    }
+    let mut stderr = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    (child.wait().unwrap().code(), stderr)
+}
+
+#[test]
+fn sigint_writes_the_files_and_exits_130() {
+    let dir = temp_dir("sigint");
+    let out = dir.join("out");
+    let (code, stderr) = interrupt("INT", &["--out", &out.to_string_lossy()]);
+    assert_eq!(code, Some(130), "{stderr}");
+    assert!(stderr.contains("error: interrupted"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["interrupted"], true);
+    let steps = summary["steps"].as_u64().unwrap();
+    assert!(steps > 0 && steps < 500_000, "{steps}");
+    let pvd = std::fs::read_to_string(out.join("particles.pvd")).unwrap();
+    assert!(pvd.trim_start().starts_with("<?xml"), "{pvd}");
+    assert!(pvd.trim_end().ends_with("</VTKFile>"), "{pvd}");
+    let files: Vec<&str> = pvd
+        .split("file=\"")
+        .skip(1)
+        .map(|rest| &rest[..rest.find('"').unwrap()])
+        .collect();
+    assert!(files.len() >= 2, "{pvd}");
+    for file in &files {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    // The last frame is the state where the run stopped.
+    let last_time: f64 = pvd
+        .rsplit("timestep=\"")
+        .next()
+        .map(|rest| rest[..rest.find('"').unwrap()].parse().unwrap())
+        .unwrap();
+    assert_eq!(last_time, summary["t_end"].as_f64().unwrap());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn sigterm_stops_a_run_with_130_and_says_so() {
+    let (code, stderr) = interrupt("TERM", &[]);
+    assert_eq!(code, Some(130), "{stderr}");
+    assert!(stderr.contains("error: interrupted"), "{stderr}");
+}
