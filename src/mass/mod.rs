@@ -13,6 +13,7 @@
 //! | `partial`, `partial:TAU`, `partial-coverage:C` | [`Partial`] | `M` with some rows lumped (thesis §5.3; by `M_ii`; by particle coverage) |
 //! | `deactivate[:THRESHOLD]` | [`Deactivate`] | `M` without the functions with `M_ii < threshold` (thesis §5.2) |
 //! | `extended[:C]` (the default) | [`Extended`] | `Eᵀ M E`: functions covered below `C` expressed through well-covered neighbours |
+//! | `extended-hybrid:C1:C2` | [`Extended`] | `Eᵀ M' E`: functions covered below `C1` extended, the rows of those covered in `[C1, C2)` lumped in `M'` |
 //! | `fmpm:K` | [`Fmpm`] | no solve: the series `Σ_{j≤K} (I − M_L⁻¹ M)^j M_L⁻¹` |
 //!
 //! Homogeneous Dirichlet conditions come as a set of fixed coefficients per
@@ -84,6 +85,14 @@ pub enum MassKind {
         /// Coverage threshold (fraction of the support's integral).
         coverage: f64,
     },
+    /// Extension of the functions covered below `extend`, and the rows of the
+    /// functions covered in `[extend, lump)` lumped.
+    ExtendedHybrid {
+        /// Coverage below which a function is extended.
+        extend: f64,
+        /// Coverage below which (and at or above `extend`) a row is lumped.
+        lump: f64,
+    },
     /// Truncated series for `M⁻¹` preconditioned by the lumped mass.
     Fmpm {
         /// Number of correction terms `K` (`0` is the lumped mass).
@@ -101,12 +110,13 @@ impl Default for MassKind {
 }
 
 /// Names [`MassKind::parse`] knows, for messages.
-pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, fmpm:K";
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid:C1:C2, fmpm:K";
 
 impl MassKind {
     /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
     /// (threshold rule), `partial-coverage:C`, `deactivate` (threshold 1e-2),
-    /// `deactivate:THRESHOLD`, `extended` (default coverage), `extended:C`, `fmpm:K`.
+    /// `deactivate:THRESHOLD`, `extended` (default coverage), `extended:C`,
+    /// `extended-hybrid:C1:C2` (`C1 ≤ C2`), `fmpm:K`.
     pub fn parse(name: &str) -> Result<Self, String> {
         let (head, arg) = match name.split_once(':') {
             Some((h, a)) => (h, Some(a)),
@@ -154,6 +164,20 @@ impl MassKind {
             ("extended", Some(a)) => Ok(MassKind::Extended {
                 coverage: fraction(a)?,
             }),
+            ("extended-hybrid", Some(a)) => {
+                // `:` between the two (lists of strategies are comma-separated);
+                // `,` is read too.
+                let (c1, c2) = a.split_once([':', ',']).ok_or_else(|| {
+                    format!("`{name}`: expected two coverages `C1:C2`, got `{a}`")
+                })?;
+                let (extend, lump) = (fraction(c1)?, fraction(c2)?);
+                if extend > lump {
+                    return Err(format!(
+                        "`{name}`: the extension coverage {extend} is above the lumping coverage {lump}"
+                    ));
+                }
+                Ok(MassKind::ExtendedHybrid { extend, lump })
+            }
             ("fmpm", Some(a)) => a
                 .parse::<usize>()
                 .ok()
@@ -180,6 +204,7 @@ impl MassKind {
             MassKind::Extended { coverage } if coverage != DEFAULT_COVERAGE => {
                 format!("extended:{coverage}")
             }
+            MassKind::ExtendedHybrid { extend, lump } => format!("extended-hybrid:{extend}:{lump}"),
             MassKind::Fmpm { order } => format!("fmpm:{order}"),
             other => other.name().to_string(),
         }
@@ -193,6 +218,7 @@ impl MassKind {
             MassKind::Partial(_) => "partial",
             MassKind::Deactivate { .. } => "deactivate",
             MassKind::Extended { .. } => "extended",
+            MassKind::ExtendedHybrid { .. } => "extended-hybrid",
             MassKind::Fmpm { .. } => "fmpm",
         }
     }
@@ -205,6 +231,7 @@ impl MassKind {
             MassKind::Partial(rule) => Box::new(Partial::new(rule)),
             MassKind::Deactivate { threshold } => Box::new(Deactivate::new(threshold)),
             MassKind::Extended { coverage } => Box::new(Extended::new(coverage)),
+            MassKind::ExtendedHybrid { extend, lump } => Box::new(Extended::hybrid(extend, lump)),
             MassKind::Fmpm { order } => Box::new(Fmpm::new(order)),
         }
     }

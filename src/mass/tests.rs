@@ -139,6 +139,26 @@ fn extension_keeps_row_sums_where_consistent_fails() {
     assert!((1.0..1e4).contains(&condition), "condition {condition}");
 }
 
+/// The hybrid (extension below the first coverage, lumped rows below the second)
+/// keeps the row sums where the consistent mass fails, and its system is well
+/// conditioned.
+#[test]
+fn hybrid_extension_keeps_row_sums_where_consistent_fails() {
+    let c = column_mass();
+    for spec in ["extended-hybrid:0.02:0.75", "extended-hybrid:0.25:0.75"] {
+        let kind = MassKind::parse(spec).unwrap();
+        let mut m = prepared(&c, kind);
+        let report = m.factorize(&c.pattern, &c.values, context(&c)).unwrap();
+        assert!(report.lumped_rows > 0, "{spec}: nothing lumped: {report:?}");
+        assert_keeps_row_sums(&c, &mut m, spec);
+        let condition = m.condition_estimate(&c.pattern);
+        assert!(
+            (1.0..1e4).contains(&condition),
+            "{spec}: condition {condition}"
+        );
+    }
+}
+
 /// With every function well covered the extension does nothing and solves the
 /// consistent system.
 #[test]
@@ -245,7 +265,26 @@ fn mass_kinds_parse() {
         MassKind::parse("fmpm:3").unwrap(),
         MassKind::Fmpm { order: 3 }
     );
-    for kind in ["partial-coverage:0.2", "fmpm:2", "extended", "lumped"] {
+    assert_eq!(
+        MassKind::parse("extended-hybrid:0.02:0.75").unwrap(),
+        MassKind::ExtendedHybrid {
+            extend: 0.02,
+            lump: 0.75
+        }
+    );
+    assert_eq!(
+        MassKind::parse("extended-hybrid:0.1,0.5").unwrap().spec(),
+        "extended-hybrid:0.1:0.5"
+    );
+    assert!(MassKind::parse("extended-hybrid:0.5:0.1").is_err());
+    assert!(MassKind::parse("extended-hybrid:0.5").is_err());
+    for kind in [
+        "partial-coverage:0.2",
+        "fmpm:2",
+        "extended",
+        "extended-hybrid:0.25:0.5",
+        "lumped",
+    ] {
         assert_eq!(MassKind::parse(kind).unwrap().spec(), kind);
         assert_eq!(MassKind::parse(kind).unwrap().build::<f64>().spec(), kind);
     }

@@ -64,6 +64,10 @@ enum Role {
 /// Extension of the functions covered below `coverage`, solved matrix-free.
 pub struct Extended<T: Scalar> {
     coverage: f64,
+    /// Rows of the solved functions covered below this are lumped (hybrid; equal
+    /// to `coverage` when nothing is lumped).
+    lump: f64,
+    lumped: Vec<bool>,
     support: SupportFacts,
     fixed: Vec<Vec<bool>>,
     solver_of: Vec<usize>,
@@ -99,8 +103,17 @@ pub struct Extended<T: Scalar> {
 impl<T: Scalar> Extended<T> {
     /// Extension below `coverage` (a fraction in `(0, 1)`).
     pub fn new(coverage: f64) -> Self {
+        Self::hybrid(coverage, coverage)
+    }
+
+    /// Extension below `extend`, and the rows of the functions covered in
+    /// `[extend, lump)` lumped (`M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ` over their
+    /// off-diagonal entries, as partial lumping does): mass and momentum are kept.
+    pub fn hybrid(extend: f64, lump: f64) -> Self {
         Extended {
-            coverage,
+            coverage: extend,
+            lump: lump.max(extend),
+            lumped: Vec::new(),
             support: SupportFacts::default(),
             fixed: Vec::new(),
             solver_of: Vec::new(),
@@ -147,7 +160,9 @@ impl<T: Scalar> Extended<T> {
 
 impl<T: Scalar> MassStrategy<T> for Extended<T> {
     fn spec(&self) -> String {
-        if self.coverage == DEFAULT_COVERAGE {
+        if self.lump > self.coverage {
+            format!("extended-hybrid:{}:{}", self.coverage, self.lump)
+        } else if self.coverage == DEFAULT_COVERAGE {
             "extended".into()
         } else {
             format!("extended:{}", self.coverage)
@@ -176,6 +191,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.row_idx = pattern.row_idx().to_vec();
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
+        self.lumped = vec![false; n];
         self.active = Vec::with_capacity(n);
         self.extended = Vec::with_capacity(n);
         self.ext_ptr = vec![0; n + 1];
@@ -219,6 +235,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             } else {
                 Role::Solved
             };
+            self.lumped[i] = self.role[i] == Role::Solved && coverage < self.lump;
         }
         self.ext_idx.clear();
         self.ext_w.clear();
@@ -228,12 +245,29 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 if self.extend(j) {
                     report.extended += 1;
                 } else {
-                    // Nothing to carry it: keep it as an unknown.
+                    // Nothing to carry it: keep it as an unknown, lumped in the hybrid.
                     self.role[j] = Role::Solved;
+                    self.lumped[j] = self.lump > self.coverage;
                 }
             }
         }
         self.ext_ptr[n] = self.ext_idx.len();
+        // Lumped rows: every off-diagonal entry of a lumped row moves onto both
+        // diagonals (row sums kept, `M' ⪰ M`).
+        if self.lumped.iter().any(|&l| l) {
+            for c in 0..n {
+                for k in self.col_ptr[c]..self.col_ptr[c + 1] {
+                    let r = self.row_idx[k];
+                    if r != c && (self.lumped[r] || self.lumped[c]) {
+                        let v = self.values[k];
+                        self.values[k] = T::zero();
+                        self.values[pattern.diagonal_position(r)] += v;
+                        self.values[pattern.diagonal_position(c)] += v;
+                    }
+                }
+            }
+        }
+        report.lumped_rows = self.lumped.iter().filter(|&&l| l).count();
         self.active.clear();
         self.extended.clear();
         for i in 0..n {
@@ -268,7 +302,8 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 self.cholesky.inactive[i] = self.role[i] == Role::Inactive;
                 self.cholesky.lumped[i] = false;
             }
-            self.direct = self.cholesky.factorize(pattern, values).is_ok();
+            // `self.values` holds the lumped rows of the hybrid (else `values`).
+            self.direct = self.cholesky.factorize(pattern, &self.values).is_ok();
         }
         // Jacobi preconditioner of the CG, M_ii + Σ_j e_ji² M_jj (not needed when
         // the step is solved directly).
@@ -279,14 +314,14 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                     let op = self.reduced(s);
                     for i in 0..n {
                         precond[i] = if op.free(i) {
-                            values[pattern.diagonal_position(i)]
+                            self.values[pattern.diagonal_position(i)]
                         } else {
                             T::one()
                         };
                     }
                     for j in 0..n {
                         if self.role[j] == Role::Extended && !op.fixed[j] {
-                            let mjj = values[pattern.diagonal_position(j)];
+                            let mjj = self.values[pattern.diagonal_position(j)];
                             for t in self.ext_ptr[j]..self.ext_ptr[j + 1] {
                                 let i = self.ext_idx[t];
                                 if op.free(i) {
