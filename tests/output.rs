@@ -3,6 +3,10 @@
 //!
 //! These tests need `python3` with `meshio`; they fail (never skip) without them.
 
+mod common;
+
+use common::meshio::{array, read_back};
+use common::TempDir;
 use nalgebra::{Matrix1, Matrix2, Vector1, Vector2};
 use psmpm::output::dir::{is_frame, prepare_dir, OutputDir, OutputError};
 use psmpm::output::vtk::VtuEncoding;
@@ -10,108 +14,10 @@ use psmpm::particles::Particles;
 use psmpm_basis::mesh::generators::block_grid;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-/// The meshio version `.ci/run` installs and these tests were written against.
-const MESHIO: &str = "5.3.5";
-
-/// Reads every `.vtu` in `vtus` with meshio and every `.pvd` in `pvds` with
-/// `xml.etree`; floats come back as Python `repr` strings (exact round trip).
-const SCRIPT: &str = r#"
-import json, sys
-try:
-    import meshio
-except ImportError as e:
-    print(f"cannot import meshio: {e}", file=sys.stderr)
-    sys.exit(3)
-import xml.etree.ElementTree as ET
-
-def floats(a):
-    return [repr(float(x)) for x in a.ravel()]
-
-out = {"meshio": meshio.__version__, "vtu": {}, "pvd": {}}
-for path in sys.argv[1:]:
-    if path.endswith(".pvd"):
-        root = ET.parse(path).getroot()
-        assert root.tag == "VTKFile" and root.get("type") == "Collection", root.attrib
-        out["pvd"][path] = [[repr(float(d.get("timestep"))), d.get("file")]
-                            for d in root.find("Collection").findall("DataSet")]
-        continue
-    m = meshio.read(path)
-    out["vtu"][path] = {
-        "points": {"shape": list(m.points.shape), "values": floats(m.points)},
-        "cells": [[c.type, [[int(i) for i in cell] for cell in c.data]] for c in m.cells],
-        "point_data": {k: {"shape": list(v.shape), "values": floats(v)}
-                       for k, v in m.point_data.items()},
-        "cell_data": {k: [[int(i) for i in block.ravel()] for block in v]
-                      for k, v in m.cell_data.items()},
-    }
-print(json.dumps(out))
-"#;
-
-fn install_hint() -> String {
-    format!(
-        "these tests read the output back with meshio: run `python3 -m pip install meshio=={MESHIO}`"
-    )
-}
-
-/// Runs the reader script on `files` and returns its JSON.
-fn read_back(files: &[PathBuf]) -> Value {
-    let output = Command::new("python3")
-        .arg("-c")
-        .arg(SCRIPT)
-        .args(files)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run python3 ({e}); {}", install_hint()));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if output.status.code() == Some(3) {
-        panic!("{}; {}", stderr.trim(), install_hint());
-    }
-    assert!(
-        output.status.success(),
-        "the meshio reader failed ({}):\n{stderr}",
-        output.status
-    );
-    serde_json::from_slice(&output.stdout).expect("the reader prints JSON")
-}
-
-/// A fresh, empty directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let path = std::env::temp_dir().join(format!("psmpm-output-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&path);
-        TempDir(path)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// The `.vtu` entry of the reader's JSON for `path`.
 fn vtu<'a>(json: &'a Value, path: &Path) -> &'a Value {
     &json["vtu"][path.to_str().unwrap()]
-}
-
-/// An array of `repr` strings, parsed as `f64`, with its shape.
-fn array(value: &Value) -> (Vec<usize>, Vec<f64>) {
-    let shape = value["shape"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_u64().unwrap() as usize)
-        .collect();
-    let values = value["values"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().unwrap().parse::<f64>().unwrap())
-        .collect();
-    (shape, values)
 }
 
 /// Bit-for-bit equality of float arrays (so `-0.0` and `0.0` differ).
@@ -212,7 +118,7 @@ fn particles_2d(shift: f64) -> Particles<f64, 2> {
 #[test]
 fn particles_2d_mesh_and_collection_read_back_with_meshio() {
     let dir = TempDir::new("2d");
-    let mut out = OutputDir::create(dir.0.join("run"), 2).unwrap();
+    let mut out = OutputDir::create(dir.join("run"), 2).unwrap();
 
     // Steps 0..=4 at cadence 2: frames at steps 0, 2, 4.
     let dt = 0.125;
@@ -235,11 +141,11 @@ fn particles_2d_mesh_and_collection_read_back_with_meshio() {
         .write_mesh(&mesh, Some(("temperature", &field)))
         .unwrap();
     let pvd = out.finish().unwrap();
-    assert_eq!(mesh_path, dir.0.join("run/mesh.vtu"));
-    assert_eq!(pvd, dir.0.join("run/particles.pvd"));
+    assert_eq!(mesh_path, dir.join("run/mesh.vtu"));
+    assert_eq!(pvd, dir.join("run/particles.pvd"));
 
     let frames: Vec<PathBuf> = (0..3)
-        .map(|i| dir.0.join(format!("run/particles_{i:05}.vtu")))
+        .map(|i| dir.join(format!("run/particles_{i:05}.vtu")))
         .collect();
     let mut files = frames.clone();
     files.push(mesh_path.clone());
@@ -277,7 +183,7 @@ fn particles_2d_mesh_and_collection_read_back_with_meshio() {
     for (i, ((time, file), (t, _))) in entries.iter().zip(&written).enumerate() {
         assert_eq!(time.parse::<f64>().unwrap(), *t);
         assert_eq!(*file, format!("particles_{i:05}.vtu"));
-        assert!(dir.0.join("run").join(file).is_file());
+        assert!(dir.join("run").join(file).is_file());
     }
     let text = std::fs::read_to_string(&pvd).unwrap();
     assert!(text.contains("<VTKFile type=\"Collection\""));
@@ -289,7 +195,7 @@ fn particles_2d_mesh_and_collection_read_back_with_meshio() {
 #[test]
 fn particles_1d_read_back_with_meshio() {
     let dir = TempDir::new("1d");
-    let mut out = OutputDir::create(&dir.0, 1).unwrap();
+    let mut out = OutputDir::create(dir.path(), 1).unwrap();
     let mut p = Particles::new(
         vec![
             Vector1::new(0.125),
@@ -322,8 +228,8 @@ fn particles_1d_read_back_with_meshio() {
 #[test]
 fn an_output_directory_that_cannot_be_created_is_an_error() {
     let dir = TempDir::new("blocked");
-    std::fs::create_dir_all(&dir.0).unwrap();
-    let file = dir.0.join("a-file");
+    std::fs::create_dir_all(dir.path()).unwrap();
+    let file = dir.join("a-file");
     std::fs::write(&file, "not a directory").unwrap();
     let err = OutputDir::create(file.join("out"), 1).unwrap_err();
     assert!(matches!(err, OutputError::CreateDir { .. }), "{err:?}");
@@ -360,7 +266,7 @@ fn binary_and_ascii_frames_read_back_the_same() {
         ("binary", VtuEncoding::Binary),
         ("ascii", VtuEncoding::Ascii),
     ] {
-        let mut out = OutputDir::create(dir.0.join(name), 1)
+        let mut out = OutputDir::create(dir.join(name), 1)
             .unwrap()
             .with_encoding(encoding);
         assert_eq!(out.encoding(), encoding);
@@ -395,38 +301,38 @@ fn a_directory_is_reused_only_when_it_holds_output_files() {
     let dir = TempDir::new("reuse");
     let owned = |name: &str| is_frame(name) || name == "particles.pvd";
     // A new directory is created; an empty one is used as it is.
-    assert!(prepare_dir(&dir.0, false, owned).unwrap().is_empty());
-    assert!(prepare_dir(&dir.0, false, owned).unwrap().is_empty());
+    assert!(prepare_dir(dir.path(), false, owned).unwrap().is_empty());
+    assert!(prepare_dir(dir.path(), false, owned).unwrap().is_empty());
     for name in [
         "particles_00000.vtu",
         "particles_00001.vtu",
         "particles.pvd",
     ] {
-        std::fs::write(dir.0.join(name), "x").unwrap();
+        std::fs::write(dir.join(name), "x").unwrap();
     }
     // Files of an earlier run: refused without overwrite, naming the directory.
-    let err = prepare_dir(&dir.0, false, owned).unwrap_err();
+    let err = prepare_dir(dir.path(), false, owned).unwrap_err();
     assert!(
         matches!(err, OutputError::NotEmpty { files: 3, .. }),
         "{err:?}"
     );
     let message = err.to_string();
-    assert!(message.contains(dir.0.to_str().unwrap()), "{message}");
+    assert!(message.contains(dir.path().to_str().unwrap()), "{message}");
     assert!(message.contains("particles_00000.vtu"), "{message}");
     // A file of someone else: refused even with overwrite, and nothing removed.
-    std::fs::write(dir.0.join("notes.txt"), "mine").unwrap();
-    let err = prepare_dir(&dir.0, true, owned).unwrap_err();
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    let err = prepare_dir(dir.path(), true, owned).unwrap_err();
     assert!(
         matches!(err, OutputError::Foreign { files: 1, .. }),
         "{err:?}"
     );
     assert!(err.to_string().contains("notes.txt"), "{err}");
-    assert!(dir.0.join("particles_00001.vtu").is_file());
+    assert!(dir.join("particles_00001.vtu").is_file());
     // With overwrite and only output files: they are removed.
-    std::fs::remove_file(dir.0.join("notes.txt")).unwrap();
-    let removed = prepare_dir(&dir.0, true, owned).unwrap();
+    std::fs::remove_file(dir.join("notes.txt")).unwrap();
+    let removed = prepare_dir(dir.path(), true, owned).unwrap();
     assert_eq!(removed.len(), 3);
-    assert_eq!(std::fs::read_dir(&dir.0).unwrap().count(), 0);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     assert!(is_frame("particles_123456.vtu"));
     assert!(!is_frame("particles_.vtu") && !is_frame("particles_1a.vtu"));
 }

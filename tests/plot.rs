@@ -4,6 +4,9 @@
 //! The SVGs go to a fresh directory under the system's temp dir, removed at the end;
 //! with `PSMPM_PLOT_DIR` set, copies are also kept there (to look at them).
 
+mod common;
+
+use common::TempDir;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -13,27 +16,6 @@ use psmpm::basis::Basis;
 use psmpm::output::basis_picture::{basis_function_plot, BasisPlotOptions, MESH_EDGE};
 use psmpm::output::chart::{line_plot, series_colour, LinePlot, PlotError, Scale, Series};
 use psmpm::output::mesh_picture::{mesh_plot, MeshPlotOptions, VertexSelection};
-
-/// A fresh directory for one test's files, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("psmpm-plot-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-    fn file(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Copies `path` into `$PSMPM_PLOT_DIR` when that is set.
 fn keep(path: &Path) {
@@ -183,9 +165,9 @@ fn sample_plot() -> LinePlot {
 
 #[test]
 fn line_plot_draws_one_curve_per_line_series_and_names_them_in_the_legend() {
-    let dir = TempDir::new("line");
+    let dir = TempDir::created("line");
     let plot = sample_plot();
-    let path = dir.file("displacement.svg");
+    let path = dir.join("displacement.svg");
     line_plot(&path, &plot).unwrap();
     keep(&path);
     let (_, elements) = read_svg(&path);
@@ -235,7 +217,7 @@ fn line_plot_draws_one_curve_per_line_series_and_names_them_in_the_legend() {
     });
     assert_eq!(coloured, 2);
     // Same input, same bytes.
-    let again = dir.file("again.svg");
+    let again = dir.join("again.svg");
     line_plot(&again, &plot).unwrap();
     assert_eq!(
         std::fs::read(&path).unwrap(),
@@ -245,7 +227,7 @@ fn line_plot_draws_one_curve_per_line_series_and_names_them_in_the_legend() {
 
 #[test]
 fn log_log_convergence_plot_has_power_of_ten_ticks() {
-    let dir = TempDir::new("loglog");
+    let dir = TempDir::created("loglog");
     let h: Vec<f64> = (1..=5).map(|k| 0.5f64.powi(k)).collect();
     let plot = LinePlot::new("L² projection error", "mesh width h [m]", "error [m]")
         .x_scale(Scale::Log10)
@@ -262,7 +244,7 @@ fn log_log_convergence_plot_has_power_of_ten_ticks() {
             "O(h³)",
             h.iter().map(|&h| (h, 0.6 * h.powi(3))),
         ));
-    let path = dir.file("convergence.svg");
+    let path = dir.join("convergence.svg");
     line_plot(&path, &plot).unwrap();
     keep(&path);
     let (_, elements) = read_svg(&path);
@@ -277,8 +259,8 @@ fn log_log_convergence_plot_has_power_of_ten_ticks() {
 
 #[test]
 fn log_axes_reject_non_positive_values() {
-    let dir = TempDir::new("logerr");
-    let path = dir.file("bad.svg");
+    let dir = TempDir::created("logerr");
+    let path = dir.join("bad.svg");
     let plot = LinePlot::new("errors", "h [m]", "error [m]")
         .y_scale(Scale::Log10)
         .with_series(Series::markers(
@@ -324,8 +306,8 @@ fn log_axes_reject_non_positive_values() {
 
 #[test]
 fn empty_and_non_finite_data_are_errors() {
-    let dir = TempDir::new("empty");
-    let path = dir.file("bad.svg");
+    let dir = TempDir::created("empty");
+    let path = dir.join("bad.svg");
     let plot = LinePlot::new("nothing", "x", "y");
     assert!(matches!(line_plot(&path, &plot), Err(PlotError::Empty(_))));
     let plot = plot.with_series(Series::line("none", []));
@@ -363,12 +345,12 @@ fn empty_and_non_finite_data_are_errors() {
 
 #[test]
 fn mesh_plot_draws_one_control_triangle_per_vertex() {
-    let dir = TempDir::new("mesh");
+    let dir = TempDir::created("mesh");
     let mesh = block_grid(0.0, 1.0, 0.0, 1.0, 2, 2).unwrap();
     let ps = bases::powell_sabin::<f64>(mesh).unwrap();
     let nv = ps.mesh().num_vertices();
     assert_eq!(nv, 13);
-    let path = dir.file("ps-mesh.svg");
+    let path = dir.join("ps-mesh.svg");
     mesh_plot(&path, &ps, &MeshPlotOptions::default()).unwrap();
     keep(&path);
     let (_, elements) = read_svg(&path);
@@ -401,7 +383,7 @@ fn mesh_plot_draws_one_control_triangle_per_vertex() {
         control_triangles: VertexSelection::Only(vec![0, 4, 12]),
         ..MeshPlotOptions::default()
     };
-    let some = dir.file("some.svg");
+    let some = dir.join("some.svg");
     mesh_plot(&some, &ps, &options).unwrap();
     let (_, elements) = read_svg(&some);
     assert_eq!(count(&elements, "polygon", |_| true), 3);
@@ -430,12 +412,12 @@ fn mesh_plot_draws_one_control_triangle_per_vertex() {
 
 #[test]
 fn basis_function_plot_shades_one_function_with_mesh_edges_on_top() {
-    let dir = TempDir::new("basis");
+    let dir = TempDir::created("basis");
     let mesh = block_grid(0.0, 1.0, 0.0, 1.0, 2, 2).unwrap();
     let ps = bases::powell_sabin::<f64>(mesh.clone()).unwrap();
     // Vertex 4 is the centre of the square: its first function.
     let index = 3 * 4;
-    let path = dir.file("ps-basis-12.svg");
+    let path = dir.join("ps-basis-12.svg");
     basis_function_plot(&path, &ps, index, &BasisPlotOptions::default()).unwrap();
     keep(&path);
     let (_, elements) = read_svg(&path);
@@ -463,7 +445,7 @@ fn basis_function_plot_shades_one_function_with_mesh_edges_on_top() {
 
     // A piecewise-linear basis through the same generic code.
     let pl = bases::linear::<f64>(mesh).unwrap();
-    let path = dir.file("pl-basis.svg");
+    let path = dir.join("pl-basis.svg");
     let options = BasisPlotOptions {
         subdivisions: 4,
         pieces: true,
@@ -515,7 +497,7 @@ fn basis_function_plot_shades_one_function_with_mesh_edges_on_top() {
 
 #[test]
 fn plots_of_an_unstructured_rectangle_keep_its_aspect_ratio() {
-    let dir = TempDir::new("jittered");
+    let dir = TempDir::created("jittered");
     let mesh = psmpm::basis::mesh::generators::jittered_lattice_delaunay(
         7,
         4,
@@ -536,7 +518,7 @@ fn plots_of_an_unstructured_rectangle_keep_its_aspect_ratio() {
         control_triangles: VertexSelection::Only(vec![0, 2, interior]),
         ..MeshPlotOptions::default()
     };
-    let path = dir.file("jittered-mesh.svg");
+    let path = dir.join("jittered-mesh.svg");
     mesh_plot(&path, &ps, &options).unwrap();
     keep(&path);
     let (_, elements) = read_svg(&path);
@@ -555,7 +537,7 @@ fn plots_of_an_unstructured_rectangle_keep_its_aspect_ratio() {
     let (wide, high) = (span(|p| p.0), span(|p| p.1));
     assert!((wide / high - 2.0).abs() < 0.02, "{wide} × {high}");
 
-    let path = dir.file("jittered-basis.svg");
+    let path = dir.join("jittered-basis.svg");
     basis_function_plot(&path, &ps, 3 * interior + 1, &BasisPlotOptions::default()).unwrap();
     keep(&path);
     read_svg(&path);

@@ -15,24 +15,18 @@
 //! `known_library_gaps` keeps the gaps these cases first found (errors without a
 //! location or a field name, locations that were off) closed.
 
-use assert_cmd::Command;
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../common/cli.rs"]
+mod common_cli;
+
+use common::temp_dir;
+use common_cli::cli;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-fn cli() -> Command {
-    Command::cargo_bin("mpm-cli").unwrap()
-}
-
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// A fresh directory for the files of one test.
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("psmpm-bad-input-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// A 2D elastic bar on blocks with every optional table.
@@ -494,7 +488,7 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("basis: unknown basis `cubic` (known: ps, pl, bspline, pl1d)"),
         case("unknown-mass-strategy", BAR)
             .edit("mass = \"consistent\"", "mass = @@\"heavy\"")
-            .expect("mass: unknown mass strategy `heavy` (known: default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, fmpm:K)"),
+            .expect("mass: unknown mass strategy `heavy` (known: default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid:C1:C2, fmpm:K)"),
         case("negative-partial-threshold", BAR)
             .edit("mass = \"consistent\"", "mass = @@\"partial:-1\"")
             .expect("mass: `partial:-1`: the threshold must be a positive number, got `-1`"),

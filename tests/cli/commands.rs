@@ -2,12 +2,14 @@
 //! `reproduce`: output pinned with snapshots (wall times removed), round trips, and
 //! determinism across threads.
 
-use assert_cmd::Command;
-use serde_json::Value;
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../common/cli.rs"]
+mod common_cli;
 
-fn cli() -> Command {
-    Command::cargo_bin("mpm-cli").unwrap()
-}
+use common::temp_dir;
+use common_cli::cli;
+use serde_json::Value;
 
 fn stdout(args: &[&str]) -> String {
     let out = cli().args(args).output().unwrap();
@@ -17,12 +19,6 @@ fn stdout(args: &[&str]) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()
-}
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("psmpm-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Drops the `seconds` values (the only machine-dependent numbers) from JSON.
@@ -84,7 +80,8 @@ fn scene_show_prints_the_scene_file() {
         "scene_show_column_small",
         stdout(&["scene", "show", "column-small"])
     );
-    // A file is shown normalised (comments dropped, defaults written out).
+    // A file is shown normalised (its own comments dropped, defaults written out)
+    // and annotated.
     let dir = temp_dir("show-file");
     let path = dir.join("c.toml");
     std::fs::write(&path, stdout(&["scene", "show", "column-small"])).unwrap();

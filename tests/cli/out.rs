@@ -6,130 +6,19 @@
 //! These tests need `python3` with `meshio` (pinned in `tests/requirements.txt`,
 //! installed by `.ci/run`); they fail (never skip) without them.
 
-use assert_cmd::Command;
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../common/cli.rs"]
+mod common_cli;
+
+use common::meshio::{array, read_back};
+use common::TempDir;
+use common_cli::cli;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-/// The meshio version `tests/requirements.txt` pins.
-const MESHIO: &str = "5.3.5";
-
-fn cli() -> Command {
-    Command::cargo_bin("mpm-cli").unwrap()
-}
-
-/// Reads `.vtu` files with meshio, `.pvd` files and SVGs with `xml.etree` (which
-/// rejects a file that is not well-formed XML); floats come back as `repr` strings.
-const SCRIPT: &str = r#"
-import json, sys
-try:
-    import meshio
-except ImportError as e:
-    print(f"cannot import meshio: {e}", file=sys.stderr)
-    sys.exit(3)
-import xml.etree.ElementTree as ET
-
-def floats(a):
-    return [repr(float(x)) for x in a.ravel()]
-
-def local(tag):
-    return tag.rsplit("}", 1)[-1]
-
-out = {"vtu": {}, "pvd": {}, "svg": {}}
-for path in sys.argv[1:]:
-    if path.endswith(".pvd"):
-        root = ET.parse(path).getroot()
-        assert root.tag == "VTKFile" and root.get("type") == "Collection", root.attrib
-        out["pvd"][path] = [[repr(float(d.get("timestep"))), d.get("file")]
-                            for d in root.find("Collection").findall("DataSet")]
-    elif path.endswith(".svg"):
-        root = ET.parse(path).getroot()
-        assert local(root.tag) == "svg", root.tag
-        elements = list(root.iter())
-        out["svg"][path] = {
-            "polyline_strokes": [e.get("stroke") for e in elements if local(e.tag) == "polyline"],
-            "circles": sum(1 for e in elements if local(e.tag) == "circle"),
-            "texts": ["".join(e.itertext()).strip() for e in elements if local(e.tag) == "text"],
-        }
-    else:
-        m = meshio.read(path)
-        out["vtu"][path] = {
-            "points": {"shape": list(m.points.shape), "values": floats(m.points)},
-            "cells": [[c.type, len(c.data)] for c in m.cells],
-            "point_data": {k: {"shape": list(v.shape), "values": floats(v)}
-                           for k, v in m.point_data.items()},
-        }
-print(json.dumps(out))
-"#;
-
-fn install_hint() -> String {
-    format!(
-        "these tests read the output back with meshio: run `python3 -m pip install meshio=={MESHIO}` (or `-r tests/requirements.txt`)"
-    )
-}
-
-/// Runs the reader on `files` and returns its JSON.
-fn read_back(files: &[PathBuf]) -> Value {
-    let output = std::process::Command::new("python3")
-        .arg("-c")
-        .arg(SCRIPT)
-        .args(files)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run python3 ({e}); {}", install_hint()));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if output.status.code() == Some(3) {
-        panic!("{}; {}", stderr.trim(), install_hint());
-    }
-    assert!(
-        output.status.success(),
-        "the reader failed ({}):\n{stderr}",
-        output.status
-    );
-    serde_json::from_slice(&output.stdout).expect("the reader prints JSON")
-}
-
-/// A fresh directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let path =
-            std::env::temp_dir().join(format!("psmpm-cli-out-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&path);
-        TempDir(path)
-    }
-    fn path(&self) -> &Path {
-        &self.0
-    }
-    fn join(&self, file: &str) -> PathBuf {
-        self.0.join(file)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn key(path: &Path) -> &str {
     path.to_str().unwrap()
-}
-
-/// A float array of the reader's JSON with its shape.
-fn array(value: &Value) -> (Vec<usize>, Vec<f64>) {
-    let shape = value["shape"]
-        .as_array()
-        .unwrap_or_else(|| panic!("no array in {value}"))
-        .iter()
-        .map(|s| s.as_u64().unwrap() as usize)
-        .collect();
-    let values = value["values"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().unwrap().parse::<f64>().unwrap())
-        .collect();
-    (shape, values)
 }
 
 /// Parses a CSV file: the header and the rows as strings.
@@ -346,7 +235,7 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
     let json = read_back(&files);
     let mesh = &json["vtu"][key(&files[0])];
     // 4 x 1 blocks of four triangles: 16 triangles on 10 corners + 4 centres.
-    assert_eq!(mesh["cells"], serde_json::json!([["triangle", 16]]));
+    assert_eq!(mesh["cell_counts"], serde_json::json!([["triangle", 16]]));
     assert_eq!(array(&mesh["points"]).0, [14, 3]);
 
     let first = &json["vtu"][key(&files[1])];
@@ -356,7 +245,7 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
     assert_eq!(shape, [n, 3]);
     let (shape, x) = array(&last["points"]);
     assert_eq!(shape, [n, 3]);
-    assert_eq!(last["cells"], serde_json::json!([["vertex", n]]));
+    assert_eq!(last["cell_counts"], serde_json::json!([["vertex", n]]));
     let (shape, u) = array(&last["point_data"]["displacement"]);
     assert_eq!(shape, [n, 3]);
     assert_eq!(array(&last["point_data"]["velocity"]).0, [n, 3]);
@@ -467,7 +356,7 @@ fn a_1d_run_writes_about_50_frames_and_no_mesh() {
     assert!(out.stderr.is_empty());
     // 1000 steps: a frame every 20 steps and the initial state.
     for k in 0..=50 {
-        assert!(dir.join(&format!("particles_{k:05}.vtu")).is_file(), "{k}");
+        assert!(dir.join(format!("particles_{k:05}.vtu")).is_file(), "{k}");
     }
     assert!(!dir.join("particles_00051.vtu").exists());
     for file in ["mesh.vtu", "tracked.csv", "tracked.svg"] {

@@ -1,11 +1,10 @@
 //! `mpm-cli project`: output formats, the Gmsh path, and every kind of bad input.
 
-use assert_cmd::Command;
-use serde_json::Value;
+#[path = "../common/cli.rs"]
+mod common_cli;
 
-fn cli() -> Command {
-    Command::cargo_bin("mpm-cli").unwrap()
-}
+use common_cli::cli;
+use serde_json::Value;
 
 fn data(name: &str) -> String {
     format!("{}/../tests/data/{name}", env!("CARGO_MANIFEST_DIR"))

@@ -1,11 +1,10 @@
 //! `mpm-cli run`: JSON lines and summary, the table, and bad input.
 
-use assert_cmd::Command;
-use serde_json::Value;
+#[path = "../common/cli.rs"]
+mod common_cli;
 
-fn cli() -> Command {
-    Command::cargo_bin("mpm-cli").unwrap()
-}
+use common_cli::cli;
+use serde_json::Value;
 
 #[test]
 fn json_lines_then_a_summary_with_the_documented_keys() {

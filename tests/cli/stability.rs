@@ -1,12 +1,11 @@
 //! `mpm-cli stability`: the matrix of cases × mass strategies, its JSON structure,
 //! the cells known to be stable, determinism across threads, and bad arguments.
 
-use assert_cmd::Command;
-use serde_json::Value;
+#[path = "../common/cli.rs"]
+mod common_cli;
 
-fn cli() -> Command {
-    Command::cargo_bin("mpm-cli").unwrap()
-}
+use common_cli::cli;
+use serde_json::Value;
 
 fn json(args: &[&str]) -> Value {
     let out = cli().args(args).output().unwrap();
