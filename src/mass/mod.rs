@@ -100,8 +100,17 @@ pub enum MassKind {
     },
 }
 
+/// Coverage below which `extended-hybrid` (without numbers) extends a function
+/// (its `C1`): only functions with almost no particles leave the solve.
+pub const DEFAULT_HYBRID_EXTEND: f64 = 0.02;
+/// Coverage below which `extended-hybrid` (without numbers) lumps a function's row
+/// (its `C2`).
+pub const DEFAULT_HYBRID_LUMP: f64 = 0.75;
+
 impl Default for MassKind {
     /// The default strategy of every basis: extension at the default coverage.
+    /// (`extended-hybrid` is more accurate on the seeds' columns but lumped rows
+    /// lose the rotation of a free body: `docs/stability.md`, "Variants tried".)
     fn default() -> Self {
         MassKind::Extended {
             coverage: DEFAULT_COVERAGE,
@@ -110,7 +119,7 @@ impl Default for MassKind {
 }
 
 /// Names [`MassKind::parse`] knows, for messages.
-pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid:C1:C2, fmpm:K";
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, fmpm:K";
 
 impl MassKind {
     /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
@@ -160,7 +169,13 @@ impl MassKind {
             ("deactivate", Some(a)) => Ok(MassKind::Deactivate {
                 threshold: number(a)?,
             }),
-            ("extended", None) => Ok(MassKind::default()),
+            ("extended", None) => Ok(MassKind::Extended {
+                coverage: DEFAULT_COVERAGE,
+            }),
+            ("extended-hybrid", None) => Ok(MassKind::ExtendedHybrid {
+                extend: DEFAULT_HYBRID_EXTEND,
+                lump: DEFAULT_HYBRID_LUMP,
+            }),
             ("extended", Some(a)) => Ok(MassKind::Extended {
                 coverage: fraction(a)?,
             }),
@@ -204,7 +219,11 @@ impl MassKind {
             MassKind::Extended { coverage } if coverage != DEFAULT_COVERAGE => {
                 format!("extended:{coverage}")
             }
-            MassKind::ExtendedHybrid { extend, lump } => format!("extended-hybrid:{extend}:{lump}"),
+            MassKind::ExtendedHybrid { extend, lump }
+                if (extend, lump) != (DEFAULT_HYBRID_EXTEND, DEFAULT_HYBRID_LUMP) =>
+            {
+                format!("extended-hybrid:{extend}:{lump}")
+            }
             MassKind::Fmpm { order } => format!("fmpm:{order}"),
             other => other.name().to_string(),
         }

@@ -129,7 +129,12 @@ fn partial_lumping_keeps_row_sums_and_stays_spd() {
 #[test]
 fn extension_keeps_row_sums_where_consistent_fails() {
     let c = column_mass();
-    let mut m = prepared(&c, MassKind::default());
+    let mut m = prepared(
+        &c,
+        MassKind::Extended {
+            coverage: DEFAULT_COVERAGE,
+        },
+    );
     let report = m.factorize(&c.pattern, &c.values, context(&c)).unwrap();
     assert!(report.extended > 0, "nothing extended: {report:?}");
     let (_, worst) = report.worst_coverage.unwrap();
@@ -165,14 +170,19 @@ fn hybrid_extension_keeps_row_sums_where_consistent_fails() {
 fn extension_is_the_consistent_mass_where_everything_is_covered() {
     let c = filled_to(2.0);
     let mut consistent = prepared(&c, MassKind::Consistent);
-    let mut extended = prepared(&c, MassKind::default());
+    let mut extended = prepared(
+        &c,
+        MassKind::Extended {
+            coverage: DEFAULT_COVERAGE,
+        },
+    );
     consistent
         .factorize(&c.pattern, &c.values, context(&c))
         .unwrap();
     let report = extended
         .factorize(&c.pattern, &c.values, context(&c))
         .unwrap();
-    assert_eq!(report.extended, 0, "{report:?}");
+    assert_eq!(report.treated(), 0, "{report:?}");
     let n = c.ps.num_functions();
     let rhs: Vec<f64> = (0..n).map(|i| ((i * 7) % 5) as f64 * 1e-3 - 1e-3).collect();
     let (mut a, mut b) = (rhs.clone(), rhs);

@@ -160,7 +160,10 @@ impl<T: Scalar> Extended<T> {
 
 impl<T: Scalar> MassStrategy<T> for Extended<T> {
     fn spec(&self) -> String {
-        if self.lump > self.coverage {
+        if (self.coverage, self.lump) == (super::DEFAULT_HYBRID_EXTEND, super::DEFAULT_HYBRID_LUMP)
+        {
+            "extended-hybrid".into()
+        } else if self.lump > self.coverage {
             format!("extended-hybrid:{}:{}", self.coverage, self.lump)
         } else if self.coverage == DEFAULT_COVERAGE {
             "extended".into()
