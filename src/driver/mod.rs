@@ -18,6 +18,11 @@
 //! We use the full gradient `∇v` (see [`phases::update_deformation_gradient`]).
 //!
 //! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
+//!
+//! The particle phases run on the current rayon thread pool (run the loop inside
+//! [`rayon::ThreadPool::install`] to choose the threads, or see
+//! [`crate::threads`]); results are bit-identical for any number of threads (see
+//! [`phases`]).
 
 mod critical;
 mod failure;
@@ -37,7 +42,7 @@ use crate::material::Material;
 use crate::particles::Particles;
 use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::SVector;
-use phases::{Evaluations, UpdateFailure};
+use phases::{Bins, Evaluations, Gather, Local, UpdateFailure};
 use psmpm_basis::{Basis, BasisError, BasisEval};
 use std::time::Instant;
 
@@ -97,7 +102,6 @@ pub struct Fix {
 /// The per-step facts a mass strategy asked for.
 struct StrategyInputs {
     needs: Needs,
-    occupied: Vec<bool>,
     touches_empty: Vec<bool>,
     particle_volume: Vec<f64>,
     support: Option<SupportFacts>,
@@ -125,7 +129,14 @@ where
     time: f64,
     // Buffers, sized once.
     evals: Evaluations<T, D>,
-    eval: BasisEval<T, D>,
+    /// One basis scratch per particle chunk ([`phases::CHUNK`]).
+    scratch: Vec<BasisEval<T, D>>,
+    /// Particles by element, every step.
+    bins: Bins,
+    /// Element-local sums.
+    local: Local<T, D>,
+    /// Element-local sums → matrix entries and coefficients.
+    gather: Gather,
     values: Vec<T>,
     /// `F`, then the acceleration coefficients `a`.
     rhs: Vec<Vec<T>>,
@@ -222,19 +233,20 @@ where
         });
         let inputs = StrategyInputs {
             needs,
-            occupied: if needs.empty_elements {
-                vec![false; basis.num_elements()]
-            } else {
-                Vec::new()
-            },
             touches_empty: vec![false; if needs.empty_elements { n } else { 0 }],
             particle_volume: vec![0.0; if needs.coverage { n } else { 0 }],
             support,
         };
         let np = particles.len();
+        let stride = basis.max_functions_per_element();
         Ok(Driver {
-            eval: BasisEval::for_basis(&basis),
-            evals: Evaluations::new(np, basis.max_functions_per_element()),
+            scratch: (0..phases::chunks(np))
+                .map(|_| BasisEval::for_basis(&basis))
+                .collect(),
+            evals: Evaluations::new(np, stride),
+            bins: Bins::new(basis.num_elements(), np),
+            local: Local::new(basis.num_elements(), stride),
+            gather: Gather::new(&basis, &pattern, stride),
             values: vec![T::zero(); pattern.nnz()],
             rhs: vec![vec![T::zero(); n]; D],
             velocity: vec![vec![T::zero(); n]; D],
@@ -325,6 +337,9 @@ where
         let t_solve = clock.elapsed().as_secs_f64() - t_assemble;
         phases::update_velocities_and_momentum(
             &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
             &self.rhs,
             self.dt,
             &self.particles.mass,
@@ -354,7 +369,7 @@ where
             &self.basis,
             &self.particles.x,
             &mut self.particles.element,
-            &mut self.eval,
+            &mut self.scratch,
             &mut self.evals,
         )
         .map_err(|o| {
@@ -375,24 +390,25 @@ where
     /// Phase 2a: `M`, `F = −F^int` into `rhs`, and the facts the mass strategy
     /// asked for.
     fn assemble_mass(&mut self) {
+        self.bins.fill(&self.particles.element);
         phases::assemble_mass_and_internal_force(
-            &self.pattern,
             &self.particles,
             &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
             &mut self.values,
             &mut self.rhs,
         );
         if self.inputs.needs.empty_elements {
-            phases::mark_empty_elements(
-                &self.basis,
-                &self.particles.element,
-                &mut self.inputs.occupied,
-                &mut self.inputs.touches_empty,
-            );
+            phases::mark_empty_elements(&self.basis, &self.bins, &mut self.inputs.touches_empty);
         }
         if self.inputs.needs.coverage {
-            phases::particle_volume(
+            phases::particle_volume_by_elements(
                 &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
                 &self.particles.volume,
                 &mut self.inputs.particle_volume,
             );
@@ -500,6 +516,9 @@ where
             phases::zero(&mut self.velocity);
             phases::scatter_to_functions(
                 &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
                 &self.particles.mass,
                 &self.particles.v,
                 &mut self.velocity,
