@@ -100,11 +100,18 @@ fn steps_allocate<B: Basis<f64, 2> + Clone + Send>(
         .unwrap_or(0)
 }
 
-/// The pool of 1 or 2 threads, built once: a pool dropped while another counts
-/// would end its threads, and ending threads allocate and free.
+/// The pool of 1 or 2 threads, built once and started before any count: threads
+/// that start or end allocate.
 fn pool(threads: usize) -> &'static ThreadPool {
     static POOLS: OnceLock<[ThreadPool; 2]> = OnceLock::new();
-    let pools = POOLS.get_or_init(|| [1, 2].map(|n| psmpm::threads::pool(Some(n)).unwrap()));
+    let pools = POOLS.get_or_init(|| {
+        let pools = [1, 2].map(|n| psmpm::threads::pool(Some(n)).unwrap());
+        // Every worker started (starting threads allocate) before any count.
+        for pool in &pools {
+            pool.broadcast(|_| ());
+        }
+        pools
+    });
     &pools[threads - 1]
 }
 
