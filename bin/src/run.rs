@@ -117,6 +117,10 @@ pub struct RunArgs {
     /// first and last state only, which are always written).
     #[arg(long, value_name = "N", requires = "out")]
     out_every: Option<usize>,
+    /// Threads of the particle phases (default: all cores). The results are the
+    /// same, bit for bit, for any number.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
 }
 
 /// Parses `AxB`.
@@ -239,6 +243,21 @@ fn row_cells(r: &StepReport) -> Vec<String> {
 /// Runs the scene and prints diagnostics and the summary (and writes the files of
 /// `--out`).
 pub fn run(args: RunArgs) -> Result<(), CliError> {
+    let pool = thread_pool(args.threads)?;
+    pool.install(move || run_on_pool(args))
+}
+
+/// The pool of `--threads N` (`None`: one thread per core).
+pub fn thread_pool(threads: Option<usize>) -> Result<psmpm::threads::ThreadPool, CliError> {
+    if threads == Some(0) {
+        return Err(CliError::Input("--threads must be at least 1".into()));
+    }
+    psmpm::threads::pool(threads)
+        .map_err(|e| CliError::Input(format!("--threads: no thread pool ({e})")))
+}
+
+/// [`run`] on the current thread pool.
+fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     let s = scene(&args)?;
     let every = args
         .diag_every
