@@ -44,6 +44,7 @@ use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::SVector;
 use phases::{Bins, Evaluations, Gather, Local, UpdateFailure};
 use psmpm_basis::{Basis, BasisError, BasisEval};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Coverage below which a function counts as under-supported in failure messages.
@@ -148,6 +149,9 @@ where
     work_force: Vec<Vec<T>>,
     /// Scratch for [`Effect::adjust_forces`]; empty without effects.
     adjust: Vec<Vec<T>>,
+    /// Per-particle forces of the effects that act per particle
+    /// ([`Effect::particle_force`]); empty without any.
+    particle_force: Vec<SVector<T, D>>,
     work: f64,
     inputs: StrategyInputs,
     last_report: MassReport,
@@ -253,6 +257,11 @@ where
             velocity_known: false,
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             adjust: scratch(!effects.is_empty()),
+            particle_force: if effects.iter().any(|e| e.acts_per_particle()) {
+                vec![SVector::zeros(); np]
+            } else {
+                Vec::new()
+            },
             work: 0.0,
             constraints: Constraints::new(general, n),
             inputs,
@@ -436,12 +445,15 @@ where
         if tracks_work {
             phases::zero(&mut self.work_force);
         }
-        for effect in &self.effects {
+        for effect in self.effects.iter().filter(|e| !e.acts_per_particle()) {
             if effect.does_work() {
                 effect.add_forces(&self.particles, &state, &mut self.work_force);
             } else {
                 effect.add_forces(&self.particles, &state, &mut self.rhs);
             }
+        }
+        for work in [false, true] {
+            self.scatter_particle_forces(work);
         }
         if tracks_work {
             phases::add_into(&mut self.rhs, &self.work_force);
@@ -455,6 +467,45 @@ where
             effect.adjust_forces(&self.rhs, &self.velocity, &mut self.adjust);
         }
         phases::add_into(&mut self.rhs, &self.adjust);
+    }
+
+    /// The forces of the effects that act per particle and do work (`work`) or
+    /// not, summed per particle in the effects' order, then scattered into
+    /// `work_force` or `rhs`.
+    fn scatter_particle_forces(&mut self, work: bool) {
+        let acting = |e: &&Box<dyn Effect<T, D>>| e.acts_per_particle() && e.does_work() == work;
+        if !self.effects.iter().any(|e| acting(&e)) {
+            return;
+        }
+        let (effects, particles, time) = (&self.effects, &self.particles, self.time);
+        self.particle_force
+            .par_chunks_mut(phases::CHUNK)
+            .enumerate()
+            .for_each(|(c, forces)| {
+                for (q, f) in forces.iter_mut().enumerate() {
+                    let p = c * phases::CHUNK + q;
+                    *f = SVector::zeros();
+                    for effect in effects.iter().filter(acting) {
+                        if let Some(force) = effect.particle_force(particles, p, time) {
+                            *f += force;
+                        }
+                    }
+                }
+            });
+        let target = if work {
+            &mut self.work_force
+        } else {
+            &mut self.rhs
+        };
+        let (evals, forces) = (&self.evals, &self.particle_force);
+        phases::scatter_by_elements(
+            &self.bins,
+            evals,
+            &self.gather,
+            &mut self.local,
+            target,
+            |p, s| forces[p] * evals.phi[s],
+        );
     }
 
     /// Phase 3a: the strategy's numeric work on `M`, the condition estimate when
