@@ -473,8 +473,8 @@ where
     /// not, summed per particle in the effects' order, then scattered into
     /// `work_force` or `rhs`.
     fn scatter_particle_forces(&mut self, work: bool) {
-        let acting = |e: &&Box<dyn Effect<T, D>>| e.acts_per_particle() && e.does_work() == work;
-        if !self.effects.iter().any(|e| acting(&e)) {
+        let acting = move |e: &dyn Effect<T, D>| e.acts_per_particle() && e.does_work() == work;
+        if !self.effects.iter().any(|e| acting(e.as_ref())) {
             return;
         }
         let (effects, particles, time) = (&self.effects, &self.particles, self.time);
@@ -485,7 +485,7 @@ where
                 for (q, f) in forces.iter_mut().enumerate() {
                     let p = c * phases::CHUNK + q;
                     *f = SVector::zeros();
-                    for effect in effects.iter().filter(acting) {
+                    for effect in effects.iter().filter(|e| acting(e.as_ref())) {
                         if let Some(force) = effect.particle_force(particles, p, time) {
                             *f += force;
                         }
