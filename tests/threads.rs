@@ -116,3 +116,73 @@ fn damped_column_is_the_same_for_any_threads() {
     s.time.t_end = 2e-4;
     same_for_any_threads(&s, "PS partial, damped");
 }
+
+/// The step report's energies (per-particle terms in parallel, summed in particle
+/// order) are those of `Driver::report` (all sequential), bit for bit.
+#[test]
+fn step_energies_are_the_sequential_sums() {
+    use nalgebra::Vector2;
+    use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+    use psmpm::basis::mesh::generators::block_grid;
+    use psmpm::driver::{Driver, Fix};
+    use psmpm::effect::{Effect, Gravity};
+    use psmpm::mass::Consistent;
+    use psmpm::material::{Elastic, LinearElastic};
+    use psmpm::particles::Particles;
+
+    let mesh = block_grid(0.0, 2.0, 0.0, 25.0, 2, 16).unwrap();
+    let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+    let mut x = Vec::new();
+    for j in 0..160 {
+        for i in 0..16 {
+            x.push(Vector2::new(
+                (i as f64 + 0.5) / 8.0,
+                (j as f64 + 0.5) * 25.0 / 160.0,
+            ));
+        }
+    }
+    let n = x.len();
+    let particles = Particles::new(x, vec![50.0 / n as f64; n], 1.0);
+    let fixes = [
+        Fix {
+            tag: "bottom".into(),
+            component: 1,
+        },
+        Fix {
+            tag: "left".into(),
+            component: 0,
+        },
+    ];
+    let effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity {
+        g: Vector2::new(0.0, -9.81),
+    })];
+    let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
+    let mut d = Driver::new(
+        ps,
+        particles,
+        material,
+        Consistent::default(),
+        &fixes,
+        effects,
+        1e-4,
+    )
+    .unwrap();
+    let pool = psmpm::threads::pool(Some(2)).unwrap();
+    for _ in 0..5 {
+        let stepped = pool.install(|| d.step().unwrap());
+        let sequential = d.report();
+        let bits = |r: &StepReport| {
+            [
+                r.kinetic,
+                r.strain,
+                r.potential,
+                r.mass,
+                r.momentum[0],
+                r.momentum[1],
+                r.max_speed,
+            ]
+            .map(f64::to_bits)
+        };
+        assert_eq!(bits(&stepped), bits(&sequential));
+    }
+}

@@ -33,7 +33,7 @@ pub use critical::CRITICAL_ITERATIONS;
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
 
-use crate::diagnostics::energies;
+use crate::diagnostics::{energies, energies_from_terms, particle_terms, Energies};
 use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{
     Constraints, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
@@ -152,6 +152,8 @@ where
     /// Per-particle forces of the effects that act per particle
     /// ([`Effect::particle_force`]); empty without any.
     particle_force: Vec<SVector<T, D>>,
+    /// Per-particle terms of the step report's energies.
+    energy_terms: Vec<[f64; 8]>,
     work: f64,
     inputs: StrategyInputs,
     last_report: MassReport,
@@ -257,6 +259,7 @@ where
             velocity_known: false,
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             adjust: scratch(!effects.is_empty()),
+            energy_terms: vec![[0.0; 8]; np],
             particle_force: if effects.iter().any(|e| e.acts_per_particle()) {
                 vec![SVector::zeros(); np]
             } else {
@@ -369,7 +372,23 @@ where
         self.step += 1;
         // Time from the step count, so that it does not accumulate round-off.
         self.time = self.step as f64 * self.dt.to_f64();
-        Ok(self.report())
+        let e = self.step_energies();
+        Ok(self.report_with(e))
+    }
+
+    /// [`energies`] of the current state, the per-particle terms computed in
+    /// parallel and summed in particle order (the same sums, bit for bit).
+    fn step_energies(&mut self) -> Energies {
+        let (parts, material) = (&self.particles, &self.material);
+        self.energy_terms
+            .par_chunks_mut(phases::CHUNK)
+            .enumerate()
+            .for_each(|(c, terms)| {
+                for (q, t) in terms.iter_mut().enumerate() {
+                    *t = particle_terms(parts, material, c * phases::CHUNK + q);
+                }
+            });
+        energies_from_terms(self.energy_terms.iter().copied(), parts, &self.effects)
     }
 
     /// Phase 1.
@@ -620,7 +639,10 @@ where
 
     /// Energies and momentum of the current state.
     pub fn report(&self) -> StepReport {
-        let e = energies(&self.particles, &self.material, &self.effects);
+        self.report_with(energies(&self.particles, &self.material, &self.effects))
+    }
+
+    fn report_with(&self, e: Energies) -> StepReport {
         StepReport {
             step: self.step,
             time: self.time,
