@@ -5,6 +5,12 @@
 //! Run: `cargo bench --bench step`. The per-phase split comes from the driver's
 //! phase timers: `cargo run --release -p mpm-cli -- run column-small --blocks 4x32
 //! --particles 8x10 --t-end 0.01 --basis ps --diag-every 0` prints it.
+//!
+//! Threads: the `threads` group steps about 1e5 particles (8 × 64 blocks, 8 × 24
+//! particles per block: 98 304) with PL lumped, PS lumped, PS consistent and PS
+//! with the default mass, on a pool of one thread and on one of all cores
+//! (`cargo bench --bench step -- threads`). The results are the same, bit for
+//! bit; only the time differs.
 
 use nalgebra::Vector2;
 use psmpm::basis::basis::linear::Linear;
@@ -13,25 +19,36 @@ use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::{Basis, TriMesh};
 use psmpm::driver::{Driver, Fix};
 use psmpm::effect::{Effect, Gravity};
-use psmpm::mass::{Consistent, Lumped, MassStrategy};
+use psmpm::mass::{Consistent, Lumped, MassKind, MassStrategy};
 use psmpm::material::{Elastic, LinearElastic};
 use psmpm::particles::Particles;
 
 const BLOCKS: (usize, usize) = (4, 32);
 const PER_BLOCK: (usize, usize) = (8, 10);
 
+/// Blocks and particles per block of the thread benchmarks (98 304 particles).
+const LARGE: ((usize, usize), (usize, usize)) = ((8, 64), (8, 24));
+
 fn mesh() -> TriMesh {
-    block_grid(0.0, 2.0, 0.0, 25.0, BLOCKS.0, BLOCKS.1).unwrap()
+    mesh_of(BLOCKS)
+}
+
+fn mesh_of(blocks: (usize, usize)) -> TriMesh {
+    block_grid(0.0, 2.0, 0.0, 25.0, blocks.0, blocks.1).unwrap()
 }
 
 fn particles() -> Particles<f64, 2> {
-    let (bx, by) = (2.0 / BLOCKS.0 as f64, 25.0 / BLOCKS.1 as f64);
+    particles_of(BLOCKS, PER_BLOCK)
+}
+
+fn particles_of(blocks: (usize, usize), per_block: (usize, usize)) -> Particles<f64, 2> {
+    let (bx, by) = (2.0 / blocks.0 as f64, 25.0 / blocks.1 as f64);
     let mut x = Vec::new();
-    for j in 0..BLOCKS.1 * PER_BLOCK.1 {
-        for i in 0..BLOCKS.0 * PER_BLOCK.0 {
+    for j in 0..blocks.1 * per_block.1 {
+        for i in 0..blocks.0 * per_block.0 {
             x.push(Vector2::new(
-                (i as f64 + 0.5) * bx / PER_BLOCK.0 as f64,
-                (j as f64 + 0.5) * by / PER_BLOCK.1 as f64,
+                (i as f64 + 0.5) * bx / per_block.0 as f64,
+                (j as f64 + 0.5) * by / per_block.1 as f64,
             ));
         }
     }
@@ -42,6 +59,14 @@ fn particles() -> Particles<f64, 2> {
 fn driver<B: Basis<f64, 2>, M: MassStrategy<f64>>(
     basis: B,
     mass: M,
+) -> Driver<f64, 2, B, M, LinearElastic> {
+    driver_with(basis, mass, particles())
+}
+
+fn driver_with<B: Basis<f64, 2>, M: MassStrategy<f64>>(
+    basis: B,
+    mass: M,
+    particles: Particles<f64, 2>,
 ) -> Driver<f64, 2, B, M, LinearElastic> {
     let fixes = [
         Fix {
@@ -65,7 +90,7 @@ fn driver<B: Basis<f64, 2>, M: MassStrategy<f64>>(
         g: Vector2::new(0.0, -9.81),
     })];
     let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
-    Driver::new(basis, particles(), material, mass, &fixes, effects, 1e-5).unwrap()
+    Driver::new(basis, particles, material, mass, &fixes, effects, 1e-5).unwrap()
 }
 
 #[divan::bench(sample_count = 20)]
@@ -79,6 +104,67 @@ fn ps_consistent_step(bencher: divan::Bencher) {
     let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
     let mut d = driver(ps, Consistent::default());
     bencher.bench_local(|| d.step().unwrap());
+}
+
+/// One thread, then one per core.
+fn thread_counts() -> Vec<usize> {
+    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if all > 1 {
+        vec![1, all]
+    } else {
+        vec![1]
+    }
+}
+
+/// Steps of about 1e5 particles on a pool of `threads` threads; the variants
+/// are named `BASIS_MASS`.
+mod threads {
+    use super::*;
+
+    fn bench_on<B: Basis<f64, 2> + Send>(
+        bencher: divan::Bencher,
+        threads: usize,
+        basis: B,
+        mass: &str,
+    ) {
+        let pool = psmpm::threads::pool(Some(threads)).unwrap();
+        let mass = MassKind::parse(mass).unwrap().build::<f64>();
+        let (blocks, per_block) = LARGE;
+        let mut d = driver_with(basis, mass, particles_of(blocks, per_block));
+        pool.install(|| d.step().unwrap());
+        bencher
+            .counter(divan::counter::ItemsCount::new(d.particles.len()))
+            .bench_local(|| pool.install(|| d.step().unwrap()));
+    }
+
+    fn ps() -> PowellSabin<f64> {
+        PowellSabin::<f64>::new(mesh_of(LARGE.0), SplitPoint::Incentre).unwrap()
+    }
+
+    #[divan::bench(args = thread_counts(), sample_count = 10, sample_size = 1)]
+    fn pl_lumped(bencher: divan::Bencher, threads: usize) {
+        bench_on(
+            bencher,
+            threads,
+            Linear::<f64>::new(mesh_of(LARGE.0)),
+            "lumped",
+        );
+    }
+
+    #[divan::bench(args = thread_counts(), sample_count = 10, sample_size = 1)]
+    fn ps_lumped(bencher: divan::Bencher, threads: usize) {
+        bench_on(bencher, threads, ps(), "lumped");
+    }
+
+    #[divan::bench(args = thread_counts(), sample_count = 10, sample_size = 1)]
+    fn ps_consistent(bencher: divan::Bencher, threads: usize) {
+        bench_on(bencher, threads, ps(), "consistent");
+    }
+
+    #[divan::bench(args = thread_counts(), sample_count = 10, sample_size = 1)]
+    fn ps_default(bencher: divan::Bencher, threads: usize) {
+        bench_on(bencher, threads, ps(), "default");
+    }
 }
 
 fn main() {

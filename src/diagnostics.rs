@@ -98,23 +98,61 @@ pub fn energies<T: Scalar, const D: usize, Mat: Material<T, D>>(
     material: &Mat,
     effects: &[Box<dyn Effect<T, D>>],
 ) -> Energies {
+    energies_from_terms(
+        (0..parts.len()).map(|p| particle_terms(parts, material, p)),
+        parts,
+        effects,
+    )
+}
+
+/// What particle `p` adds to [`energies`]: `½ m |v|²`, `|v|`, `V⁰ W(F)`, the
+/// initial stress's work `V⁰ σ⁰ : (sym F − I)`, whether it has an initial stress
+/// (1 or 0), `m`, `m v` (up to two components). Computed apart (in parallel by the
+/// driver) and summed by [`energies_from_terms`] in particle order, the sums are
+/// those of [`energies`], bit for bit.
+pub fn particle_terms<T: Scalar, const D: usize, Mat: Material<T, D>>(
+    parts: &Particles<T, D>,
+    material: &Mat,
+    p: usize,
+) -> [f64; 8] {
+    let m = parts.mass[p].to_f64();
+    let speed2 = parts.v[p].norm_squared().to_f64();
+    let mut terms = [0.0; 8];
+    terms[0] = 0.5 * m * speed2;
+    terms[1] = speed2.sqrt();
+    terms[2] = parts.volume0[p].to_f64() * material.energy_density(&parts.f[p]).to_f64();
+    if parts.sigma0[p] != SMatrix::<T, D, D>::zeros() {
+        // First-order work of the initial stress: V⁰ σ⁰ : (sym F − I).
+        let f = &parts.f[p];
+        let e = (f + f.transpose()) * T::of(0.5) - SMatrix::<T, D, D>::identity();
+        terms[3] = parts.volume0[p].to_f64() * parts.sigma0[p].dot(&e).to_f64();
+        terms[4] = 1.0;
+    }
+    terms[5] = m;
+    for k in 0..D {
+        terms[6 + k] = m * parts.v[p][k].to_f64();
+    }
+    terms
+}
+
+/// [`energies`] from the [`particle_terms`] of every particle, in particle order.
+pub fn energies_from_terms<T: Scalar, const D: usize>(
+    terms: impl Iterator<Item = [f64; 8]>,
+    parts: &Particles<T, D>,
+    effects: &[Box<dyn Effect<T, D>>],
+) -> Energies {
     let (mut kinetic, mut strain, mut mass, mut max_speed) = (0.0, 0.0, 0.0, 0.0f64);
     let mut momentum = [0.0; 2];
-    for p in 0..parts.len() {
-        let m = parts.mass[p].to_f64();
-        let speed2 = parts.v[p].norm_squared().to_f64();
-        kinetic += 0.5 * m * speed2;
-        max_speed = max_speed.max(speed2.sqrt());
-        strain += parts.volume0[p].to_f64() * material.energy_density(&parts.f[p]).to_f64();
-        if parts.sigma0[p] != SMatrix::<T, D, D>::zeros() {
-            // First-order work of the initial stress: V⁰ σ⁰ : (sym F − I).
-            let f = &parts.f[p];
-            let e = (f + f.transpose()) * T::of(0.5) - SMatrix::<T, D, D>::identity();
-            strain += parts.volume0[p].to_f64() * parts.sigma0[p].dot(&e).to_f64();
+    for t in terms {
+        kinetic += t[0];
+        max_speed = max_speed.max(t[1]);
+        strain += t[2];
+        if t[4] != 0.0 {
+            strain += t[3];
         }
-        mass += m;
+        mass += t[5];
         for k in 0..D {
-            momentum[k] += m * parts.v[p][k].to_f64();
+            momentum[k] += t[6 + k];
         }
     }
     Energies {

@@ -71,6 +71,22 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
         _forces: &mut [Vec<T>],
     ) {
     }
+    /// The force `f_p` this effect puts on particle `p` at time `time`, for an
+    /// effect whose forces are `F_{k,i} = Σ_p phi_i(x_p) f_{p,k}`: the driver then
+    /// scatters them itself, in parallel, instead of calling
+    /// [`add_forces`](Self::add_forces). `None` (the default): not such an effect.
+    fn particle_force(
+        &self,
+        _particles: &Particles<T, D>,
+        _p: usize,
+        _time: f64,
+    ) -> Option<SVector<T, D>> {
+        None
+    }
+    /// `true` if [`particle_force`](Self::particle_force) gives the forces.
+    fn acts_per_particle(&self) -> bool {
+        false
+    }
     /// Adds a correction computed from the total force `total` (everything assembled
     /// so far) and the velocity coefficients `velocity` of the previous step to
     /// `forces`. Called after every effect's [`add_forces`](Self::add_forces).
@@ -108,6 +124,17 @@ impl<T: Scalar, const D: usize> Effect<T, D> for Gravity<T, D> {
                 .basis
                 .scatter(p, &(self.g * particles.mass[p]), forces);
         }
+    }
+    fn particle_force(
+        &self,
+        particles: &Particles<T, D>,
+        p: usize,
+        _time: f64,
+    ) -> Option<SVector<T, D>> {
+        Some(self.g * particles.mass[p])
+    }
+    fn acts_per_particle(&self) -> bool {
+        true
     }
     fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
         particles
@@ -184,6 +211,22 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyForce<T, D> {
                 }
             }
         }
+    }
+    fn particle_force(
+        &self,
+        particles: &Particles<T, D>,
+        p: usize,
+        time: f64,
+    ) -> Option<SVector<T, D>> {
+        Some(match self {
+            BodyForce::Uniform(b) => *b * particles.mass[p],
+            BodyForce::Manufactured(a) => {
+                manufactured(a, &particles.x0[p], time) * particles.mass[p]
+            }
+        })
+    }
+    fn acts_per_particle(&self) -> bool {
+        true
     }
     fn does_work(&self) -> bool {
         true

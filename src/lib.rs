@@ -72,3 +72,4 @@ pub mod setup;
 pub mod simulation;
 pub mod sparse;
 pub mod studies;
+pub mod threads;

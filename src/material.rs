@@ -109,7 +109,7 @@ pub fn det<T: Scalar, const D: usize>(m: &SMatrix<T, D, D>) -> T {
 }
 
 /// A constitutive model.
-pub trait Material<T: Scalar, const D: usize> {
+pub trait Material<T: Scalar, const D: usize>: Sync {
     /// Cauchy stress `σ(F)`.
     fn stress(&self, f: &SMatrix<T, D, D>) -> SMatrix<T, D, D>;
     /// Strain-energy density per unit reference volume `W(F)`.

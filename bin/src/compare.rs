@@ -14,6 +14,7 @@ use psmpm::bases::BasisKind;
 use psmpm::mass::MassKind;
 use psmpm::scene::Scene;
 use psmpm::simulation::{self, RunError, Summary};
+use psmpm::threads::ThreadPool;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -31,6 +32,10 @@ pub struct CompareArgs {
     /// Variants run at the same time (default: the number of cores).
     #[arg(long)]
     jobs: Option<usize>,
+    /// Threads of the particle phases, shared by the variants running at the same
+    /// time (default: all cores). The results are the same for any number.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     #[command(flatten)]
     overrides: Overrides,
     /// Exit with status 1 when a variant failed or is unstable (default: 0, the
@@ -82,8 +87,9 @@ pub fn variants(
     Ok(out)
 }
 
-/// Runs `scenes` on up to `jobs` threads; results in the order of `scenes`.
-pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, CliError>> {
+/// Runs `scenes`, up to `jobs` at the same time, their steps on `pool`; results in
+/// the order of `scenes`.
+pub fn run_all(scenes: &[Scene], jobs: usize, pool: &ThreadPool) -> Vec<Result<Summary, CliError>> {
     let next = AtomicUsize::new(0);
     let progress =
         crate::progress::Progress::new(scenes.iter().map(|s| s.steps() as u64).sum(), "steps");
@@ -94,7 +100,7 @@ pub fn run_all(scenes: &[Scene], jobs: usize) -> Vec<Result<Summary, CliError>> 
             scope.spawn(|| loop {
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 let Some(scene) = scenes.get(k) else { break };
-                let r = simulation::run(scene, &mut |_| progress.inc(1));
+                let r = pool.install(|| simulation::run(scene, &mut |_| progress.inc(1)));
                 if let Ok(mut all) = results.lock() {
                     all[k] = Some(r);
                 }
@@ -137,7 +143,8 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
     if jobs == 0 {
         return Err(CliError::Input("--jobs must be at least 1".into()));
     }
-    let results = run_all(&scenes, jobs);
+    let pool = crate::run::thread_pool(args.threads)?;
+    let results = run_all(&scenes, jobs, &pool);
     let mut summaries = Vec::new();
     for r in results {
         summaries.push(r?);

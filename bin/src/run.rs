@@ -183,6 +183,10 @@ pub struct RunArgs {
     /// or ascii (text).
     #[arg(long, value_enum, value_name = "ENCODING", default_value_t = Vtu::Binary, requires = "out")]
     vtu: Vtu,
+    /// Threads of the particle phases (default: all cores). The results are the
+    /// same, bit for bit, for any number.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
 }
 
 /// `--vtu`.
@@ -383,6 +387,21 @@ fn stop_on_signals() -> Result<Arc<AtomicBool>, CliError> {
 /// aligned at the end. A closed stdout or a first SIGINT/SIGTERM stops the run after
 /// the current step; the files of `--out` and the summary are still written.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
+    let pool = thread_pool(args.threads)?;
+    pool.install(move || run_on_pool(args))
+}
+
+/// The pool of `--threads N` (`None`: one thread per core).
+pub fn thread_pool(threads: Option<usize>) -> Result<psmpm::threads::ThreadPool, CliError> {
+    if threads == Some(0) {
+        return Err(CliError::Input("--threads must be at least 1".into()));
+    }
+    psmpm::threads::pool(threads)
+        .map_err(|e| CliError::Input(format!("--threads: no thread pool ({e})")))
+}
+
+/// [`run`] on the current thread pool.
+fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     let s = scene(&args)?;
     let every = args
         .diag_every

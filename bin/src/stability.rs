@@ -79,6 +79,10 @@ pub struct StabilityArgs {
     /// Exit with status 1 when a case is unstable (default: 0, the table marks it).
     #[arg(long)]
     strict: bool,
+    /// Threads of the particle phases, shared by the runs at the same time
+    /// (default: all cores). The results are the same for any number.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -398,12 +402,13 @@ fn run_cell(case: &str, scene: &Scene, on_step: &mut dyn FnMut()) -> Result<Cell
     })
 }
 
-/// Runs every case with every strategy on up to `jobs` threads; cells in case
-/// order, strategies in the order given.
+/// Runs every case with every strategy, up to `jobs` at the same time, their
+/// steps on `pool`; cells in case order, strategies in the order given.
 pub fn run_matrix(
     cases: &[(String, Scene)],
     masses: &[MassKind],
     jobs: usize,
+    pool: &psmpm::threads::ThreadPool,
 ) -> Result<Vec<Cell>, CliError> {
     let mut cells: Vec<(String, Scene)> = Vec::new();
     for (name, scene) in cases {
@@ -425,7 +430,7 @@ pub fn run_matrix(
                 let k = next.fetch_add(1, atomic::Ordering::SeqCst);
                 let Some(&i) = order.get(k) else { break };
                 let (name, scene) = &cells[i];
-                let r = run_cell(name, scene, &mut || {});
+                let r = pool.install(|| run_cell(name, scene, &mut || {}));
                 progress.inc(1);
                 if let Ok(mut all) = results.lock() {
                     all[i] = Some(r);
@@ -569,7 +574,8 @@ pub fn stability(args: StabilityArgs) -> Result<(), CliError> {
         let scene = read_scene(&path.to_string_lossy())?;
         cases.push((name, scene));
     }
-    let cells = run_matrix(&cases, &masses, jobs)?;
+    let pool = crate::run::thread_pool(args.threads)?;
+    let cells = run_matrix(&cases, &masses, jobs, &pool)?;
     print(&cells, args.format, jobs);
     let failed = cells.iter().filter(|c| !c.stable).count();
     crate::error::study_verdict(args.strict, failed, cells.len())

@@ -18,6 +18,11 @@
 //! We use the full gradient `∇v` (see [`phases::update_deformation_gradient`]).
 //!
 //! All buffers are allocated once in [`Driver::new`]; a step allocates nothing.
+//!
+//! The particle phases run on the current rayon thread pool (run the loop inside
+//! [`rayon::ThreadPool::install`] to choose the threads, or see
+//! [`crate::threads`]); results are bit-identical for any number of threads (see
+//! [`phases`]).
 
 mod critical;
 mod failure;
@@ -28,7 +33,7 @@ pub use critical::CRITICAL_ITERATIONS;
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
 
-use crate::diagnostics::energies;
+use crate::diagnostics::{energies, energies_from_terms, particle_terms, Energies};
 use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{
     Constraints, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
@@ -37,8 +42,9 @@ use crate::material::Material;
 use crate::particles::Particles;
 use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::SVector;
-use phases::{Evaluations, UpdateFailure};
+use phases::{Bins, Evaluations, Gather, Local, UpdateFailure};
 use psmpm_basis::{Basis, BasisError, BasisEval};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Coverage below which a function counts as under-supported in failure messages.
@@ -97,7 +103,6 @@ pub struct Fix {
 /// The per-step facts a mass strategy asked for.
 struct StrategyInputs {
     needs: Needs,
-    occupied: Vec<bool>,
     touches_empty: Vec<bool>,
     particle_volume: Vec<f64>,
     support: Option<SupportFacts>,
@@ -125,7 +130,14 @@ where
     time: f64,
     // Buffers, sized once.
     evals: Evaluations<T, D>,
-    eval: BasisEval<T, D>,
+    /// One basis scratch per particle chunk ([`phases::CHUNK`]).
+    scratch: Vec<BasisEval<T, D>>,
+    /// Particles by element, every step.
+    bins: Bins,
+    /// Element-local sums.
+    local: Local<T, D>,
+    /// Element-local sums → matrix entries and coefficients.
+    gather: Gather,
     values: Vec<T>,
     /// `F`, then the acceleration coefficients `a`.
     rhs: Vec<Vec<T>>,
@@ -137,6 +149,11 @@ where
     work_force: Vec<Vec<T>>,
     /// Scratch for [`Effect::adjust_forces`]; empty without effects.
     adjust: Vec<Vec<T>>,
+    /// Per-particle forces of the effects that act per particle
+    /// ([`Effect::particle_force`]); empty without any.
+    particle_force: Vec<SVector<T, D>>,
+    /// Per-particle terms of the step report's energies.
+    energy_terms: Vec<[f64; 8]>,
     work: f64,
     inputs: StrategyInputs,
     last_report: MassReport,
@@ -222,25 +239,32 @@ where
         });
         let inputs = StrategyInputs {
             needs,
-            occupied: if needs.empty_elements {
-                vec![false; basis.num_elements()]
-            } else {
-                Vec::new()
-            },
             touches_empty: vec![false; if needs.empty_elements { n } else { 0 }],
             particle_volume: vec![0.0; if needs.coverage { n } else { 0 }],
             support,
         };
         let np = particles.len();
+        let stride = basis.max_functions_per_element();
         Ok(Driver {
-            eval: BasisEval::for_basis(&basis),
-            evals: Evaluations::new(np, basis.max_functions_per_element()),
+            scratch: (0..phases::chunks(np))
+                .map(|_| BasisEval::for_basis(&basis))
+                .collect(),
+            evals: Evaluations::new(np, stride),
+            bins: Bins::new(basis.num_elements(), np),
+            local: Local::new(basis.num_elements(), stride),
+            gather: Gather::new(&basis, &pattern, stride),
             values: vec![T::zero(); pattern.nnz()],
             rhs: vec![vec![T::zero(); n]; D],
             velocity: vec![vec![T::zero(); n]; D],
             velocity_known: false,
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             adjust: scratch(!effects.is_empty()),
+            energy_terms: vec![[0.0; 8]; np],
+            particle_force: if effects.iter().any(|e| e.acts_per_particle()) {
+                vec![SVector::zeros(); np]
+            } else {
+                Vec::new()
+            },
             work: 0.0,
             constraints: Constraints::new(general, n),
             inputs,
@@ -325,6 +349,9 @@ where
         let t_solve = clock.elapsed().as_secs_f64() - t_assemble;
         phases::update_velocities_and_momentum(
             &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
             &self.rhs,
             self.dt,
             &self.particles.mass,
@@ -345,7 +372,23 @@ where
         self.step += 1;
         // Time from the step count, so that it does not accumulate round-off.
         self.time = self.step as f64 * self.dt.to_f64();
-        Ok(self.report())
+        let e = self.step_energies();
+        Ok(self.report_with(e))
+    }
+
+    /// [`energies`] of the current state, the per-particle terms computed in
+    /// parallel and summed in particle order (the same sums, bit for bit).
+    fn step_energies(&mut self) -> Energies {
+        let (parts, material) = (&self.particles, &self.material);
+        self.energy_terms
+            .par_chunks_mut(phases::CHUNK)
+            .enumerate()
+            .for_each(|(c, terms)| {
+                for (q, t) in terms.iter_mut().enumerate() {
+                    *t = particle_terms(parts, material, c * phases::CHUNK + q);
+                }
+            });
+        energies_from_terms(self.energy_terms.iter().copied(), parts, &self.effects)
     }
 
     /// Phase 1.
@@ -354,7 +397,7 @@ where
             &self.basis,
             &self.particles.x,
             &mut self.particles.element,
-            &mut self.eval,
+            &mut self.scratch,
             &mut self.evals,
         )
         .map_err(|o| {
@@ -375,24 +418,25 @@ where
     /// Phase 2a: `M`, `F = −F^int` into `rhs`, and the facts the mass strategy
     /// asked for.
     fn assemble_mass(&mut self) {
+        self.bins.fill(&self.particles.element);
         phases::assemble_mass_and_internal_force(
-            &self.pattern,
             &self.particles,
             &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
             &mut self.values,
             &mut self.rhs,
         );
         if self.inputs.needs.empty_elements {
-            phases::mark_empty_elements(
-                &self.basis,
-                &self.particles.element,
-                &mut self.inputs.occupied,
-                &mut self.inputs.touches_empty,
-            );
+            phases::mark_empty_elements(&self.basis, &self.bins, &mut self.inputs.touches_empty);
         }
         if self.inputs.needs.coverage {
-            phases::particle_volume(
+            phases::particle_volume_by_elements(
                 &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
                 &self.particles.volume,
                 &mut self.inputs.particle_volume,
             );
@@ -420,12 +464,15 @@ where
         if tracks_work {
             phases::zero(&mut self.work_force);
         }
-        for effect in &self.effects {
+        for effect in self.effects.iter().filter(|e| !e.acts_per_particle()) {
             if effect.does_work() {
                 effect.add_forces(&self.particles, &state, &mut self.work_force);
             } else {
                 effect.add_forces(&self.particles, &state, &mut self.rhs);
             }
+        }
+        for work in [false, true] {
+            self.scatter_particle_forces(work);
         }
         if tracks_work {
             phases::add_into(&mut self.rhs, &self.work_force);
@@ -439,6 +486,45 @@ where
             effect.adjust_forces(&self.rhs, &self.velocity, &mut self.adjust);
         }
         phases::add_into(&mut self.rhs, &self.adjust);
+    }
+
+    /// The forces of the effects that act per particle and do work (`work`) or
+    /// not, summed per particle in the effects' order, then scattered into
+    /// `work_force` or `rhs`.
+    fn scatter_particle_forces(&mut self, work: bool) {
+        let acting = move |e: &dyn Effect<T, D>| e.acts_per_particle() && e.does_work() == work;
+        if !self.effects.iter().any(|e| acting(e.as_ref())) {
+            return;
+        }
+        let (effects, particles, time) = (&self.effects, &self.particles, self.time);
+        self.particle_force
+            .par_chunks_mut(phases::CHUNK)
+            .enumerate()
+            .for_each(|(c, forces)| {
+                for (q, f) in forces.iter_mut().enumerate() {
+                    let p = c * phases::CHUNK + q;
+                    *f = SVector::zeros();
+                    for effect in effects.iter().filter(|e| acting(e.as_ref())) {
+                        if let Some(force) = effect.particle_force(particles, p, time) {
+                            *f += force;
+                        }
+                    }
+                }
+            });
+        let target = if work {
+            &mut self.work_force
+        } else {
+            &mut self.rhs
+        };
+        let (evals, forces) = (&self.evals, &self.particle_force);
+        phases::scatter_by_elements(
+            &self.bins,
+            evals,
+            &self.gather,
+            &mut self.local,
+            target,
+            |p, s| forces[p] * evals.phi[s],
+        );
     }
 
     /// Phase 3a: the strategy's numeric work on `M`, the condition estimate when
@@ -500,6 +586,9 @@ where
             phases::zero(&mut self.velocity);
             phases::scatter_to_functions(
                 &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
                 &self.particles.mass,
                 &self.particles.v,
                 &mut self.velocity,
@@ -550,7 +639,10 @@ where
 
     /// Energies and momentum of the current state.
     pub fn report(&self) -> StepReport {
-        let e = energies(&self.particles, &self.material, &self.effects);
+        self.report_with(energies(&self.particles, &self.material, &self.effects))
+    }
+
+    fn report_with(&self, e: Energies) -> StepReport {
         StepReport {
             step: self.step,
             time: self.time,

@@ -5,12 +5,245 @@
 //!
 //! Per-particle basis data are stored as [`Evaluations`]: particle `p` has
 //! `len[p]` entries (function index, `phi`, `grad_phi`) at `p * stride ..`.
+//!
+//! # Threads and determinism
+//!
+//! The phases run on the current rayon pool and give bit-identical results for
+//! any number of threads. Per-particle work (locate, evaluate, update) is split
+//! into chunks of [`CHUNK`] particles, a size independent of the thread count.
+//! Sums over particles (the mass matrix, forces, momentum) are never accumulated
+//! across threads: particles are binned by element ([`Bins`], stable: particle
+//! order within an element); each element sums its own particles into its own
+//! local buffer ([`Local`]), in particle order; each matrix entry and function
+//! coefficient then sums its elements' local values in element order
+//! ([`Gather`]). Every sum therefore has one fixed order, whatever the threads.
 
 use crate::material::{det, Material};
 use crate::particles::Particles;
 use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::{SMatrix, SVector};
 use psmpm_basis::{Basis, BasisEval};
+use rayon::prelude::*;
+
+/// Particles per parallel task of the per-particle phases: fixed, so that the
+/// split (and with it every result) does not depend on the number of threads.
+pub const CHUNK: usize = 1024;
+
+/// Elements per parallel task of the element-local sums.
+const ELEMENT_CHUNK: usize = 64;
+
+/// Matrix entries or coefficients per parallel task of the gathers.
+const ENTRY_CHUNK: usize = 4096;
+
+/// Number of [`CHUNK`]s for `particles` particles.
+pub fn chunks(particles: usize) -> usize {
+    particles.div_ceil(CHUNK)
+}
+
+/// Particles grouped by element, in particle order within each element (a
+/// stable counting sort, refilled every step).
+pub struct Bins {
+    /// Particles of element `e`: `order[start[e]..start[e + 1]]`.
+    start: Vec<usize>,
+    order: Vec<usize>,
+    cursor: Vec<usize>,
+}
+
+impl Bins {
+    /// Buffers for `elements` elements and `particles` particles.
+    pub fn new(elements: usize, particles: usize) -> Self {
+        Bins {
+            start: vec![0; elements + 1],
+            order: vec![0; particles],
+            cursor: vec![0; elements],
+        }
+    }
+
+    /// Sorts the particles by their `element`.
+    pub fn fill(&mut self, element: &[usize]) {
+        self.start.iter_mut().for_each(|s| *s = 0);
+        for &e in element {
+            self.start[e + 1] += 1;
+        }
+        let ne = self.cursor.len();
+        for e in 0..ne {
+            self.start[e + 1] += self.start[e];
+        }
+        self.cursor.copy_from_slice(&self.start[..ne]);
+        for (p, &e) in element.iter().enumerate() {
+            self.order[self.cursor[e]] = p;
+            self.cursor[e] += 1;
+        }
+    }
+
+    /// The particles in element `e`, in increasing order.
+    #[inline]
+    pub fn particles(&self, e: usize) -> &[usize] {
+        &self.order[self.start[e]..self.start[e + 1]]
+    }
+
+    /// `true` if element `e` holds a particle.
+    #[inline]
+    pub fn occupied(&self, e: usize) -> bool {
+        self.start[e + 1] > self.start[e]
+    }
+}
+
+/// Element-local sums: per element an upper-triangular `stride × stride` block of
+/// the mass matrix and `stride × D` coefficients of a vector field (local
+/// function `a` is the element's `a`-th function, as evaluated in phase 1).
+pub struct Local<T: Scalar, const D: usize> {
+    stride: usize,
+    matrix: Vec<T>,
+    vector: Vec<T>,
+}
+
+impl<T: Scalar, const D: usize> Local<T, D> {
+    /// Buffers for `elements` elements of up to `stride` functions.
+    pub fn new(elements: usize, stride: usize) -> Self {
+        Local {
+            stride,
+            matrix: vec![T::zero(); elements * stride * stride],
+            vector: vec![T::zero(); elements * stride * D],
+        }
+    }
+}
+
+/// Where each matrix entry and each function coefficient finds its element-local
+/// contributions, in element order (fixed by the mesh, built once).
+pub struct Gather {
+    matrix_start: Vec<usize>,
+    /// Offsets into [`Local`]'s matrix buffer.
+    matrix_source: Vec<usize>,
+    function_start: Vec<usize>,
+    /// `e * stride + a`: local function `a` of element `e`.
+    function_source: Vec<usize>,
+}
+
+impl Gather {
+    /// The maps of `basis` with `pattern` (its element scatter maps) and local
+    /// blocks of `stride` functions.
+    pub fn new<T: Scalar, const D: usize, B: Basis<T, D>>(
+        basis: &B,
+        pattern: &SymmetricPattern,
+        stride: usize,
+    ) -> Self {
+        let (ne, n) = (basis.num_elements(), basis.num_functions());
+        let mut matrix: Vec<(usize, usize)> = Vec::new();
+        let mut function: Vec<(usize, usize)> = Vec::new();
+        for e in 0..ne {
+            let m = basis.element_functions(e).len();
+            let scatter = pattern.element_scatter(e);
+            for (a, &i) in basis.element_functions(e).iter().enumerate() {
+                function.push((i, e * stride + a));
+                for b in a..m {
+                    matrix.push((scatter[a * m + b], (e * stride + a) * stride + b));
+                }
+            }
+        }
+        let group = |pairs: Vec<(usize, usize)>, len: usize| {
+            // Stable: element order kept within each target.
+            let mut start = vec![0; len + 1];
+            for &(t, _) in &pairs {
+                start[t + 1] += 1;
+            }
+            for t in 0..len {
+                start[t + 1] += start[t];
+            }
+            let mut cursor = start[..len].to_vec();
+            let mut source = vec![0; pairs.len()];
+            for (t, s) in pairs {
+                source[cursor[t]] = s;
+                cursor[t] += 1;
+            }
+            (start, source)
+        };
+        let (matrix_start, matrix_source) = group(matrix, pattern.nnz());
+        let (function_start, function_source) = group(function, n);
+        Gather {
+            matrix_start,
+            matrix_source,
+            function_start,
+            function_source,
+        }
+    }
+
+    /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order.
+    fn matrix<T: Scalar, const D: usize>(&self, local: &Local<T, D>, values: &mut [T]) {
+        values
+            .par_iter_mut()
+            .with_min_len(ENTRY_CHUNK)
+            .enumerate()
+            .for_each(|(j, v)| {
+                let mut sum = T::zero();
+                for &s in &self.matrix_source[self.matrix_start[j]..self.matrix_start[j + 1]] {
+                    sum += local.matrix[s];
+                }
+                *v = sum;
+            });
+    }
+
+    /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in
+    /// element order.
+    fn functions<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        negate: bool,
+        out: &mut [Vec<T>],
+    ) {
+        for (k, out) in out.iter_mut().enumerate() {
+            out.par_iter_mut()
+                .with_min_len(ENTRY_CHUNK)
+                .enumerate()
+                .for_each(|(i, o)| {
+                    let mut sum = T::zero();
+                    for &s in
+                        &self.function_source[self.function_start[i]..self.function_start[i + 1]]
+                    {
+                        sum += local.vector[s * D + k];
+                    }
+                    if negate {
+                        *o -= sum;
+                    } else {
+                        *o += sum;
+                    }
+                });
+        }
+    }
+}
+
+/// The element-local sums `Σ_{p in e} q(p, s)` of a per-slot vector `q` (slot
+/// `s` of particle `p`), then gathered: `out_{k,i} += Σ_p q_k(p, s_i)`.
+pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
+    bins: &Bins,
+    evals: &Evaluations<T, D>,
+    gather: &Gather,
+    local: &mut Local<T, D>,
+    out: &mut [Vec<T>],
+    q: Q,
+) where
+    Q: Fn(usize, usize) -> SVector<T, D> + Sync,
+{
+    let stride = local.stride;
+    local
+        .vector
+        .par_chunks_mut(stride * D)
+        .with_min_len(ELEMENT_CHUNK)
+        .enumerate()
+        .for_each(|(e, lv)| {
+            lv.iter_mut().for_each(|v| *v = T::zero());
+            for &p in bins.particles(e) {
+                let base = p * evals.stride;
+                for a in 0..evals.len[p] {
+                    let f = q(p, base + a);
+                    for k in 0..D {
+                        lv[a * D + k] += f[k];
+                    }
+                }
+            }
+        });
+    gather.functions(local, false, out);
+}
 
 /// Basis values and gradients of every particle, as evaluated in phase 1.
 pub struct Evaluations<T: Scalar, const D: usize> {
@@ -53,59 +286,96 @@ pub struct Outside {
 }
 
 /// Phase 1: locate every particle (walking from its previous element) and
-/// evaluate the basis there.
+/// evaluate the basis there, [`CHUNK`] particles per task with one scratch
+/// buffer each (`scratch` holds [`chunks`]`(x.len())` of them). On failure, the
+/// first particle outside.
 pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
     basis: &B,
     x: &[SVector<T, D>],
     element: &mut [usize],
-    scratch: &mut BasisEval<T, D>,
+    scratch: &mut [BasisEval<T, D>],
     out: &mut Evaluations<T, D>,
 ) -> Result<(), Outside> {
-    for p in 0..x.len() {
-        let e = basis
-            .locate(&x[p], Some(element[p]))
-            .ok_or(Outside { particle: p })?;
-        element[p] = e;
-        basis.eval(e, &x[p], scratch);
-        let base = p * out.stride;
-        let m = scratch.len();
-        out.len[p] = m;
-        out.index[base..base + m].copy_from_slice(&scratch.index[..m]);
-        out.phi[base..base + m].copy_from_slice(&scratch.phi[..m]);
-        out.grad_phi[base..base + m].copy_from_slice(&scratch.grad_phi[..m]);
+    let stride = out.stride;
+    let failure = (
+        x.par_chunks(CHUNK),
+        element.par_chunks_mut(CHUNK),
+        out.len.par_chunks_mut(CHUNK),
+        out.index.par_chunks_mut(CHUNK * stride),
+        out.phi.par_chunks_mut(CHUNK * stride),
+        out.grad_phi.par_chunks_mut(CHUNK * stride),
+        scratch.par_iter_mut(),
+    )
+        .into_par_iter()
+        .enumerate()
+        .filter_map(|(c, (x, element, len, index, phi, grad_phi, scratch))| {
+            for q in 0..x.len() {
+                let Some(e) = basis.locate(&x[q], Some(element[q])) else {
+                    return Some(c * CHUNK + q);
+                };
+                element[q] = e;
+                basis.eval(e, &x[q], scratch);
+                let base = q * stride;
+                let m = scratch.len();
+                len[q] = m;
+                index[base..base + m].copy_from_slice(&scratch.index[..m]);
+                phi[base..base + m].copy_from_slice(&scratch.phi[..m]);
+                grad_phi[base..base + m].copy_from_slice(&scratch.grad_phi[..m]);
+            }
+            None
+        })
+        .min();
+    match failure {
+        Some(particle) => Err(Outside { particle }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Phase 2a: the mass matrix `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)` (eq. (13)),
 /// upper triangle in the pattern's order, and the internal force
-/// `F_{k,i} = −Σ_p V_p σ_{kl} ∂phi_i/∂x_l` (eq. (15)) into `force`.
+/// `F_{k,i} = −Σ_p V_p σ_{kl} ∂phi_i/∂x_l` (eq. (15)) into `force` (overwritten);
+/// summed element by element (see the module's notes on threads).
+#[allow(clippy::too_many_arguments)]
 pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
-    pattern: &SymmetricPattern,
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
+    bins: &Bins,
+    gather: &Gather,
+    local: &mut Local<T, D>,
     values: &mut [T],
     force: &mut [Vec<T>],
 ) {
-    values.iter_mut().for_each(|v| *v = T::zero());
+    let stride = local.stride;
+    (
+        local.matrix.par_chunks_mut(stride * stride),
+        local.vector.par_chunks_mut(stride * D),
+    )
+        .into_par_iter()
+        .with_min_len(ELEMENT_CHUNK)
+        .enumerate()
+        .for_each(|(e, (lm, lv))| {
+            lm.iter_mut().for_each(|v| *v = T::zero());
+            lv.iter_mut().for_each(|v| *v = T::zero());
+            for &p in bins.particles(e) {
+                let base = p * evals.stride;
+                let m = evals.len[p];
+                let (mass, vol, sigma) =
+                    (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+                for a in 0..m {
+                    let w = mass * evals.phi[base + a];
+                    for b in a..m {
+                        lm[a * stride + b] += w * evals.phi[base + b];
+                    }
+                    let f_int = sigma * evals.grad_phi[base + a] * vol;
+                    for k in 0..D {
+                        lv[a * D + k] += f_int[k];
+                    }
+                }
+            }
+        });
+    gather.matrix(local, values);
     zero(force);
-    for p in 0..particles.len() {
-        let base = p * evals.stride;
-        let m = evals.len[p];
-        let scatter = pattern.element_scatter(particles.element[p]);
-        let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
-        for a in 0..m {
-            let w = mass * evals.phi[base + a];
-            for b in a..m {
-                values[scatter[a * m + b]] += w * evals.phi[base + b];
-            }
-            let f_int = sigma * evals.grad_phi[base + a] * vol;
-            let i = evals.index[base + a];
-            for k in 0..D {
-                force[k][i] -= f_int[k];
-            }
-        }
-    }
+    gather.functions(local, true, force);
 }
 
 /// The particle → function scatter `out_{k,i} += Σ_p w_p phi_i(x_p) q_{p,k}`
@@ -113,47 +383,50 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
 /// particle field onto the basis.
 pub fn scatter_to_functions<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
+    bins: &Bins,
+    gather: &Gather,
+    local: &mut Local<T, D>,
     weight: &[T],
     field: &[SVector<T, D>],
     out: &mut [Vec<T>],
 ) {
-    for p in 0..weight.len() {
-        for s in evals.range(p) {
-            let w = weight[p] * evals.phi[s];
-            for k in 0..D {
-                out[k][evals.index[s]] += w * field[p][k];
-            }
-        }
-    }
+    scatter_by_elements(bins, evals, gather, local, out, |p, s| {
+        field[p] * (weight[p] * evals.phi[s])
+    });
 }
 
 /// Phases 4–5: particle velocities `v_p += Δt Σ_i a_i phi_i(x_p)` (eq. (18)) and
 /// the momentum `P_i = Σ_p m_p phi_i(x_p) v_p` (eq. (21)) into `momentum`.
+#[allow(clippy::too_many_arguments)]
 pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
+    bins: &Bins,
+    gather: &Gather,
+    local: &mut Local<T, D>,
     acceleration: &[Vec<T>],
     dt: T,
     mass: &[T],
     v: &mut [SVector<T, D>],
     momentum: &mut [Vec<T>],
 ) {
+    v.par_chunks_mut(CHUNK).enumerate().for_each(|(c, v)| {
+        for (q, v) in v.iter_mut().enumerate() {
+            let mut a = SVector::<T, D>::zeros();
+            for s in evals.range(c * CHUNK + q) {
+                let i = evals.index[s];
+                for k in 0..D {
+                    a[k] += acceleration[k][i] * evals.phi[s];
+                }
+            }
+            *v += a * dt;
+        }
+    });
     zero(momentum);
-    for p in 0..v.len() {
-        let mut a = SVector::<T, D>::zeros();
-        for s in evals.range(p) {
-            let i = evals.index[s];
-            for k in 0..D {
-                a[k] += acceleration[k][i] * evals.phi[s];
-            }
-        }
-        v[p] += a * dt;
-        for s in evals.range(p) {
-            let w = mass[p] * evals.phi[s];
-            for k in 0..D {
-                momentum[k][evals.index[s]] += w * v[p][k];
-            }
-        }
-    }
+    let v = &*v;
+    scatter_by_elements(bins, evals, gather, local, momentum, |p, s| {
+        let w = mass[p] * evals.phi[s];
+        SVector::<T, D>::from_fn(|k, _| w * v[p][k])
+    });
 }
 
 /// Why phase 6 stopped.
@@ -190,6 +463,8 @@ pub fn update_deformation_gradient<T: Scalar, const D: usize>(
 /// Phase 6: from the projected velocity `v̂`, the deformation gradient (eq. (22)),
 /// stress (eqs. (25)–(27)), volume `V_p = det F_p V_p⁰` (eqs. (28)–(29)), and the
 /// positions and displacements `x_p += Δt Σ_i v̂_i phi_i(x_p)` (eqs. (30)–(31)).
+/// [`CHUNK`] particles per task; on failure, that of the first failing particle
+/// (the particles of other chunks are updated all the same).
 pub fn update_particles<T: Scalar, const D: usize, Mat: Material<T, D>>(
     evals: &Evaluations<T, D>,
     velocity: &[Vec<T>],
@@ -197,61 +472,126 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: Material<T, D>>(
     material: &Mat,
     parts: &mut Particles<T, D>,
 ) -> Result<(), UpdateFailure> {
-    for p in 0..parts.len() {
-        let mut grad_v = SMatrix::<T, D, D>::zeros();
-        let mut v_hat = SVector::<T, D>::zeros();
-        for s in evals.range(p) {
-            let i = evals.index[s];
-            for k in 0..D {
-                let c = velocity[k][i];
-                v_hat[k] += c * evals.phi[s];
-                for l in 0..D {
-                    grad_v[(k, l)] += c * evals.grad_phi[s][l];
+    let failure = (
+        parts.f.par_chunks_mut(CHUNK),
+        parts.sigma.par_chunks_mut(CHUNK),
+        parts.volume.par_chunks_mut(CHUNK),
+        parts.x.par_chunks_mut(CHUNK),
+        parts.u.par_chunks_mut(CHUNK),
+        parts.sigma0.par_chunks(CHUNK),
+        parts.volume0.par_chunks(CHUNK),
+        parts.v.par_chunks(CHUNK),
+    )
+        .into_par_iter()
+        .enumerate()
+        .filter_map(|(c, (fs, sigma, volume, x, u, sigma0, volume0, v))| {
+            for q in 0..fs.len() {
+                let p = c * CHUNK + q;
+                let mut grad_v = SMatrix::<T, D, D>::zeros();
+                let mut v_hat = SVector::<T, D>::zeros();
+                for s in evals.range(p) {
+                    let i = evals.index[s];
+                    for k in 0..D {
+                        let c = velocity[k][i];
+                        v_hat[k] += c * evals.phi[s];
+                        for l in 0..D {
+                            grad_v[(k, l)] += c * evals.grad_phi[s][l];
+                        }
+                    }
+                }
+                let f = update_deformation_gradient(&fs[q], &grad_v, dt);
+                let j = det(&f);
+                if !(j.to_f64() > 0.0 && j.to_f64().is_finite()) {
+                    return Some(UpdateFailure::Jacobian {
+                        particle: p,
+                        jacobian: j.to_f64(),
+                    });
+                }
+                fs[q] = f;
+                sigma[q] = sigma0[q] + material.stress(&f);
+                volume[q] = volume0[q] * j;
+                x[q] += v_hat * dt;
+                u[q] += v_hat * dt;
+                if !x[q].iter().all(|c| c.to_f64().is_finite())
+                    || !v[q].iter().all(|c| c.to_f64().is_finite())
+                {
+                    return Some(UpdateFailure::NotFinite { particle: p });
                 }
             }
-        }
-        let f = update_deformation_gradient(&parts.f[p], &grad_v, dt);
-        let j = det(&f);
-        if !(j.to_f64() > 0.0 && j.to_f64().is_finite()) {
-            return Err(UpdateFailure::Jacobian {
-                particle: p,
-                jacobian: j.to_f64(),
-            });
-        }
-        parts.f[p] = f;
-        parts.sigma[p] = parts.sigma0[p] + material.stress(&f);
-        parts.volume[p] = parts.volume0[p] * j;
-        parts.x[p] += v_hat * dt;
-        parts.u[p] += v_hat * dt;
-        if !parts.x[p].iter().all(|c| c.to_f64().is_finite())
-            || !parts.v[p].iter().all(|c| c.to_f64().is_finite())
-        {
-            return Err(UpdateFailure::NotFinite { particle: p });
+            None
+        })
+        .min_by_key(UpdateFailure::particle);
+    match failure {
+        Some(f) => Err(f),
+        None => Ok(()),
+    }
+}
+
+impl UpdateFailure {
+    /// The particle that failed.
+    pub fn particle(&self) -> usize {
+        match *self {
+            UpdateFailure::Jacobian { particle, .. } | UpdateFailure::NotFinite { particle } => {
+                particle
+            }
         }
     }
-    Ok(())
 }
 
 /// `touches_empty[i]`: the support of function `i` contains an element without
 /// particles (the seeds' partial-lumping rule).
 pub fn mark_empty_elements<T: Scalar, const D: usize, B: Basis<T, D>>(
     basis: &B,
-    element: &[usize],
-    occupied: &mut [bool],
+    bins: &Bins,
     touches_empty: &mut [bool],
 ) {
-    occupied.iter_mut().for_each(|o| *o = false);
-    for &e in element {
-        occupied[e] = true;
-    }
     touches_empty.iter_mut().for_each(|t| *t = false);
-    for (e, &occupied) in occupied.iter().enumerate() {
-        if !occupied {
+    for e in 0..basis.num_elements() {
+        if !bins.occupied(e) {
             for &i in basis.element_functions(e) {
                 touches_empty[i] = true;
             }
         }
     }
+}
+
+/// [`particle_volume`] summed element by element (the step's version; see the
+/// module's notes on threads).
+pub fn particle_volume_by_elements<T: Scalar, const D: usize>(
+    evals: &Evaluations<T, D>,
+    bins: &Bins,
+    gather: &Gather,
+    local: &mut Local<T, D>,
+    volume: &[T],
+    out: &mut [f64],
+) {
+    let stride = local.stride;
+    local
+        .vector
+        .par_chunks_mut(stride * D)
+        .with_min_len(ELEMENT_CHUNK)
+        .enumerate()
+        .for_each(|(e, lv)| {
+            lv.iter_mut().for_each(|v| *v = T::zero());
+            for &p in bins.particles(e) {
+                let base = p * evals.stride;
+                for a in 0..evals.len[p] {
+                    lv[a * D] += volume[p] * evals.phi[base + a];
+                }
+            }
+        });
+    out.par_iter_mut()
+        .with_min_len(ENTRY_CHUNK)
+        .enumerate()
+        .for_each(|(i, o)| {
+            let mut sum = 0.0;
+            for &s in
+                &gather.function_source[gather.function_start[i]..gather.function_start[i + 1]]
+            {
+                sum += local.vector[s * D].to_f64();
+            }
+            *o = sum;
+        });
 }
 
 /// `Σ_p V_p phi_i(x_p)`: the particle volume each function sees (its coverage

@@ -310,7 +310,7 @@ pub struct MassSetup<'a> {
 }
 
 /// How to solve the mass systems of a step.
-pub trait MassStrategy<T: Scalar> {
+pub trait MassStrategy<T: Scalar>: Send {
     /// The form [`MassKind::parse`] reads back.
     fn spec(&self) -> String;
     /// The per-step facts this strategy uses.

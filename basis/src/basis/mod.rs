@@ -121,7 +121,7 @@ pub enum BasisError {
 /// (and the test suites check): partition of unity `Σ_i phi_i = 1`,
 /// non-negativity, linear precision `Σ_i X_i phi_i = x` with the
 /// [`function_point`](Basis::function_point)s `X_i`.
-pub trait Basis<T: Real, const D: usize> {
+pub trait Basis<T: Real, const D: usize>: Sync {
     /// Short name for output (`"pl"`, `"ps"`, `"bspline"`, `"pl1d"`).
     fn name(&self) -> &'static str;
     /// Number of basis functions.
