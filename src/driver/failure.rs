@@ -2,11 +2,12 @@
 //! almost no particle support that the strategy solves for, a time step above the
 //! critical one, an inversion below it.
 
-use super::{phases, to_f64_point, Driver, StepError, UNDER_SUPPORTED_COVERAGE};
+use super::{phases, to_f64_point, Driver, UNDER_SUPPORTED_COVERAGE};
 use crate::mass::{MassError, MassStrategy, SupportFacts};
 use crate::material::Material;
 use crate::sparse::Scalar;
 use psmpm_basis::Basis;
+use psmpm_basis::BasisError;
 
 impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
 where
@@ -99,4 +100,45 @@ where
             hint,
         }
     }
+}
+
+/// Why a step failed. Each names the step, the cause the driver can see, and a
+/// fix that fits that cause.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    #[error("step {step}: particle {particle} at {position:?} left the mesh; {hint}")]
+    ParticleLeftMesh {
+        step: usize,
+        particle: usize,
+        position: Vec<f64>,
+        /// What to change.
+        hint: String,
+    },
+    #[error("step {step}: the mass system could not be solved ({source}); {hint}")]
+    MassNotPositiveDefinite {
+        step: usize,
+        source: MassError,
+        /// What the driver sees (the worst-covered function) and what to change.
+        hint: String,
+    },
+    #[error("step {step}: {quantity} of particle {particle} at {position:?} is not valid; {hint}")]
+    NotFinite {
+        step: usize,
+        quantity: &'static str,
+        particle: usize,
+        position: Vec<f64>,
+        /// What the driver sees near the particle and what to change.
+        hint: String,
+    },
+}
+
+/// Errors setting up a driver.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetupError {
+    #[error(transparent)]
+    Basis(#[from] BasisError),
+    #[error("boundary condition on `{tag}`: {message}")]
+    Boundary { tag: String, message: String },
+    #[error("particle {particle} at {position:?} lies outside the mesh")]
+    ParticleOutside { particle: usize, position: Vec<f64> },
 }

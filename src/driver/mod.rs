@@ -24,72 +24,33 @@
 //! [`crate::threads`]); results are bit-identical for any number of threads (see
 //! [`phases`]).
 
+mod binning;
 mod critical;
+mod energy;
 mod failure;
 pub mod phases;
 
 pub use critical::CRITICAL_ITERATIONS;
+pub use failure::{SetupError, StepError};
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
 
-use crate::diagnostics::{energies, energies_from_terms, particle_terms, Energies};
 use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{
-    Constraints, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
+    Constraints, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
 };
 use crate::material::Material;
 use crate::particles::Particles;
 use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::SVector;
 use phases::{Bins, Evaluations, Gather, Local, UpdateFailure};
-use psmpm_basis::{Basis, BasisError, BasisEval};
+use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 use std::time::Instant;
 
 /// Coverage below which a function counts as under-supported in failure messages.
 pub const UNDER_SUPPORTED_COVERAGE: f64 = 0.1;
-
-/// Why a step failed. Each names the step, the cause the driver can see, and a
-/// fix that fits that cause.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum StepError {
-    #[error("step {step}: particle {particle} at {position:?} left the mesh; {hint}")]
-    ParticleLeftMesh {
-        step: usize,
-        particle: usize,
-        position: Vec<f64>,
-        /// What to change.
-        hint: String,
-    },
-    #[error("step {step}: the mass system could not be solved ({source}); {hint}")]
-    MassNotPositiveDefinite {
-        step: usize,
-        source: MassError,
-        /// What the driver sees (the worst-covered function) and what to change.
-        hint: String,
-    },
-    #[error("step {step}: {quantity} of particle {particle} at {position:?} is not valid; {hint}")]
-    NotFinite {
-        step: usize,
-        quantity: &'static str,
-        particle: usize,
-        position: Vec<f64>,
-        /// What the driver sees near the particle and what to change.
-        hint: String,
-    },
-}
-
-/// Errors setting up a driver.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SetupError {
-    #[error(transparent)]
-    Basis(#[from] BasisError),
-    #[error("boundary condition on `{tag}`: {message}")]
-    Boundary { tag: String, message: String },
-    #[error("particle {particle} at {position:?} lies outside the mesh")]
-    ParticleOutside { particle: usize, position: Vec<f64> },
-}
 
 /// A homogeneous Dirichlet condition: velocity component `component` vanishes on `tag`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -376,21 +337,6 @@ where
         Ok(self.report_with(e))
     }
 
-    /// [`energies`] of the current state, the per-particle terms computed in
-    /// parallel and summed in particle order (the same sums, bit for bit).
-    fn step_energies(&mut self) -> Energies {
-        let (parts, material) = (&self.particles, &self.material);
-        self.energy_terms
-            .par_chunks_mut(phases::CHUNK)
-            .enumerate()
-            .for_each(|(c, terms)| {
-                for (q, t) in terms.iter_mut().enumerate() {
-                    *t = particle_terms(parts, material, c * phases::CHUNK + q);
-                }
-            });
-        energies_from_terms(self.energy_terms.iter().copied(), parts, &self.effects)
-    }
-
     /// Phase 1.
     fn locate_and_evaluate(&mut self) -> Result<(), StepError> {
         phases::locate_and_evaluate(
@@ -575,42 +521,6 @@ where
         self.solve_projected(Which::Velocity)
     }
 
-    /// Power of the non-conservative forces with the velocity at the start of the
-    /// step, `v̂ⁿ`; before the first step `v̂⁰` is the projection of the initial
-    /// particle velocities with this step's mass matrix.
-    fn power_at_start(&mut self) -> Result<f64, StepError> {
-        if self.work_force.is_empty() {
-            return Ok(0.0);
-        }
-        if !self.velocity_known {
-            phases::zero(&mut self.velocity);
-            phases::scatter_to_functions(
-                &self.evals,
-                &self.bins,
-                &self.gather,
-                &mut self.local,
-                &self.particles.mass,
-                &self.particles.v,
-                &mut self.velocity,
-            );
-            self.solve_projection()?;
-            self.velocity_known = true;
-        }
-        Ok(phases::power(&self.work_force, &self.velocity))
-    }
-
-    /// Work of the non-conservative effects over the step with the mean of the
-    /// start and end velocities, the rule under which the kinetic energy of the
-    /// symplectic Euler update changes: `W += Δt F · (v̂ⁿ + v̂ⁿ⁺¹) / 2`.
-    fn book_work(&mut self, power_start: f64) {
-        self.velocity_known = true;
-        if !self.work_force.is_empty() {
-            self.work += 0.5
-                * (power_start + phases::power(&self.work_force, &self.velocity))
-                * self.dt.to_f64();
-        }
-    }
-
     /// Phase 6: deformation, stress, volume and positions (eqs. (22)–(31)).
     fn update_particles(&mut self) -> Result<(), StepError> {
         phases::update_particles(
@@ -635,28 +545,6 @@ where
                 hint: self.diagnose_particle(particle),
             }
         })
-    }
-
-    /// Energies and momentum of the current state.
-    pub fn report(&self) -> StepReport {
-        self.report_with(energies(&self.particles, &self.material, &self.effects))
-    }
-
-    fn report_with(&self, e: Energies) -> StepReport {
-        StepReport {
-            step: self.step,
-            time: self.time,
-            kinetic: e.kinetic,
-            strain: e.strain,
-            potential: e.potential,
-            work: self.work,
-            mass: e.mass,
-            momentum: e.momentum,
-            max_speed: e.max_speed,
-            mass_report: self.last_report,
-            condition: self.last_condition,
-            phases: self.phases,
-        }
     }
 }
 

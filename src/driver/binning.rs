@@ -1,0 +1,227 @@
+//! Deterministic sums over particles for any number of threads: particles binned
+//! by element ([`Bins`], a stable counting sort), element-local sums in particle
+//! order ([`Local`]), and gathers of the element-local values into matrix entries
+//! and function coefficients in element order ([`Gather`]). Used by the phases of
+//! [`super::phases`]; see its module doc for why.
+
+use super::phases::{Evaluations, CHUNK};
+use crate::sparse::{Scalar, SymmetricPattern};
+use nalgebra::SVector;
+use psmpm_basis::Basis;
+use rayon::prelude::*;
+
+/// Elements per parallel task of the element-local sums.
+pub(super) const ELEMENT_CHUNK: usize = 64;
+
+/// Matrix entries or coefficients per parallel task of the gathers.
+pub(super) const ENTRY_CHUNK: usize = 4096;
+
+/// Number of [`CHUNK`]s for `particles` particles.
+pub fn chunks(particles: usize) -> usize {
+    particles.div_ceil(CHUNK)
+}
+
+/// Particles grouped by element, in particle order within each element (a
+/// stable counting sort, refilled every step).
+pub struct Bins {
+    /// Particles of element `e`: `order[start[e]..start[e + 1]]`.
+    pub(super) start: Vec<usize>,
+    pub(super) order: Vec<usize>,
+    pub(super) cursor: Vec<usize>,
+}
+
+impl Bins {
+    /// Buffers for `elements` elements and `particles` particles.
+    pub fn new(elements: usize, particles: usize) -> Self {
+        Bins {
+            start: vec![0; elements + 1],
+            order: vec![0; particles],
+            cursor: vec![0; elements],
+        }
+    }
+
+    /// Sorts the particles by their `element`.
+    pub fn fill(&mut self, element: &[usize]) {
+        self.start.iter_mut().for_each(|s| *s = 0);
+        for &e in element {
+            self.start[e + 1] += 1;
+        }
+        let ne = self.cursor.len();
+        for e in 0..ne {
+            self.start[e + 1] += self.start[e];
+        }
+        self.cursor.copy_from_slice(&self.start[..ne]);
+        for (p, &e) in element.iter().enumerate() {
+            self.order[self.cursor[e]] = p;
+            self.cursor[e] += 1;
+        }
+    }
+
+    /// The particles in element `e`, in increasing order.
+    #[inline]
+    pub fn particles(&self, e: usize) -> &[usize] {
+        &self.order[self.start[e]..self.start[e + 1]]
+    }
+
+    /// `true` if element `e` holds a particle.
+    #[inline]
+    pub fn occupied(&self, e: usize) -> bool {
+        self.start[e + 1] > self.start[e]
+    }
+}
+
+/// Element-local sums: per element an upper-triangular `stride × stride` block of
+/// the mass matrix and `stride × D` coefficients of a vector field (local
+/// function `a` is the element's `a`-th function, as evaluated in phase 1).
+pub struct Local<T: Scalar, const D: usize> {
+    pub(super) stride: usize,
+    pub(super) matrix: Vec<T>,
+    pub(super) vector: Vec<T>,
+}
+
+impl<T: Scalar, const D: usize> Local<T, D> {
+    /// Buffers for `elements` elements of up to `stride` functions.
+    pub fn new(elements: usize, stride: usize) -> Self {
+        Local {
+            stride,
+            matrix: vec![T::zero(); elements * stride * stride],
+            vector: vec![T::zero(); elements * stride * D],
+        }
+    }
+}
+
+/// Where each matrix entry and each function coefficient finds its element-local
+/// contributions, in element order (fixed by the mesh, built once).
+pub struct Gather {
+    pub(super) matrix_start: Vec<usize>,
+    /// Offsets into [`Local`]'s matrix buffer.
+    pub(super) matrix_source: Vec<usize>,
+    pub(super) function_start: Vec<usize>,
+    /// `e * stride + a`: local function `a` of element `e`.
+    pub(super) function_source: Vec<usize>,
+}
+
+impl Gather {
+    /// The maps of `basis` with `pattern` (its element scatter maps) and local
+    /// blocks of `stride` functions.
+    pub fn new<T: Scalar, const D: usize, B: Basis<T, D>>(
+        basis: &B,
+        pattern: &SymmetricPattern,
+        stride: usize,
+    ) -> Self {
+        let (ne, n) = (basis.num_elements(), basis.num_functions());
+        let mut matrix: Vec<(usize, usize)> = Vec::new();
+        let mut function: Vec<(usize, usize)> = Vec::new();
+        for e in 0..ne {
+            let m = basis.element_functions(e).len();
+            let scatter = pattern.element_scatter(e);
+            for (a, &i) in basis.element_functions(e).iter().enumerate() {
+                function.push((i, e * stride + a));
+                for b in a..m {
+                    matrix.push((scatter[a * m + b], (e * stride + a) * stride + b));
+                }
+            }
+        }
+        let group = |pairs: Vec<(usize, usize)>, len: usize| {
+            // Stable: element order kept within each target.
+            let mut start = vec![0; len + 1];
+            for &(t, _) in &pairs {
+                start[t + 1] += 1;
+            }
+            for t in 0..len {
+                start[t + 1] += start[t];
+            }
+            let mut cursor = start[..len].to_vec();
+            let mut source = vec![0; pairs.len()];
+            for (t, s) in pairs {
+                source[cursor[t]] = s;
+                cursor[t] += 1;
+            }
+            (start, source)
+        };
+        let (matrix_start, matrix_source) = group(matrix, pattern.nnz());
+        let (function_start, function_source) = group(function, n);
+        Gather {
+            matrix_start,
+            matrix_source,
+            function_start,
+            function_source,
+        }
+    }
+
+    /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order.
+    pub(super) fn matrix<T: Scalar, const D: usize>(&self, local: &Local<T, D>, values: &mut [T]) {
+        values
+            .par_iter_mut()
+            .with_min_len(ENTRY_CHUNK)
+            .enumerate()
+            .for_each(|(j, v)| {
+                let mut sum = T::zero();
+                for &s in &self.matrix_source[self.matrix_start[j]..self.matrix_start[j + 1]] {
+                    sum += local.matrix[s];
+                }
+                *v = sum;
+            });
+    }
+
+    /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in
+    /// element order.
+    pub(super) fn functions<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        negate: bool,
+        out: &mut [Vec<T>],
+    ) {
+        for (k, out) in out.iter_mut().enumerate() {
+            out.par_iter_mut()
+                .with_min_len(ENTRY_CHUNK)
+                .enumerate()
+                .for_each(|(i, o)| {
+                    let mut sum = T::zero();
+                    for &s in
+                        &self.function_source[self.function_start[i]..self.function_start[i + 1]]
+                    {
+                        sum += local.vector[s * D + k];
+                    }
+                    if negate {
+                        *o -= sum;
+                    } else {
+                        *o += sum;
+                    }
+                });
+        }
+    }
+}
+
+/// The element-local sums `Σ_{p in e} q(p, s)` of a per-slot vector `q` (slot
+/// `s` of particle `p`), then gathered: `out_{k,i} += Σ_p q_k(p, s_i)`.
+pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
+    bins: &Bins,
+    evals: &Evaluations<T, D>,
+    gather: &Gather,
+    local: &mut Local<T, D>,
+    out: &mut [Vec<T>],
+    q: Q,
+) where
+    Q: Fn(usize, usize) -> SVector<T, D> + Sync,
+{
+    let stride = local.stride;
+    local
+        .vector
+        .par_chunks_mut(stride * D)
+        .with_min_len(ELEMENT_CHUNK)
+        .enumerate()
+        .for_each(|(e, lv)| {
+            lv.iter_mut().for_each(|v| *v = T::zero());
+            for &p in bins.particles(e) {
+                let base = p * evals.stride;
+                for a in 0..evals.len[p] {
+                    let f = q(p, base + a);
+                    for k in 0..D {
+                        lv[a * D + k] += f[k];
+                    }
+                }
+            }
+        });
+    gather.functions(local, false, out);
+}

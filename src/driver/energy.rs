@@ -1,0 +1,92 @@
+//! The energy balance of a step: the energies and momentum of the state (the
+//! per-particle terms in parallel, summed in particle order), and the work of the
+//! non-conservative effects booked with the mean of the start and end velocities.
+
+use super::{phases, Driver, StepError};
+use crate::diagnostics::{energies, energies_from_terms, particle_terms, Energies, StepReport};
+use crate::mass::MassStrategy;
+use crate::material::Material;
+use crate::sparse::Scalar;
+use psmpm_basis::Basis;
+use rayon::prelude::*;
+
+impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
+where
+    T: Scalar,
+    B: Basis<T, D>,
+    M: MassStrategy<T>,
+    Mat: Material<T, D>,
+{
+    /// [`energies`] of the current state, the per-particle terms computed in
+    /// parallel and summed in particle order (the same sums, bit for bit).
+    pub(super) fn step_energies(&mut self) -> Energies {
+        let (parts, material) = (&self.particles, &self.material);
+        self.energy_terms
+            .par_chunks_mut(phases::CHUNK)
+            .enumerate()
+            .for_each(|(c, terms)| {
+                for (q, t) in terms.iter_mut().enumerate() {
+                    *t = particle_terms(parts, material, c * phases::CHUNK + q);
+                }
+            });
+        energies_from_terms(self.energy_terms.iter().copied(), parts, &self.effects)
+    }
+
+    /// Power of the non-conservative forces with the velocity at the start of the
+    /// step, `v̂ⁿ`; before the first step `v̂⁰` is the projection of the initial
+    /// particle velocities with this step's mass matrix.
+    pub(super) fn power_at_start(&mut self) -> Result<f64, StepError> {
+        if self.work_force.is_empty() {
+            return Ok(0.0);
+        }
+        if !self.velocity_known {
+            phases::zero(&mut self.velocity);
+            phases::scatter_to_functions(
+                &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
+                &self.particles.mass,
+                &self.particles.v,
+                &mut self.velocity,
+            );
+            self.solve_projection()?;
+            self.velocity_known = true;
+        }
+        Ok(phases::power(&self.work_force, &self.velocity))
+    }
+
+    /// Work of the non-conservative effects over the step with the mean of the
+    /// start and end velocities, the rule under which the kinetic energy of the
+    /// symplectic Euler update changes: `W += Δt F · (v̂ⁿ + v̂ⁿ⁺¹) / 2`.
+    pub(super) fn book_work(&mut self, power_start: f64) {
+        self.velocity_known = true;
+        if !self.work_force.is_empty() {
+            self.work += 0.5
+                * (power_start + phases::power(&self.work_force, &self.velocity))
+                * self.dt.to_f64();
+        }
+    }
+
+    /// Energies and momentum of the current state.
+    pub fn report(&self) -> StepReport {
+        self.report_with(energies(&self.particles, &self.material, &self.effects))
+    }
+
+    pub(super) fn report_with(&self, e: Energies) -> StepReport {
+        StepReport {
+            step: self.step,
+            time: self.time,
+            kinetic: e.kinetic,
+            strain: e.strain,
+            potential: e.potential,
+            work: self.work,
+            mass: e.mass,
+            momentum: e.momentum,
+            max_speed: e.max_speed,
+            mass_report: self.last_report,
+            condition: self.last_condition,
+            phases: self.phases,
+        }
+    }
+}
