@@ -48,7 +48,10 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
         BasisKind::Ps => Basis2d::Ps(
             PowellSabin::<f64>::new(mesh, scene.split).map_err(|e| conflict("basis", e))?,
         ),
-        _ => Basis2d::Linear(Linear::<f64>::new(mesh)),
+        BasisKind::Pl => Basis2d::Linear(Linear::<f64>::new(mesh)),
+        one_d @ (BasisKind::Bspline | BasisKind::Pl1d) => {
+            return Err(conflict("basis", format!("`{}` is a 1D basis", one_d.name())).into())
+        }
     };
     Ok(Domain { basis, h, walls })
 }
@@ -71,7 +74,10 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
         .collect();
     let basis = match scene.basis {
         BasisKind::Bspline => Basis1d::Bspline(QuadraticBSpline::<f64>::new(mesh)),
-        _ => Basis1d::Linear(Linear1d::<f64>::new(mesh)),
+        BasisKind::Pl1d => Basis1d::Linear(Linear1d::<f64>::new(mesh)),
+        two_d @ (BasisKind::Ps | BasisKind::Pl) => {
+            return Err(conflict("basis", format!("`{}` is a 2D basis", two_d.name())).into())
+        }
     };
     Ok(Domain { basis, h, walls })
 }
