@@ -33,8 +33,10 @@ pub struct StepReport {
     pub work: f64,
     /// Total mass.
     pub mass: f64,
-    /// Total momentum (x, and y in 2D; unused components are zero).
-    pub momentum: [f64; 2],
+    /// Total momentum, `dim` components ([`StepReport::momentum`]).
+    pub(crate) momentum: [f64; 2],
+    /// Spatial dimension: the number of momentum components.
+    pub dim: usize,
     /// Largest particle speed.
     pub max_speed: f64,
     /// What the mass strategy did.
@@ -69,6 +71,11 @@ impl PhaseTimes {
 }
 
 impl StepReport {
+    /// Total momentum `Σ m_p v_p`, one component per dimension.
+    pub fn momentum(&self) -> &[f64] {
+        &self.momentum[..self.dim]
+    }
+
     /// Kinetic + strain + potential energy minus the work of the non-conservative
     /// effects: constant up to the time-integration error.
     pub fn total_energy(&self) -> f64 {

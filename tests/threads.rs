@@ -22,8 +22,8 @@ fn row_bits(r: &StepReport) -> Vec<u64> {
         r.potential.to_bits(),
         r.work.to_bits(),
         r.mass.to_bits(),
-        r.momentum[0].to_bits(),
-        r.momentum[1].to_bits(),
+        r.momentum()[0].to_bits(),
+        r.momentum()[1].to_bits(),
         r.max_speed.to_bits(),
         r.condition.map_or(0, f64::to_bits),
         m.active as u64,
@@ -177,8 +177,8 @@ fn step_energies_are_the_sequential_sums() {
                 r.strain,
                 r.potential,
                 r.mass,
-                r.momentum[0],
-                r.momentum[1],
+                r.momentum()[0],
+                r.momentum()[1],
                 r.max_speed,
             ]
             .map(f64::to_bits)

@@ -253,8 +253,9 @@ impl Recorder {
             float(r.work),
             float(r.total_energy()),
             float(r.mass),
-            float(r.momentum[0]),
-            float(r.momentum[1]),
+            float(r.momentum()[0]),
+            // (0 in 1D: the file has the same columns for every scene)
+            float(r.momentum().get(1).copied().unwrap_or(0.0)),
             float(r.max_speed),
             r.mass_report.active.to_string(),
             r.mass_report.lumped_rows.to_string(),

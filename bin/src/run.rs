@@ -275,7 +275,7 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         "work": r.work,
         "total": r.total_energy(),
         "mass": r.mass,
-        "momentum": r.momentum,
+        "momentum": r.momentum(),
         "max_speed": r.max_speed,
         "active": r.mass_report.active,
         "lumped_rows": r.mass_report.lumped_rows,

@@ -83,6 +83,7 @@ where
             work: self.work,
             mass: e.mass,
             momentum: e.momentum,
+            dim: D,
             max_speed: e.max_speed,
             mass_report: self.last_report,
             condition: self.last_condition,
