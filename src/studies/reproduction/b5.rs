@@ -115,6 +115,9 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
             s.mass = mass;
             setup(s.set_blocks(nx, ny))?;
             s.time.t_end = t_end;
+            // The seeds' Δt = 1e-3 on every grid: on 2 × 16 it is above the critical
+            // step of the consistent mass, and what that does is part of the study.
+            s.time.allow_above_critical = true;
             s.output.condition = true;
             s.output.tracked = vec![vec![0.05, 0.5]];
             let run = run_2d(&s, 10)?;
