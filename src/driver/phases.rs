@@ -17,7 +17,7 @@
 //! local buffer ([`Local`]), in particle order; each matrix entry and function
 //! coefficient then sums its elements' local values in element order
 //! ([`Gather`]). Every sum therefore has one fixed order, whatever the threads.
-//! The binning and the gathers are in [`super::binning`].
+//! The binning and the gathers are in `driver/binning.rs`.
 
 use crate::material::{det, Material};
 use crate::particles::Particles;
