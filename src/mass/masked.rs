@@ -9,6 +9,47 @@ use super::condition::{estimate, Operator};
 use super::{distinct_fixed_sets, MassError, MassSetup};
 use crate::sparse::{Scalar, SparseCholesky, SymmetricPattern};
 
+/// `out = M'`: `values` (`M` in `pattern`) with the rows and columns where
+/// `masked(i)` replaced by the diagonal entry `masked_diagonal`, and every
+/// off-diagonal entry of a `lumped` row (or column) moved onto both diagonals.
+/// `diagonal_add` is the caller's buffer (`n` entries). Shared by the row-wise
+/// strategies and the hybrid extension.
+pub(super) fn modify_rows<T: Scalar>(
+    pattern: &SymmetricPattern,
+    values: &[T],
+    lumped: &[bool],
+    masked: impl Fn(usize) -> bool,
+    masked_diagonal: T,
+    diagonal_add: &mut [T],
+    out: &mut [T],
+) {
+    let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
+    diagonal_add.iter_mut().for_each(|v| *v = T::zero());
+    for c in 0..pattern.dim() {
+        for k in ptr[c]..ptr[c + 1] {
+            let r = rows[k];
+            out[k] = if r == c {
+                if masked(r) {
+                    masked_diagonal
+                } else {
+                    values[k]
+                }
+            } else if masked(r) || masked(c) {
+                T::zero()
+            } else if lumped[r] || lumped[c] {
+                diagonal_add[r] += values[k];
+                diagonal_add[c] += values[k];
+                T::zero()
+            } else {
+                values[k]
+            };
+        }
+    }
+    for (i, add) in diagonal_add.iter().enumerate() {
+        out[pattern.diagonal_position(i)] += *add;
+    }
+}
+
 /// One factorisation per distinct set of fixed coefficients.
 #[derive(Default)]
 pub(super) struct MaskedCholesky<T: Scalar> {
@@ -64,35 +105,18 @@ impl<T: Scalar> MaskedCholesky<T> {
         } else {
             T::one()
         };
-        let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
         for (s, fixed) in self.fixed.iter().enumerate() {
-            let out = &mut self.modified[s];
-            self.diagonal_add.iter_mut().for_each(|v| *v = T::zero());
-            let masked = |i: usize| fixed[i] || self.inactive[i];
-            for c in 0..n {
-                for k in ptr[c]..ptr[c + 1] {
-                    let r = rows[k];
-                    out[k] = if r == c {
-                        if masked(r) {
-                            scale
-                        } else {
-                            values[k]
-                        }
-                    } else if masked(r) || masked(c) {
-                        T::zero()
-                    } else if self.lumped[r] || self.lumped[c] {
-                        self.diagonal_add[r] += values[k];
-                        self.diagonal_add[c] += values[k];
-                        T::zero()
-                    } else {
-                        values[k]
-                    };
-                }
-            }
-            for i in 0..n {
-                out[pattern.diagonal_position(i)] += self.diagonal_add[i];
-            }
-            self.solvers[s].factorize(out)?;
+            let inactive = &self.inactive;
+            modify_rows(
+                pattern,
+                values,
+                &self.lumped,
+                |i| fixed[i] || inactive[i],
+                scale,
+                &mut self.diagonal_add,
+                &mut self.modified[s],
+            );
+            self.solvers[s].factorize(&self.modified[s])?;
         }
         Ok(())
     }

@@ -68,6 +68,8 @@ pub struct Extended<T: Scalar> {
     /// to `coverage` when nothing is lumped).
     lump: f64,
     lumped: Vec<bool>,
+    /// Buffer of the row lumping.
+    diagonal_add: Vec<T>,
     support: SupportFacts,
     fixed: Vec<Vec<bool>>,
     solver_of: Vec<usize>,
@@ -114,6 +116,7 @@ impl<T: Scalar> Extended<T> {
             coverage: extend,
             lump: lump.max(extend),
             lumped: Vec::new(),
+            diagonal_add: Vec::new(),
             support: SupportFacts::default(),
             fixed: Vec::new(),
             solver_of: Vec::new(),
@@ -195,6 +198,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
         self.lumped = vec![false; n];
+        self.diagonal_add = vec![T::zero(); n];
         self.active = Vec::with_capacity(n);
         self.extended = Vec::with_capacity(n);
         self.ext_ptr = vec![0; n + 1];
@@ -258,17 +262,15 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         // Lumped rows: every off-diagonal entry of a lumped row moves onto both
         // diagonals (row sums kept, `M' ⪰ M`).
         if self.lumped.iter().any(|&l| l) {
-            for c in 0..n {
-                for k in self.col_ptr[c]..self.col_ptr[c + 1] {
-                    let r = self.row_idx[k];
-                    if r != c && (self.lumped[r] || self.lumped[c]) {
-                        let v = self.values[k];
-                        self.values[k] = T::zero();
-                        self.values[pattern.diagonal_position(r)] += v;
-                        self.values[pattern.diagonal_position(c)] += v;
-                    }
-                }
-            }
+            super::masked::modify_rows(
+                pattern,
+                values,
+                &self.lumped,
+                |_| false,
+                T::zero(),
+                &mut self.diagonal_add,
+                &mut self.values,
+            );
         }
         report.lumped_rows = self.lumped.iter().filter(|&&l| l).count();
         self.active.clear();
