@@ -156,7 +156,7 @@ fn lumped_rows_lose_the_rotation_that_the_default_mass_keeps() {
     let angle = |mass: &str| spin(law, MassKind::parse(mass).unwrap()).rotation;
     let kept = angle("default");
     assert!((kept - expected).abs() < 0.01 * expected, "default: {kept}");
-    for lumping in ["partial", "extended-hybrid"] {
+    for lumping in ["partial", "extended-hybrid", "lumped"] {
         let lost = angle(lumping);
         println!("{lumping}: {lost:.3} rad of {expected}");
         assert!(lost < 0.7 * expected, "{lumping}: {lost}");
