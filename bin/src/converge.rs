@@ -11,8 +11,12 @@ use crate::run::{read_scene, Overrides};
 use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::output::chart::{line_plot, Axis, LinePlot, Scale, Series, SeriesStyle};
-use psmpm::simulation::{self, RunError};
+use psmpm::particles::Particles;
+use psmpm::scene::Scene;
+use psmpm::simulation::{self, RunError, Summary};
+use psmpm::studies::self_convergence::{error_against, FinestField};
 use serde::Serialize;
+use serde_json::{json, Value};
 use std::path::PathBuf;
 
 /// Arguments of `mpm-cli converge`.
@@ -67,6 +71,84 @@ pub struct Level {
     pub stable: bool,
 }
 
+/// What the errors of a study are measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Against {
+    /// The scene's exact or reference solution.
+    Exact,
+    /// The finest level of the same basis (the scene has no exact solution).
+    FinestLevel,
+}
+
+/// Why an order fell, measured by two extra runs at the level where it fell.
+#[derive(Debug, Clone, Serialize)]
+pub struct Diagnosis {
+    /// Basis.
+    pub basis: &'static str,
+    /// The level whose order fell.
+    pub level: u32,
+    /// Its order.
+    pub order: f64,
+    /// Error of that level with half the time step, over its error.
+    pub half_dt: Option<f64>,
+    /// Error of that level with twice the particles along every axis, over its error.
+    pub double_particles: Option<f64>,
+    /// What limits the error, and what to change.
+    pub verdict: String,
+}
+
+/// A probe that lowers the error by more than this fraction names what limits it.
+const LIMITING_GAIN: f64 = 0.2;
+
+/// An order falls when it is below this…
+const LOW_ORDER: f64 = 0.5;
+/// …or this far below the best order the basis reached on the coarser levels.
+const ORDER_DROP: f64 = 0.5;
+
+/// A level's final particles, kept to measure the coarser levels against the finest.
+enum Final {
+    One(Particles<f64, 1>),
+    Two(Particles<f64, 2>),
+}
+
+/// The finest level's field, in the scene's dimension.
+enum Finest {
+    One(FinestField<1>),
+    Two(FinestField<2>),
+}
+
+impl Finest {
+    fn new(particles: &Final) -> Result<Self, String> {
+        Ok(match particles {
+            Final::One(p) => Finest::One(FinestField::new(p).map_err(|e| e.to_string())?),
+            Final::Two(p) => Finest::Two(FinestField::new(p).map_err(|e| e.to_string())?),
+        })
+    }
+
+    fn error(&self, particles: &Final) -> Option<f64> {
+        match (self, particles) {
+            (Finest::One(f), Final::One(p)) => Some(error_against(f, p)),
+            (Finest::Two(f), Final::Two(p)) => Some(error_against(f, p)),
+            _ => None,
+        }
+    }
+}
+
+/// Runs `scene` and keeps its final particles when the run reached its end.
+fn run_level(scene: &Scene) -> Result<(Summary, Option<Final>), CliError> {
+    let err = |e: RunError| CliError::Input(e.to_string());
+    let (summary, particles) = if scene.dim == 1 {
+        let o = simulation::run_1d(scene, &mut |_| {}).map_err(err)?;
+        (o.summary, Final::One(o.particles))
+    } else {
+        let o = simulation::run_2d(scene, &mut |_| {}).map_err(err)?;
+        (o.summary, Final::Two(o.particles))
+    };
+    let finished = summary.failure.is_none() && !summary.interrupted;
+    Ok((summary, finished.then_some(particles)))
+}
+
 /// Runs the study.
 pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     if args.levels == 0 || args.levels > 7 {
@@ -76,65 +158,241 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
         )));
     }
     let base = read_scene(&args.scene)?;
-    if base.reference.is_none() {
-        return Err(CliError::Input(format!(
-            "scene `{}` has no reference solution, so there is no error to converge",
-            base.name
-        )));
-    }
+    let against = if base.reference.is_some() {
+        Against::Exact
+    } else {
+        if args.levels < 3 {
+            return Err(CliError::Input(format!(
+                "scene `{}` has no exact solution, so its levels are measured against the \
+                 finest one: --levels must be at least 3 to give an order, got {}",
+                base.name, args.levels
+            )));
+        }
+        Against::FinestLevel
+    };
     let masses: Vec<String> = args.mass.iter().cloned().collect();
     let bases = variants(&base, &args.basis, &masses, &args.overrides)?;
     let mut rows: Vec<Level> = Vec::new();
+    let mut diagnoses: Vec<Diagnosis> = Vec::new();
+    let mut notes: Vec<String> = Vec::new();
     let progress =
         crate::progress::Progress::new((bases.len() * args.levels as usize) as u64, "runs");
     for scene in &bases {
-        let mut previous: Option<(f64, f64)> = None;
+        let mut levels = Vec::new();
+        let mut finals = Vec::new();
         for level in 0..args.levels {
             let s = scene
                 .refined(level)
                 .map_err(|e| CliError::Input(format!("level {level}: {e}")))?;
+            let (summary, particles) = run_level(&s)?;
+            progress.inc(1);
+            levels.push((s, summary));
+            finals.push(particles);
+        }
+        let finest = match against {
+            Against::Exact => None,
+            Against::FinestLevel => match finals.last().and_then(|f| f.as_ref()) {
+                Some(f) => match Finest::new(f) {
+                    Ok(field) => Some(field),
+                    Err(e) => {
+                        notes.push(format!("{}: no error: {e}", levels[0].1.basis));
+                        None
+                    }
+                },
+                None => {
+                    notes.push(format!(
+                        "{}: the finest level did not reach the end, so no level has an error",
+                        levels[0].1.basis
+                    ));
+                    None
+                }
+            },
+        };
+        let error_of = |summary: &Summary, particles: &Option<Final>| match against {
+            Against::Exact => summary.error,
+            Against::FinestLevel => match (&finest, particles) {
+                (Some(f), Some(p)) => f.error(p),
+                _ => None,
+            },
+        };
+        let mut previous: Option<(f64, f64)> = None;
+        let mut best_order = f64::NEG_INFINITY;
+        let mut falling: Option<(usize, f64)> = None;
+        let first = rows.len();
+        for (index, ((s, summary), particles)) in levels.iter().zip(&finals).enumerate() {
+            let is_finest = against == Against::FinestLevel && index + 1 == levels.len();
+            let error = if is_finest {
+                None
+            } else {
+                error_of(summary, particles)
+            };
             let h = s.mesh_size().unwrap_or(f64::NAN);
-            let summary = simulation::run(&s, &mut |_| {})
-                .map_err(|e: RunError| CliError::Input(e.to_string()))?;
-            let order = match (previous, summary.error) {
+            let order = match (previous, error) {
                 (Some((h0, e0)), Some(e)) if e > 0.0 && e0 > 0.0 => {
                     Some((e0 / e).ln() / (h0 / h).ln())
                 }
                 _ => None,
             };
-            if let Some(e) = summary.error {
+            if let Some(p) = order {
+                if summary.stable && (p < LOW_ORDER || p < best_order - ORDER_DROP) {
+                    falling = Some((index, p));
+                }
+                best_order = best_order.max(p);
+            }
+            if let Some(e) = error {
                 previous = Some((h, e));
             }
-            progress.inc(1);
             rows.push(Level {
                 basis: summary.basis,
-                level,
+                level: index as u32,
                 h,
                 functions: summary.functions,
                 particles: summary.particles,
-                error: summary.error,
+                error,
                 order,
                 seconds: summary.seconds,
                 stable: summary.stable,
             });
         }
+        if let Some((index, order)) = falling {
+            let error = rows[first + index].error.unwrap_or(f64::NAN);
+            let probe = |s: Scene| -> Result<Option<f64>, CliError> {
+                let (summary, particles) = run_level(&s)?;
+                Ok(error_of(&summary, &particles).map(|e| e / error))
+            };
+            let s = &levels[index].0;
+            let half_dt = probe(with_half_time_step(s))?;
+            let double_particles = match with_double_particles(s) {
+                Some(denser) => probe(denser)?,
+                None => None,
+            };
+            diagnoses.push(Diagnosis {
+                basis: rows[first].basis,
+                level: index as u32,
+                order,
+                half_dt,
+                double_particles,
+                verdict: verdict(s, half_dt, double_particles),
+            });
+        }
     }
     progress.finish();
-    print_levels(&rows, args.format);
+    print_levels(&rows, against, &diagnoses, &notes, args.format);
     if let Some(dir) = &args.out {
-        write_outputs(dir, &base.name, &rows)?;
+        write_outputs(dir, &base.name, &rows, against, &diagnoses, &notes)?;
     }
     let failed = rows.iter().filter(|r| !r.stable).count();
     crate::error::study_verdict(args.strict, failed, rows.len())
 }
 
-fn print_levels(rows: &[Level], format: Format) {
-    match format {
-        Format::Json => {
-            let text = serde_json::to_string(rows).unwrap_or_else(|e| format!("\"{e}\""));
-            println!("{text}");
+/// `scene` with half its time step (half its Courant number).
+fn with_half_time_step(scene: &Scene) -> Scene {
+    let mut s = scene.clone();
+    if let Some(dt) = &mut s.time.dt {
+        *dt *= 0.5;
+    }
+    if let Some(c) = &mut s.time.courant {
+        *c *= 0.5;
+    }
+    s
+}
+
+/// `scene` with twice the particles of every body along every axis, or `None` when
+/// a body's particles are not given per block or per axis.
+fn with_double_particles(scene: &Scene) -> Option<Scene> {
+    let mut s = scene.clone();
+    for body in &mut s.bodies {
+        let counts = body.per_block.as_mut().or(body.count.as_mut())?;
+        counts.iter_mut().for_each(|n| *n *= 2);
+    }
+    Some(s)
+}
+
+/// What the two probes say limits the error at a level whose order fell.
+fn verdict(scene: &Scene, half_dt: Option<f64>, double_particles: Option<f64>) -> String {
+    let lowers = |r: Option<f64>| r.is_some_and(|r| r < 1.0 - LIMITING_GAIN);
+    let time = if scene.time.courant.is_some() {
+        "a smaller `courant` (or --dt)"
+    } else {
+        "a smaller `dt` (--dt), or `courant` so that the step shrinks with h"
+    };
+    let particles = "more particles per element as h shrinks (`per_block` or `count`, \
+                     --particles)";
+    match (lowers(half_dt), lowers(double_particles)) {
+        (true, true) => format!(
+            "both the time step and the particles per element limit the error: {time} and {particles}"
+        ),
+        (true, false) => format!("the time step limits the error: {time}"),
+        (false, true) => format!(
+            "the particles per element limit the error (particle quadrature of the internal \
+             force): {particles}"
+        ),
+        (false, false) if double_particles.is_some_and(|r| r > 1.0 + LIMITING_GAIN) => {
+            "more particles raise the error: the error of particles crossing element edges \
+             (largest for a C⁰ basis such as PL), not h, dt or quadrature; a smooth basis \
+             (ps, bspline) avoids it"
+                .into()
         }
-        Format::Csv => print!("{}", csv(rows)),
+        (false, false) => "neither a smaller time step nor more particles lower the error: it \
+                           has reached a floor that refinement does not remove (for example \
+                           the reference's own assumptions, such as small strain, or the \
+                           finest level's error)"
+            .into(),
+    }
+}
+
+/// The study as JSON: what the errors are measured against, the levels, the
+/// diagnoses of falling orders and the notes.
+fn json(rows: &[Level], against: Against, diagnoses: &[Diagnosis], notes: &[String]) -> Value {
+    json!({
+        "against": against,
+        "levels": rows,
+        "diagnoses": diagnoses,
+        "notes": notes,
+    })
+}
+
+/// The lines printed under the table: what the error is, and why orders fell.
+fn explanation(against: Against, diagnoses: &[Diagnosis], notes: &[String]) -> String {
+    let mut out = String::new();
+    if against == Against::FinestLevel {
+        out += "error: E_u against the finest level of the same basis (the scene has no \
+                exact solution), so the finest level has none\n";
+    }
+    for n in notes {
+        out += &format!("note: {n}\n");
+    }
+    let ratio = |r: Option<f64>| r.map_or_else(|| "not measured".into(), |r| format!("× {r:.2}"));
+    for d in diagnoses {
+        out += &format!(
+            "{} level {}: the order falls to {:.2}. At this level, half the time step \
+             changes the error {}, twice the particles along each axis {}: {}.\n",
+            d.basis,
+            d.level,
+            d.order,
+            ratio(d.half_dt),
+            ratio(d.double_particles),
+            d.verdict
+        );
+    }
+    out
+}
+
+fn print_levels(
+    rows: &[Level],
+    against: Against,
+    diagnoses: &[Diagnosis],
+    notes: &[String],
+    format: Format,
+) {
+    match format {
+        Format::Json => println!("{}", json(rows, against, diagnoses, notes)),
+        Format::Csv => {
+            print!("{}", csv(rows));
+            for line in explanation(against, diagnoses, notes).lines() {
+                eprintln!("# {line}");
+            }
+        }
         Format::Table => {
             let mut table = Table::new(&[
                 "basis",
@@ -161,6 +419,7 @@ fn print_levels(rows: &[Level], format: Format) {
                 ]);
             }
             print!("{}", table.render());
+            print!("{}", explanation(against, diagnoses, notes));
         }
     }
 }
@@ -197,7 +456,14 @@ fn csv(rows: &[Level]) -> String {
 }
 
 /// `converge.csv`, `converge.json`, `error-vs-h.svg`, `work-precision.svg`.
-fn write_outputs(dir: &std::path::Path, scene: &str, rows: &[Level]) -> Result<(), CliError> {
+fn write_outputs(
+    dir: &std::path::Path,
+    scene: &str,
+    rows: &[Level],
+    against: Against,
+    diagnoses: &[Diagnosis],
+    notes: &[String],
+) -> Result<(), CliError> {
     let io = |path: &std::path::Path, e: std::io::Error| {
         CliError::Input(format!("{}: cannot write: {e}", path.display()))
     };
@@ -205,7 +471,8 @@ fn write_outputs(dir: &std::path::Path, scene: &str, rows: &[Level]) -> Result<(
     let path = dir.join("converge.csv");
     std::fs::write(&path, csv(rows)).map_err(|e| io(&path, e))?;
     let path = dir.join("converge.json");
-    let json = serde_json::to_string_pretty(rows).unwrap_or_default();
+    let json =
+        serde_json::to_string_pretty(&json(rows, against, diagnoses, notes)).unwrap_or_default();
     std::fs::write(&path, json).map_err(|e| io(&path, e))?;
     let mut bases: Vec<&str> = rows.iter().map(|r| r.basis).collect();
     bases.dedup();
@@ -247,7 +514,10 @@ fn write_outputs(dir: &std::path::Path, scene: &str, rows: &[Level]) -> Result<(
                 include: None,
             },
             y: Axis {
-                label: "error".into(),
+                label: match against {
+                    Against::Exact => "error".into(),
+                    Against::FinestLevel => "error against the finest level".into(),
+                },
                 scale: Scale::Log10,
                 include: None,
             },

@@ -9,6 +9,8 @@
 //!   benchmarks B3 and B5b, with its on-disk cache of reference runs;
 //! - [`projection`]: L² projection onto a basis, benchmark B1;
 //! - [`published`]: the seeds' printed numbers the studies and tests compare against;
+//! - [`self_convergence`]: the error of a run against the finest run of a study,
+//!   for scenes without an exact solution;
 //! - [`reproduction`]: the benchmarks B2–B5 as studies, the tables and figures of
 //!   `docs/results.md`.
 
@@ -16,4 +18,5 @@ pub mod exact;
 pub mod projection;
 pub mod published;
 pub mod reproduction;
+pub mod self_convergence;
 pub mod ulfem;

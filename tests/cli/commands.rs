@@ -211,7 +211,9 @@ fn converge_prints_levels_orders_and_writes_its_plots() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    let rows: Value = without_seconds(serde_json::from_str(&json).unwrap());
+    let study: Value = without_seconds(serde_json::from_str(&json).unwrap());
+    assert_eq!(study["against"], "exact");
+    let rows = study["levels"].clone();
     for row in rows.as_array().unwrap() {
         for key in [
             "basis",
@@ -279,6 +281,114 @@ fn converge_prints_levels_orders_and_writes_its_plots() {
         "0.02",
     ]);
     assert!(table.starts_with("  basis  level"), "{table}");
+}
+
+/// README: `converge vibrating-bar-1d --levels 4` used to end with a negative order
+/// and no word of why. The study now measures why at the level where an order falls.
+#[test]
+fn converge_explains_a_falling_order_with_two_probes() {
+    let json = stdout(&[
+        "converge",
+        "vibrating-bar-1d",
+        "--levels",
+        "4",
+        "--format",
+        "json",
+    ]);
+    let study: Value = serde_json::from_str(&json).unwrap();
+    let diagnoses = study["diagnoses"].as_array().unwrap();
+    let of = |basis: &str| diagnoses.iter().find(|d| d["basis"] == basis).unwrap();
+    for basis in ["bspline", "pl1d"] {
+        let d = of(basis);
+        assert_eq!(d["level"], 3, "{d}");
+        // Half the time step changes nothing; twice the particles halves the error.
+        let half_dt = d["half_dt"].as_f64().unwrap();
+        let double = d["double_particles"].as_f64().unwrap();
+        assert!((half_dt - 1.0).abs() < 0.05, "{d}");
+        assert!(double < 0.6, "{d}");
+        assert!(
+            d["verdict"]
+                .as_str()
+                .unwrap()
+                .contains("particles per element limit"),
+            "{d}"
+        );
+    }
+    let table = stdout(&["converge", "vibrating-bar-1d", "--levels", "4"]);
+    assert!(
+        table.contains("pl1d level 3: the order falls to -2.46") && table.contains("--particles"),
+        "{table}"
+    );
+}
+
+/// A scene of the user's own, without an exact solution: a block settling on a fixed
+/// floor. Levels are measured against the finest one, and the output says so.
+#[test]
+fn converge_measures_a_scene_without_exact_solution_against_its_finest_level() {
+    let dir = temp_dir("converge-finest");
+    let scene = dir.join("settle.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "settle"
+dim = 2
+basis = "pl"
+[mesh]
+kind = "blocks"
+x = [0.0, 1.0]
+y = [0.0, 1.0]
+blocks = [2, 2]
+[material]
+young = 1000.0
+poisson = 0.3
+density = 1.0
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 0.5]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -10.0]
+[time]
+courant = 0.4
+t_end = 0.1
+"#,
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let json = stdout(&[
+        "converge", scene, "--basis", "pl", "--levels", "4", "--format", "json",
+    ]);
+    let study: Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(study["against"], "finest-level");
+    let levels = study["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 4);
+    assert!(
+        levels[3]["error"].is_null(),
+        "the finest level is the reference"
+    );
+    let errors: Vec<f64> = levels[..3]
+        .iter()
+        .map(|l| l["error"].as_f64().unwrap())
+        .collect();
+    assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
+    // PL converges at about second order in displacement on this smooth problem.
+    let order = levels[2]["order"].as_f64().unwrap();
+    assert!((1.5..2.6).contains(&order), "{order}");
+    let table = stdout(&["converge", scene, "--basis", "pl", "--levels", "3"]);
+    assert!(table.contains("E_u against the finest level"), "{table}");
+    // Two levels cannot give an order without an exact solution.
+    let out = cli()
+        .args(["converge", scene, "--levels", "2"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--levels must be at least 3"),
+        "{out:?}"
+    );
 }
 
 #[test]
