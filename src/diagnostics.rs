@@ -22,6 +22,11 @@ pub struct StepReport {
     pub step: usize,
     /// Time after the step.
     pub time: f64,
+    /// The time step `Δt`.
+    pub dt: f64,
+    /// The critical time step estimated at the start of the run (power iteration on
+    /// `M⁻¹K`), when it was estimated; `Δt / Δt_crit` is the Courant number.
+    pub dt_critical: Option<f64>,
     /// Kinetic energy `Σ ½ m_p |v_p|²`.
     pub kinetic: f64,
     /// Strain energy `Σ V_p⁰ W(F_p)`.

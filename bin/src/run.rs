@@ -3,7 +3,7 @@
 use crate::error::CliError;
 use crate::out::{self, Recorder};
 use crate::progress::Progress;
-use crate::table::{sci, Table};
+use crate::table::{sci, short, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::driver::StepReport;
@@ -441,6 +441,14 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             recorder.observe(r, particles);
         }
         if r.step == 0 {
+            // The time step against the critical one, before the first step.
+            let line = time_step_line(r);
+            match format {
+                Format::Table => stdout.line(&line),
+                Format::Json | Format::Csv => {
+                    let _ = writeln!(std::io::stderr(), "# {line}");
+                }
+            }
             return;
         }
         if r.step == 1 && r.time > 0.0 {
@@ -512,6 +520,29 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             unstable_reason(&summary)
         ))),
         None => Ok(()),
+    }
+}
+
+/// `time step … · critical step … · Courant number …`, printed at the start of a run.
+pub fn time_step_line(r: &StepReport) -> String {
+    match r.dt_critical {
+        Some(c) if c.is_finite() && c > 0.0 => format!(
+            "time step {} · critical step {} (estimated for this mesh, basis, mass strategy \
+             and material) · Courant number {:.3}",
+            sci(r.dt),
+            sci(c),
+            r.dt / c
+        ),
+        Some(_) => format!(
+            "time step {} · no critical step (nothing stiff moves: no particle or no \
+             stiffness)",
+            sci(r.dt)
+        ),
+        None => format!(
+            "time step {} · critical step not estimated (the mass system could not be \
+             solved at the start; the first step says why)",
+            sci(r.dt)
+        ),
     }
 }
 
@@ -606,7 +637,7 @@ pub fn summary_text(summary: &Summary) -> String {
         summary.particles,
         summary.steps,
         sci(summary.dt),
-        summary.t_end
+        short(summary.t_end)
     );
     let error = match (summary.error, summary.error_measure) {
         (Some(e), Some(m)) => format!("error {m} = {}", sci(e)),
@@ -627,7 +658,8 @@ pub fn summary_text(summary: &Summary) -> String {
     if summary.interrupted {
         out += &format!(
             "interrupted after step {} (t = {}): the summary covers the steps taken\n",
-            summary.steps, summary.t_end
+            summary.steps,
+            short(summary.t_end)
         );
     }
     let p = &summary.phases;

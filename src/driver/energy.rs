@@ -77,6 +77,8 @@ where
         StepReport {
             step: self.step,
             time: self.time,
+            dt: self.dt.to_f64(),
+            dt_critical: self.dt_critical,
             kinetic: e.kinetic,
             strain: e.strain,
             potential: e.potential,

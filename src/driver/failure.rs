@@ -54,8 +54,8 @@ where
             worst.filter(|&(_, c)| c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0)
         {
             return format!(
-                "the particle sits in the support of function {i} at {:?}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
-                to_f64_point(&self.basis.function_point(i)),
+                "the particle sits in the support of function {i} at {}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                point(&to_f64_point(&self.basis.function_point(i))),
                 c,
                 self.mass.spec()
             );
@@ -63,8 +63,8 @@ where
         if let Some((i, c)) = self.last_report.worst_coverage {
             if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 {
                 return format!(
-                    "function {i} at {:?} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended`)",
-                    to_f64_point(&self.basis.function_point(i)),
+                    "function {i} at {} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended`)",
+                    point(&to_f64_point(&self.basis.function_point(i))),
                     self.mass.spec()
                 );
             }
@@ -86,8 +86,8 @@ where
     pub(super) fn mass_failure(&self, source: MassError) -> StepError {
         let hint = match (self.last_report.worst_coverage, &self.inputs.support) {
             (Some((i, c)), _) => format!(
-                "the worst-covered function {i} at {:?} is covered to {c:.1e} of its support: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
-                to_f64_point(&self.basis.function_point(i))
+                "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                point(&to_f64_point(&self.basis.function_point(i)))
             ),
             _ => format!(
                 "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended`), or `partial` / `lumped`",
@@ -106,7 +106,10 @@ where
 /// fix that fits that cause.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepError {
-    #[error("step {step}: particle {particle} at {position:?} left the mesh; {hint}")]
+    #[error(
+        "step {step}: particle {particle} at {} left the mesh; {hint}",
+        point(position)
+    )]
     ParticleLeftMesh {
         step: usize,
         particle: usize,
@@ -121,7 +124,10 @@ pub enum StepError {
         /// What the driver sees (the worst-covered function) and what to change.
         hint: String,
     },
-    #[error("step {step}: {quantity} of particle {particle} at {position:?} is not valid; {hint}")]
+    #[error(
+        "step {step}: {quantity} of particle {particle} at {} is not valid; {hint}",
+        point(position)
+    )]
     NotFinite {
         step: usize,
         quantity: &'static str,
@@ -139,6 +145,23 @@ pub enum SetupError {
     Basis(#[from] BasisError),
     #[error("boundary condition on `{tag}`: {message}")]
     Boundary { tag: String, message: String },
-    #[error("particle {particle} at {position:?} lies outside the mesh")]
+    #[error("particle {particle} at {} lies outside the mesh", point(position))]
     ParticleOutside { particle: usize, position: Vec<f64> },
+}
+
+/// A position for a message: `[0.00312378, 0.947718]`, six significant digits per
+/// coordinate (enough to find the place, without the noise of the last bits).
+pub(crate) fn point(x: &[f64]) -> String {
+    let coordinates: Vec<String> = x
+        .iter()
+        .map(|&c| {
+            if c == 0.0 || !c.is_finite() {
+                return format!("{c}");
+            }
+            // Six significant digits, read back so that `{}` prints the shortest form.
+            let rounded: f64 = format!("{c:.5e}").parse().unwrap_or(c);
+            format!("{rounded}")
+        })
+        .collect();
+    format!("[{}]", coordinates.join(", "))
 }

@@ -32,6 +32,22 @@ fn json_lines_then_a_summary_with_the_documented_keys() {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     assert_eq!(lines.len(), 3);
+    // The time step and its Courant number go to stderr, stdout stays JSON; the
+    // number printed is the summary's dt over its critical step.
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    let courant: f64 = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("# time step 1.00e-3 · critical step "))
+        .and_then(|l| l.rsplit("Courant number ").next())
+        .unwrap_or_else(|| panic!("{stderr}"))
+        .parse()
+        .unwrap();
+    let summary = &lines[2];
+    let expected = summary["dt"].as_f64().unwrap() / summary["dt_critical"].as_f64().unwrap();
+    assert!(
+        (courant - expected).abs() < 1e-3,
+        "{courant} against {expected}"
+    );
     assert_eq!(lines[0]["step"], 250);
     assert_eq!(lines[1]["step"], 500);
     let summary = &lines[2];
@@ -83,7 +99,15 @@ fn table_and_summary_for_a_1d_scene() {
         .unwrap();
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.lines().next().unwrap().split_whitespace().eq([
+    // First the time step against the critical one, then the table.
+    let mut lines = text.lines();
+    let first = lines.next().unwrap();
+    assert!(
+        first.starts_with("time step 1.00e-4 · critical step ")
+            && first.contains("Courant number 0."),
+        "{first}"
+    );
+    assert!(lines.next().unwrap().split_whitespace().eq([
         "step",
         "time",
         "kinetic",
