@@ -29,14 +29,22 @@
 //!   without a reference; the reference as a line) and below it the velocity
 //!   (computed, in the same style).
 //! - `energy.svg`: kinetic, strain, potential and total energy against time.
+//! - `particles.svg`: the particles at the first frame, the step nearest half the
+//!   run and the last step, coloured by `--picture FIELD` (default `displacement`,
+//!   `|u|`) on one colour scale, over the mesh (2D); in 1D the field against the
+//!   position, one curve per time.
 
 use crate::error::CliError;
 use psmpm::driver::StepReport;
-use psmpm::output::chart::{stacked_line_plots, LinePlot, Series};
+use psmpm::output::chart::{stacked_line_plots, LinePlot, PlotError, Series};
 use psmpm::output::dir::{is_frame, prepare_dir, write_file, OutputDir, OutputError};
+use psmpm::output::particle_picture::{
+    particle_plot, ParticleField, ParticleFrame, ParticlePicture,
+};
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::scene::Scene;
 use psmpm::simulation::{self, ParticlesRef, Summary, Tracked};
+use psmpm_basis::Vec2;
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -70,6 +78,8 @@ pub const TRACKED_CSV: &str = "tracked.csv";
 pub const TRACKED_SVG: &str = "tracked.svg";
 /// Energies, plot.
 pub const ENERGY_SVG: &str = "energy.svg";
+/// Particles at the first, middle and last frame, picture.
+pub const PARTICLES_SVG: &str = "particles.svg";
 
 /// Frames per run when `--out-every` is not given (plus the initial state).
 pub const DEFAULT_FRAMES: usize = 50;
@@ -92,6 +102,7 @@ pub fn is_output_file(name: &str) -> bool {
             TRACKED_CSV,
             TRACKED_SVG,
             ENERGY_SVG,
+            PARTICLES_SVG,
             OutputDir::MESH_FILE,
             OutputDir::PVD_FILE,
         ]
@@ -107,6 +118,8 @@ pub struct OutOptions {
     pub overwrite: bool,
     /// `--vtu`.
     pub encoding: VtuEncoding,
+    /// `--picture`: the field of `particles.svg`.
+    pub picture: ParticleField,
 }
 
 fn write_error(path: &Path, e: std::io::Error) -> CliError {
@@ -114,6 +127,19 @@ fn write_error(path: &Path, e: std::io::Error) -> CliError {
         path: path.to_path_buf(),
         source: e,
     })
+}
+
+/// The frame of `particles` for `particles.svg` (1D positions on the x axis).
+fn frame_of(particles: ParticlesRef<'_>, time: f64, field: ParticleField) -> ParticleFrame {
+    match particles {
+        ParticlesRef::Two(p) => ParticleFrame::of(p, time, field),
+        ParticlesRef::One(p) => ParticleFrame {
+            time,
+            positions: p.x.iter().map(|x| Vec2::new(x[0], 0.0)).collect(),
+            values: field.values(p),
+            sizes: p.volume0.clone(),
+        },
+    }
 }
 
 /// Writes the files of one run while it runs ([`Recorder::observe`]) and at its end
@@ -135,6 +161,11 @@ pub struct Recorder {
     last_frame: Option<usize>,
     last_step: usize,
     mesh: bool,
+    /// Mesh edges under the particles of `particles.svg` (2D).
+    edges: Vec<[Vec2; 2]>,
+    /// The field of `particles.svg`, and its first and middle frames.
+    picture: ParticleField,
+    pictured: Vec<ParticleFrame>,
     /// The first write error; nothing more is written after it.
     error: Option<CliError>,
 }
@@ -161,10 +192,17 @@ impl Recorder {
             .map_err(output_error)?
             .with_encoding(options.encoding);
         let mesh = scene.dim == 2;
+        let mut edges = Vec::new();
         if mesh {
             let triangulation =
                 simulation::triangulation(scene).map_err(|e| CliError::Input(e.to_string()))?;
             out.write_mesh(&triangulation, None).map_err(output_error)?;
+            let v = triangulation.vertices();
+            edges = triangulation
+                .edges()
+                .iter()
+                .map(|e| [v[e.vertices[0]], v[e.vertices[1]]])
+                .collect();
         }
         let path = out.file(DIAGNOSTICS_FILE);
         let mut w =
@@ -184,6 +222,9 @@ impl Recorder {
             last_frame: None,
             last_step: 0,
             mesh,
+            edges,
+            picture: options.picture,
+            pictured: Vec::new(),
             error: None,
         })
     }
@@ -224,6 +265,10 @@ impl Recorder {
         if r.step > 0 {
             self.last_step = r.step;
             self.diagnostics_row(r)?;
+        }
+        if r.step == 0 || r.step == self.total / 2 {
+            self.pictured
+                .push(frame_of(particles, r.time, self.picture));
         }
         let every = self.every();
         let due = r.step == 0 || r.step == self.total || (every > 0 && r.step % every == 0);
@@ -331,7 +376,58 @@ impl Recorder {
         if self.plots(ENERGY_SVG, vec![self.energy_plot()])? {
             files.push(ENERGY_SVG.to_string());
         }
+        if self.last_step > 0 {
+            self.pictured
+                .push(frame_of(last, summary.t_end, self.picture));
+        }
+        if self.particle_picture(summary)? {
+            files.push(PARTICLES_SVG.to_string());
+        }
         Ok(files)
+    }
+
+    /// `particles.svg` from the frames kept (see the module documentation).
+    fn particle_picture(&self, summary: &Summary) -> Result<bool, CliError> {
+        let path = self.dir.file(PARTICLES_SVG);
+        let title = format!(
+            "{}: {} ({}, {} mass)",
+            self.scene,
+            self.picture.label(),
+            summary.basis,
+            summary.mass
+        );
+        if self.dim == 1 {
+            let mut plot = LinePlot::new(title, "x", self.picture.label());
+            for f in &self.pictured {
+                let mut points: Vec<(f64, f64)> = f
+                    .positions
+                    .iter()
+                    .zip(&f.values)
+                    .map(|(x, &v)| (x.x, v))
+                    .collect();
+                points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                plot = plot.with_series(Series::line(
+                    format!("t = {}", crate::table::short(f.time)),
+                    thin(points, MAX_PLOT_POINTS),
+                ));
+            }
+            return self.plots(PARTICLES_SVG, vec![plot]);
+        }
+        let picture = ParticlePicture {
+            title,
+            field: self.picture.label().to_string(),
+            frames: self.pictured.clone(),
+            edges: self.edges.clone(),
+        };
+        match particle_plot(&path, &picture) {
+            Ok(()) => Ok(true),
+            // A failed run may leave nothing finite to draw: say so, keep the rest.
+            Err(PlotError::Empty(why)) => {
+                eprintln!("warning: no {PARTICLES_SVG}: {why}");
+                Ok(false)
+            }
+            Err(e) => Err(CliError::Input(format!("{}: {e}", path.display()))),
+        }
     }
 
     fn write_tracked_csv(&self, tracked: &[Tracked]) -> Result<(), CliError> {

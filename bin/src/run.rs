@@ -8,6 +8,7 @@ use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::driver::StepReport;
 use psmpm::mass::MassKind;
+use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
 use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS};
@@ -183,6 +184,16 @@ pub struct RunArgs {
     /// or ascii (text).
     #[arg(long, value_enum, value_name = "ENCODING", default_value_t = Vtu::Binary, requires = "out")]
     vtu: Vtu,
+    /// With --out: the field particles.svg colours the particles by (first, middle
+    /// and last frame): displacement (|u|), speed (|v|), sigma-xx, sigma-yy,
+    /// sigma-xy, pressure (−tr σ / d) or von-mises.
+    #[arg(
+        long,
+        value_name = "FIELD",
+        default_value = "displacement",
+        requires = "out"
+    )]
+    picture: String,
     /// Threads of the particle phases (default: all cores). The results are the
     /// same, bit for bit, for any number.
     #[arg(long, value_name = "N")]
@@ -420,6 +431,8 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
                     Vtu::Binary => VtuEncoding::Binary,
                     Vtu::Ascii => VtuEncoding::Ascii,
                 },
+                picture: ParticleField::parse(&args.picture, s.dim)
+                    .map_err(|e| CliError::Input(format!("--picture: {e}")))?,
             };
             Some(Recorder::create(dir, options, &s)?)
         }
@@ -445,8 +458,15 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             let line = time_step_line(r);
             match format {
                 Format::Table => stdout.line(&line),
-                Format::Json | Format::Csv => {
+                Format::Json => {
                     let _ = writeln!(std::io::stderr(), "# {line}");
+                }
+                // stderr of csv holds `# key=value` lines only (the summary's dt and
+                // dt_critical come at the end).
+                Format::Csv => {
+                    if let Some(c) = r.dt_critical.filter(|c| c.is_finite() && *c > 0.0) {
+                        let _ = writeln!(std::io::stderr(), "# courant={}", r.dt / c);
+                    }
                 }
             }
             return;

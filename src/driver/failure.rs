@@ -16,6 +16,66 @@ where
     M: MassStrategy<T>,
     Mat: Material<T, D>,
 {
+    /// The worst-covered function with particles in its support, when it is covered
+    /// below [`UNDER_SUPPORTED_COVERAGE`] and the mass strategy treated no function at
+    /// the last assembly: `(function, coverage, a message naming both and the fix)`.
+    /// Measured here if the strategy does not measure coverage itself (call after an
+    /// assembly, e.g. after [`Driver::critical_time_step`]).
+    pub fn untreated_under_supported(&self) -> Option<(usize, f64, String)> {
+        if self.last_report.treated() > 0 {
+            return None;
+        }
+        let computed;
+        let (support, particle_volume) = match &self.inputs.support {
+            Some(s) if self.inputs.needs.coverage => (s, &self.inputs.particle_volume),
+            _ => {
+                let mut volume = vec![0.0; self.basis.num_functions()];
+                phases::particle_volume(&self.evals, &self.particles.volume, &mut volume);
+                computed = (SupportFacts::new(&self.basis, &self.pattern, false), volume);
+                (&computed.0, &computed.1)
+            }
+        };
+        let (i, c) = (0..particle_volume.len())
+            .filter(|&i| particle_volume[i] > 0.0)
+            .map(|i| {
+                (
+                    i,
+                    SupportFacts::coverage_of(particle_volume[i], support.volume[i]),
+                )
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        (c < UNDER_SUPPORTED_COVERAGE).then(|| {
+            (
+                i,
+                c,
+                format!(
+                    "function {i} at {} is covered to only {c:.1e} of its support by particles and the mass strategy `{}` solves for it, which makes the mass matrix nearly singular",
+                    point(&to_f64_point(&self.basis.function_point(i))),
+                    self.mass.spec()
+                ),
+            )
+        })
+    }
+
+    /// Why the mass matrix of the last assembly is (nearly) singular, when the driver
+    /// can see it: fewer particles than the functions solved for consistently (a
+    /// matrix summed from `n` particle outer products has rank at most `n`), or a
+    /// function with almost no particle support that the strategy solves for.
+    pub fn singular_mass_cause(&self) -> Option<String> {
+        let report = &self.last_report;
+        let consistent = report.active.saturating_sub(report.treated());
+        let particles = self.particles.len();
+        if particles < consistent {
+            return Some(format!(
+                "{particles} particles for {consistent} functions solved with the `{}` mass: a mass matrix summed from fewer particles than functions is singular; use more particles per element (`per_block` or `count`; `--particles`)",
+                self.mass.spec()
+            ));
+        }
+        self.untreated_under_supported().map(|(_, _, why)| {
+            format!("{why}; use the default mass strategy (remove `mass`, or `--mass default`), which expresses such functions through their neighbours")
+        })
+    }
+
     /// What the driver can see around a failing particle, and the fix that fits.
     pub(super) fn diagnose_particle(&self, particle: usize) -> String {
         if let Some(critical) = self.dt_critical {

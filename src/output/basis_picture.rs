@@ -9,9 +9,8 @@ use std::path::Path;
 use plotters::prelude::*;
 use psmpm_basis::{Basis, BasisEval, Point, Vec2};
 
-use super::axis::{format_number, AxisCoord};
-use super::chart::{check_size, draw_err, write_svg, PlotError, LABEL_FONT, TITLE_FONT};
-use super::mesh_picture::{equal_scale_chart, padded_bbox, pt, Picture};
+use super::chart::{check_size, draw_err, write_svg, PlotError, TITLE_FONT};
+use super::mesh_picture::{colour_bar, equal_scale_chart, padded_bbox, pt, Picture};
 
 /// Colour `(r, g, b)` of the element edges in a basis function plot (near-black, to
 /// tell them from the axes).
@@ -329,33 +328,7 @@ fn render_basis_function_plot(
                 .map_err(draw_err)?;
         }
 
-        // Colour bar, aligned with the plotting area.
-        let mut bar = ChartBuilder::on(&side)
-            .margin(Picture::MARGIN)
-            .margin_left(16)
-            .x_label_area_size(Picture::X_LABELS)
-            .set_label_area_size(LabelAreaPosition::Right, 70)
-            .build_cartesian_2d(AxisCoord::linear(0.0, 1.0), AxisCoord::linear(lo, hi))
-            .map_err(draw_err)?;
-        let steps = 128;
-        bar.draw_series((0..steps).map(|k| {
-            let (v0, v1) = (
-                lo + (hi - lo) * k as f64 / steps as f64,
-                lo + (hi - lo) * (k + 1) as f64 / steps as f64,
-            );
-            Rectangle::new([(0.0, v0), (1.0, v1)], colour_of(0.5 * (v0 + v1)).filled())
-        }))
-        .map_err(draw_err)?;
-        let label = |v: &f64| format_number(*v);
-        bar.configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .x_labels(0)
-            .y_labels(8)
-            .y_label_formatter(&label)
-            .label_style(("sans-serif", LABEL_FONT))
-            .draw()
-            .map_err(draw_err)?;
+        colour_bar(&side, lo, hi, &colour_of)?;
         root.present().map_err(draw_err)?;
     }
     Ok(svg)

@@ -118,6 +118,43 @@ pub(crate) fn equal_scale_chart<'a>(
     Ok((chart, scale))
 }
 
+/// A vertical colour bar for values in `[lo, hi]` on the side strip `side`, aligned
+/// with the plotting area of an [`equal_scale_chart`] beside it.
+pub(crate) fn colour_bar(
+    side: &Area,
+    lo: f64,
+    hi: f64,
+    colour_of: &dyn Fn(f64) -> RGBColor,
+) -> Result<(), PlotError> {
+    let mut bar = ChartBuilder::on(side)
+        .margin(Picture::MARGIN)
+        .margin_left(16)
+        .x_label_area_size(Picture::X_LABELS)
+        .set_label_area_size(LabelAreaPosition::Right, 70)
+        .build_cartesian_2d(AxisCoord::linear(0.0, 1.0), AxisCoord::linear(lo, hi))
+        .map_err(draw_err)?;
+    let steps = 128;
+    bar.draw_series((0..steps).map(|k| {
+        let (v0, v1) = (
+            lo + (hi - lo) * k as f64 / steps as f64,
+            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
+        );
+        Rectangle::new([(0.0, v0), (1.0, v1)], colour_of(0.5 * (v0 + v1)).filled())
+    }))
+    .map_err(draw_err)?;
+    let label = |v: &f64| format_number(*v);
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .x_labels(0)
+        .y_labels(8)
+        .y_label_formatter(&label)
+        .label_style(("sans-serif", LABEL_FONT))
+        .draw()
+        .map_err(draw_err)?;
+    Ok(())
+}
+
 /// A point as plotters' coordinate pair.
 pub(crate) fn pt(p: Vec2) -> (f64, f64) {
     (p.x, p.y)

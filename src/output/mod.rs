@@ -32,6 +32,7 @@ pub mod chart;
 pub mod csv;
 pub mod dir;
 pub mod mesh_picture;
+pub mod particle_picture;
 pub mod vtk;
 
 use std::io::{self, Write};

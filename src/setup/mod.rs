@@ -109,7 +109,8 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         scene.time.allow_above_critical,
     ) {
         if dt > critical {
-            return Err(above_critical(scene, dt, critical).into());
+            let cause = driver.singular_mass_cause();
+            return Err(above_critical(scene, dt, critical, cause).into());
         }
     }
     Ok(Prepared {
@@ -261,7 +262,24 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
 /// approaches `λ_max(M⁻¹K)` from below, so its `Δt_crit` errs on the large side
 /// (within 0.01 % of a dense eigenvalue computation after 40 iterations, test in
 /// `driver::critical`): a step above it is unstable at the start.
-fn above_critical(scene: &Scene, dt: f64, critical: f64) -> SceneError {
+///
+/// When the driver sees why the mass matrix is nearly singular (`singular`: too few
+/// particles, or a function with almost no particle support that the strategy
+/// solves for), that is what makes the critical step small, and the fix that fits is
+/// that cause's, not a smaller step.
+fn above_critical(scene: &Scene, dt: f64, critical: f64, singular: Option<String>) -> SceneError {
+    if let Some(why) = singular {
+        return SceneError::new(
+            "time.dt",
+            ErrorKind::Conflict,
+            format!(
+                "the time step {dt} is above the critical step {critical:.3e} estimated at the start for this mesh, basis (`{}`) and mass strategy (`{}`) (Courant number {:.3e}) because the mass matrix is nearly singular: {why}",
+                scene.basis.name(),
+                scene.mass.spec(),
+                dt / critical
+            ),
+        );
+    }
     SceneError::new(
         "time.dt",
         ErrorKind::Conflict,

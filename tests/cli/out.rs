@@ -98,8 +98,13 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    // stdout stays JSON; the line naming the directory goes to stderr.
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    // stdout stays JSON; the time step (a `#` line) and the line naming the
+    // directory go to stderr.
+    assert_eq!(stderr.lines().count(), 2, "{stderr}");
+    assert!(
+        stderr.starts_with("# time step 1.00e-3 · critical step "),
+        "{stderr}"
+    );
     assert!(
         stderr.contains(&format!("output written to {}", out_dir.display())),
         "{stderr}"
@@ -624,4 +629,76 @@ fn csv_format_keeps_the_summary_on_stderr() {
         .find_map(|l| l.strip_prefix("# error="))
         .unwrap();
     assert!(error.parse::<f64>().unwrap() > 0.0, "{error}");
+}
+
+/// `particles.svg`: the particles at the first, middle and last frame, coloured by
+/// the field `--picture` names, on one colour scale over the mesh; an unknown field
+/// or one that 1D does not have is an input error.
+#[test]
+fn particles_svg_shows_the_first_middle_and_last_frame() {
+    let dir = TempDir::new("picture");
+    let root = format!("{}/..", env!("CARGO_MANIFEST_DIR"));
+    let scene = format!("{root}/docs/examples/settle.toml");
+    let out_dir = dir.join("out");
+    let out = cli()
+        .args([
+            "run",
+            &scene,
+            "--out",
+            key(&out_dir),
+            "--picture",
+            "sigma-yy",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("particles.svg"));
+    let svg = std::fs::read_to_string(out_dir.join("particles.svg")).unwrap();
+    // 2 × 2 blocks of 4 × 4 particles, three panels; 21 steps to t = 0.1 (Courant
+    // 0.4), the middle panel at step 10.
+    assert_eq!(svg.matches("<circle").count(), 3 * 32);
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let steps = summary["steps"].as_u64().unwrap();
+    let dt = summary["dt"].as_f64().unwrap();
+    let middle = (steps / 2) as f64 * dt;
+    for title in [
+        "t = 0\n".to_string(),
+        format!("t = {}\n", format!("{middle:.5e}").parse::<f64>().unwrap()),
+        "t = 0.1\n".to_string(),
+        "settle: σ_yy (pl, extended mass)".to_string(),
+        "32 particles".to_string(),
+    ] {
+        assert!(svg.contains(&title), "{title:?}");
+    }
+    // The 28 edges of 2 × 2 four-triangle blocks (13 vertices, 16 triangles: Euler's
+    // 13 + 16 − 1) under the particles of each panel.
+    assert_eq!(svg.matches("stroke=\"#B0B0B0\"").count(), 3 * 28);
+
+    let err = input_error(&[
+        "run",
+        &scene,
+        "--out",
+        key(&dir.join("x")),
+        "--picture",
+        "heat",
+    ]);
+    assert!(
+        err.contains("--picture: unknown particle field `heat`"),
+        "{err}"
+    );
+    let err = input_error(&[
+        "run",
+        "vibrating-bar-1d",
+        "--out",
+        key(&dir.join("y")),
+        "--picture",
+        "sigma-yy",
+    ]);
+    assert!(err.contains("does not exist in 1D"), "{err}");
 }
