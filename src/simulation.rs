@@ -135,6 +135,8 @@ pub struct Tracked {
     pub displacement: Vec<[f64; 2]>,
     /// The reference displacement at the same times (when the scene has one).
     pub exact_displacement: Vec<[f64; 2]>,
+    /// The reference velocity at the same times (when the scene has one).
+    pub exact_velocity: Vec<[f64; 2]>,
 }
 
 /// A run's particles and histories at the end, for tests and output.
@@ -341,6 +343,7 @@ fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>
                 } else {
                     0
                 }),
+                exact_velocity: Vec::with_capacity(if run.solution.is_some() { steps } else { 0 }),
             }
         })
         .collect()
@@ -399,6 +402,7 @@ where
             if let Some(s) = solution {
                 t.exact_displacement
                     .push(s.displacement(t.x0, origin, D, r.time));
+                t.exact_velocity.push(s.velocity(t.x0, origin, D, r.time));
             }
         }
         if let Some(Solution::AxisAligned(a)) = solution {

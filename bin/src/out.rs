@@ -24,10 +24,10 @@
 //! - `mesh.vtu`: the triangulation of a 2D scene (1D scenes have no mesh file).
 //! - `tracked.csv` and `tracked.svg` when the scene tracks particles
 //!   (`output.tracked`): `time, particle, u_x, u_y, v_x, v_y` and, with a reference
-//!   solution, `u_exact_x, u_exact_y`, one row per step and tracked particle; the
-//!   plot shows the displacement against time (computed as markers, or as a line
-//!   without a reference; the reference as a line) and below it the velocity
-//!   (computed, in the same style).
+//!   solution, `u_exact_x, u_exact_y, v_exact_x, v_exact_y`, one row per step and
+//!   tracked particle; the plot shows the displacement against time (computed as
+//!   markers, or as a line without a reference; the reference as a line) and below
+//!   it the velocity in the same style, on the same time axis.
 //! - `energy.svg`: kinetic, strain, potential and total energy against time.
 //! - `particles.svg`: the particles at the first frame, the step nearest half the
 //!   run and the last step, coloured by `--picture FIELD` (default `displacement`,
@@ -432,7 +432,9 @@ impl Recorder {
 
     fn write_tracked_csv(&self, tracked: &[Tracked]) -> Result<(), CliError> {
         let exact = tracked.iter().all(|t| {
-            !t.exact_displacement.is_empty() && t.exact_displacement.len() == t.time.len()
+            !t.exact_displacement.is_empty()
+                && t.exact_displacement.len() == t.time.len()
+                && t.exact_velocity.len() == t.time.len()
         });
         let path = self.dir.file(TRACKED_CSV);
         let steps = tracked.iter().map(|t| t.time.len()).min().unwrap_or(0);
@@ -440,7 +442,7 @@ impl Recorder {
             let mut csv = csv::Writer::from_writer(w);
             let mut header = vec!["time", "particle", "u_x", "u_y", "v_x", "v_y"];
             if exact {
-                header.extend(["u_exact_x", "u_exact_y"]);
+                header.extend(["u_exact_x", "u_exact_y", "v_exact_x", "v_exact_y"]);
             }
             csv.write_record(&header)?;
             let float = |x: f64| format!("{x:e}");
@@ -456,8 +458,8 @@ impl Recorder {
                         float(v[1]),
                     ];
                     if exact {
-                        let e = t.exact_displacement[i];
-                        record.extend([float(e[0]), float(e[1])]);
+                        let (e, w) = (t.exact_displacement[i], t.exact_velocity[i]);
+                        record.extend([float(e[0]), float(e[1]), float(w[0]), float(w[1])]);
                     }
                     csv.write_record(&record)?;
                 }
@@ -526,8 +528,8 @@ impl Recorder {
     }
 
     /// The velocity of the tracked particles against time, the components that
-    /// move, as markers when the scene has a reference (as the displacement), else
-    /// as lines.
+    /// move: with a reference, the computed velocity as markers and the reference's
+    /// as a line (as the displacement), else the computed one as a line.
     fn tracked_velocity_plot(&self, tracked: &[Tracked]) -> LinePlot {
         let mut plot = LinePlot::new(
             format!("{}: tracked particles, velocity", self.scene),
@@ -536,11 +538,11 @@ impl Recorder {
         );
         let axis = ["x", "y"];
         for t in tracked {
-            let has_exact =
-                !t.exact_displacement.is_empty() && t.exact_displacement.len() == t.time.len();
+            let has_exact = !t.exact_velocity.is_empty() && t.exact_velocity.len() == t.time.len();
             let amplitude = |c: usize| {
                 t.velocity
                     .iter()
+                    .chain(&t.exact_velocity)
                     .map(|v| v[c].abs())
                     .filter(|a| a.is_finite())
                     .fold(0.0, f64::max)
@@ -554,18 +556,33 @@ impl Recorder {
                 components.push(self.dim - 1);
             }
             for c in components {
-                let name = format!("particle {} v_{} (MPM)", t.particle, axis[c]);
+                let name = format!("particle {} v_{}", t.particle, axis[c]);
                 let points: Vec<(f64, f64)> = t
                     .time
                     .iter()
                     .zip(&t.velocity)
                     .map(|(&s, v)| (s, v[c]))
                     .collect();
-                plot = plot.with_series(if has_exact {
-                    Series::markers(name, thin(points, MAX_MARKERS))
+                if has_exact {
+                    plot = plot.with_series(Series::markers(
+                        format!("{name} (MPM)"),
+                        thin(points, MAX_MARKERS),
+                    ));
+                    let exact = t
+                        .time
+                        .iter()
+                        .zip(&t.exact_velocity)
+                        .map(|(&s, v)| (s, v[c]));
+                    plot = plot.with_series(Series::line(
+                        format!("{name} (exact)"),
+                        thin(exact.collect(), MAX_PLOT_POINTS),
+                    ));
                 } else {
-                    Series::line(name, thin(points, MAX_PLOT_POINTS))
-                });
+                    plot = plot.with_series(Series::line(
+                        format!("{name} (MPM)"),
+                        thin(points, MAX_PLOT_POINTS),
+                    ));
+                }
             }
         }
         plot

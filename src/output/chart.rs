@@ -506,10 +506,16 @@ fn render_stacked(plots: &[LinePlot]) -> Result<String, PlotError> {
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err)?;
+        // One legend width for every panel, so that their time axes line up.
+        let legend_width = plots
+            .iter()
+            .map(|p| legend_width(p, width))
+            .max()
+            .unwrap_or(0);
         let mut rest = root.clone();
         for plot in plots {
             let (panel, below) = rest.split_vertically(plot.size.1);
-            draw_line_plot(&panel, plot)?;
+            draw_line_plot(&panel, plot, legend_width)?;
             rest = below;
         }
         root.present().map_err(draw_err)?;
@@ -517,19 +523,23 @@ fn render_stacked(plots: &[LinePlot]) -> Result<String, PlotError> {
     Ok(svg)
 }
 
-/// Draws `plot` (checked) into `root`, which is `plot.size.1` pixels high.
-fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), PlotError> {
-    let width = root.dim_in_pixel().0;
-    let x = axis_range(plot, 0)?;
-    let y = axis_range(plot, 1)?;
-    let legend_width = plot
-        .series
+/// Width of the legend strip of `plot` in a picture `width` pixels wide.
+fn legend_width(plot: &LinePlot, width: u32) -> u32 {
+    plot.series
         .iter()
         .map(|s| legend_text_width(&s.name) + 70)
         .max()
         .unwrap_or(0)
         .max(120)
-        .min(width / 2);
+        .min(width / 2)
+}
+
+/// Draws `plot` (checked) into `root`, which is `plot.size.1` pixels high, with a
+/// legend strip `legend_width` pixels wide on the right.
+fn draw_line_plot(root: &Area, plot: &LinePlot, legend_width: u32) -> Result<(), PlotError> {
+    let width = root.dim_in_pixel().0;
+    let x = axis_range(plot, 0)?;
+    let y = axis_range(plot, 1)?;
     {
         let (main, legend) = root.split_horizontally(width - legend_width);
         let mut chart = ChartBuilder::on(&main)
@@ -573,8 +583,9 @@ fn draw_line_plot(root: &Area, plot: &LinePlot) -> Result<(), PlotError> {
                     .map_err(draw_err)?;
             }
         }
-        // The legend, right of the axes, from the top of the plotting area.
-        let top = chart.plotting_area().get_base_pixel().1;
+        // The legend, right of the axes, from the top of the plotting area (in the
+        // legend strip's own coordinates: a lower panel's strip starts lower).
+        let top = chart.plotting_area().get_base_pixel().1 - legend.get_base_pixel().1;
         for (k, s) in plot.series.iter().enumerate() {
             let c = colour(k);
             let y = top + 12 + LEGEND_ROW * k as i32;
@@ -612,4 +623,48 @@ pub fn line_plot(path: &Path, plot: &LinePlot) -> Result<(), PlotError> {
 pub fn stacked_line_plots(path: &Path, plots: &[LinePlot]) -> Result<(), PlotError> {
     let svg = render_stacked(plots)?;
     write_svg(path, &svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The legend of a lower panel sits beside that panel's axes (it was drawn at
+    /// twice the panel's offset, off the bottom of the picture), and the panels share
+    /// one legend width so that their x axes line up.
+    #[test]
+    fn stacked_panels_keep_their_legends_and_line_up() {
+        let top = LinePlot::new("top", "t", "u")
+            .with_series(Series::line("a short name", [(0.0, 0.0), (1.0, 1.0)]));
+        let bottom = LinePlot::new("bottom", "t", "v").with_series(Series::line(
+            "a much longer legend name for the lower panel",
+            [(0.0, 1.0), (1.0, 0.0)],
+        ));
+        let svg = render_stacked(&[top.clone(), bottom]).unwrap();
+        let y_of = |text: &str| -> i32 {
+            let at = svg.find(text).unwrap();
+            let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+            let y = tag.split("y=\"").nth(1).unwrap();
+            y[..y.find('"').unwrap()].parse().unwrap()
+        };
+        let panel = top.size.1 as i32;
+        let legend = y_of("a much longer legend name");
+        assert!(
+            legend > panel && legend < panel + panel / 2,
+            "{legend} in panel 2 of {panel}"
+        );
+        assert!(y_of("a short name") < panel / 2);
+        // Both x axes end at the same pixel: the last x tick label of each panel.
+        // (x tick labels are centred under their tick, y tick labels end at theirs)
+        let x_of_last_tick = |from: usize| -> &str {
+            let tag = svg[from..]
+                .split("<text")
+                .find(|t| t.contains("text-anchor=\"middle\"") && t.contains(">\n1\n</text>"))
+                .unwrap();
+            let x = tag.split("x=\"").nth(1).unwrap();
+            &x[..x.find('"').unwrap()]
+        };
+        let second = svg.find("bottom").unwrap();
+        assert_eq!(x_of_last_tick(0), x_of_last_tick(second));
+    }
 }

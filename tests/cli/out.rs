@@ -38,9 +38,10 @@ fn series_stroke(k: usize) -> String {
     format!("#{r:02X}{g:02X}{b:02X}")
 }
 
-/// Checks an SVG line plot: the legend names in order, one `<polyline>` in the
-/// colour of each line series (`lines[k]`), and `markers` circles at least.
-fn check_plot(svg: &Value, names: &[&str], lines: &[bool], markers: usize) {
+/// Checks an SVG line plot: the legend names in order, `lines[k]` `<polyline>`s in
+/// the colour of series `k` (one per panel it is drawn as a line in), and `markers`
+/// circles at least.
+fn check_plot(svg: &Value, names: &[&str], lines: &[usize], markers: usize) {
     let texts: Vec<&str> = svg["texts"]
         .as_array()
         .unwrap()
@@ -56,7 +57,7 @@ fn check_plot(svg: &Value, names: &[&str], lines: &[bool], markers: usize) {
     for (k, (name, &line)) in names.iter().zip(lines).enumerate() {
         assert!(texts.contains(name), "legend `{name}` missing in {texts:?}");
         let count = strokes.iter().filter(|&&s| s == series_stroke(k)).count();
-        assert_eq!(count, usize::from(line), "polylines of series {k} `{name}`");
+        assert_eq!(count, line, "polylines of series {k} `{name}`");
     }
     assert!(svg["circles"].as_u64().unwrap() as usize >= markers);
 }
@@ -211,7 +212,9 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             "v_x",
             "v_y",
             "u_exact_x",
-            "u_exact_y"
+            "u_exact_y",
+            "v_exact_x",
+            "v_exact_y"
         ]
     );
     assert_eq!(tracked.len(), 2 * steps);
@@ -225,8 +228,9 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
     }
     let last = &tracked[2 * steps - 2];
     assert_eq!(value(last, 0), 0.5);
-    // The reference is close to the computed displacement (E_u ~ 1e-5).
+    // The reference is close to the computed displacement (E_u ~ 1e-5) and velocity.
     assert!((value(last, 2) - value(last, 6)).abs() < 1e-3 * value(last, 6).abs().max(1e-3));
+    assert!((value(last, 4) - value(last, 8)).abs() < 1e-2 * value(last, 8).abs().max(1e-3));
 
     // The .vtu files and the collection, read back.
     let files: Vec<PathBuf> = vec![
@@ -299,7 +303,7 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
     check_plot(
         &json["svg"][key(&files[4])],
         &["kinetic", "strain", "potential", "total"],
-        &[true; 4],
+        &[1; 4],
         0,
     );
     let names: Vec<String> = [p0, p1]
@@ -312,21 +316,20 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
         })
         .collect();
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    check_plot(
-        &json["svg"][key(&files[5])],
-        &names,
-        &[false, true, false, true],
-        100,
-    );
+    // The exact curves are lines in both panels (displacement and velocity).
+    check_plot(&json["svg"][key(&files[5])], &names, &[0, 2, 0, 2], 100);
     let texts = json["svg"][key(&files[5])]["texts"].to_string();
     assert!(texts.contains("time (s)") && texts.contains("displacement (m)"));
-    // The second panel: the velocity, computed, as markers (the scene has a reference).
+    // The second panel: the velocity, computed as markers and the reference's as a
+    // line (the scene has a reference).
     assert!(texts.contains("velocity (m/s)"), "{texts}");
     for p in [p0, p1] {
-        assert!(
-            texts.contains(&format!("particle {p} v_x (MPM)")),
-            "{texts}"
-        );
+        for name in [
+            format!("particle {p} v_x (MPM)"),
+            format!("particle {p} v_x (exact)"),
+        ] {
+            assert!(texts.contains(&name), "{texts}");
+        }
     }
 }
 
@@ -394,7 +397,7 @@ fn a_1d_run_writes_about_50_frames_and_no_mesh() {
     check_plot(
         &json["svg"][key(&energy)],
         &["kinetic", "strain", "potential", "total"],
-        &[true; 4],
+        &[1; 4],
         0,
     );
 }
