@@ -70,6 +70,7 @@ pub mod particles;
 pub mod scene;
 pub mod setup;
 pub mod simulation;
+pub mod snapshot;
 pub mod sparse;
 pub mod studies;
 pub mod threads;
