@@ -7,6 +7,7 @@ mod basis_cmd;
 mod compare;
 mod converge;
 mod error;
+mod memory;
 mod out;
 mod progress;
 mod project;
@@ -15,9 +16,14 @@ mod run;
 mod scenes;
 mod stability;
 mod table;
+mod throughput;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::process::ExitCode;
+
+/// The system allocator, counting heap bytes for `throughput`.
+#[global_allocator]
+static ALLOCATOR: memory::Counting = memory::Counting;
 
 /// Material Point Method with Powell–Sabin spline bases on triangular grids.
 #[derive(Debug, Parser)]
@@ -99,6 +105,13 @@ enum Command {
     /// on any number of threads. See docs/stability.md.
     #[command(after_help = error::EXIT_STATUS)]
     Stability(stability::StabilityArgs),
+    /// Particle-steps per second and heap bytes per particle, per variant and size.
+    ///
+    /// The B5a column refined to about N particles (8 × 8 per block, 16 per
+    /// triangle), a few steps of each variant; prints the table and the exponent of
+    /// the cost per step against the particle count. For measuring one's own
+    /// machine; see docs/performance.md.
+    Throughput(throughput::ThroughputArgs),
 }
 
 fn main() -> ExitCode {
@@ -123,6 +136,7 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => reproduce::run(args),
         Command::Basis(command) => basis_cmd::basis(command),
         Command::Stability(args) => stability::stability(args),
+        Command::Throughput(args) => throughput::throughput(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -563,3 +563,44 @@ fn reproduce_writes_figures_only_into_out_with_numbers_in_json_and_quoted_csv() 
     assert!(records.iter().all(|r| r.len() == columns.len()));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `throughput` measures every variant at every size (the numbers are machine
+/// dependent: only their presence and sense are checked, no timing is asserted).
+#[test]
+fn throughput_prints_rates_memory_and_the_scaling_exponent() {
+    let json = stdout(&[
+        "throughput",
+        "--sizes",
+        "1000,4000",
+        "--variants",
+        "pl:lumped,ps:default",
+        "--steps",
+        "2",
+        "--threads",
+        "1",
+        "--format",
+        "json",
+    ]);
+    let v: Value = serde_json::from_str(&json).unwrap();
+    let rows = v["measurements"].as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    for r in rows {
+        assert_eq!(r["steps"], 2);
+        assert!(r["particle_steps_per_second"].as_f64().unwrap() > 0.0);
+        // Particles, their basis evaluations and the matrices take heap memory.
+        let per = r["bytes_per_particle"].as_f64().unwrap();
+        assert!(per > 100.0 && per < 1e5, "{r}");
+    }
+    // 1000 and 4000 particles round to 1 × 8 and 3 × 24 blocks of 64.
+    assert_eq!(rows[0]["particles"], 512);
+    assert_eq!(rows[1]["particles"], 4608);
+    for s in v["scaling"].as_array().unwrap() {
+        assert!(s["exponent"].as_f64().is_some(), "{s}");
+    }
+    let out = cli()
+        .args(["throughput", "--variants", "bspline:lumped"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("the throughput scene is 2D"));
+}
