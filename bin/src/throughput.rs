@@ -129,7 +129,7 @@ pub fn throughput(args: ThroughputArgs) -> Result<(), CliError> {
         )));
     }
     for &n in &args.sizes {
-        if !(n >= 100.0 && n <= MAX_PARTICLES) {
+        if !(100.0..=MAX_PARTICLES).contains(&n) {
             return Err(CliError::Input(format!(
                 "--sizes: {n} particles is outside 100..={MAX_PARTICLES:e}"
             )));
