@@ -83,7 +83,9 @@ enum Command {
     /// The full studies take about 2 minutes on one core; --quick runs the coarse
     /// versions the test suite pins. The UL-FEM references of b3 and b5b are cached
     /// in $PSMPM_CACHE_DIR, else $XDG_CACHE_HOME/psmpm, else $HOME/.cache/psmpm (none
-    /// if no variable is set).
+    /// if no variable is set). A run that fails or is unstable is part of a study
+    /// (its table marks it); --strict makes it exit status 1.
+    #[command(after_help = error::EXIT_STATUS)]
     Reproduce(reproduce::ReproduceArgs),
     /// Pictures of the bases: a mesh with its PS refinement and control triangles,
     /// or one basis function.

@@ -550,6 +550,7 @@ fn the_exit_status_rule_is_in_the_help() {
         vec!["--help"],
         vec!["run", "--help"],
         vec!["compare", "--help"],
+        vec!["reproduce", "--help"],
     ] {
         let out = cli().args(&args).output().unwrap();
         assert!(out.status.success());
@@ -595,6 +596,62 @@ fn a_study_with_failed_variants_exits_0_unless_strict() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn reproduce_exits_0_with_unstable_runs_unless_strict() {
+    // The quick b4 has 4 unstable runs of 16 (its tables mark them), b5c none.
+    let out = cli().args(["reproduce", "b4", "--quick"]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("- 4 of 16 runs failed or are unstable"),
+        "{stdout}"
+    );
+    let out = cli()
+        .args([
+            "reproduce",
+            "b5c,b4",
+            "--quick",
+            "--strict",
+            "--format",
+            "json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "error: --strict: 4 of 18 variants failed or are unstable (see the table)\n"
+    );
+    // Both studies were printed before the verdict, with their counts.
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let counts: Vec<(u64, u64)> = stdout
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            (
+                v["runs"].as_u64().unwrap(),
+                v["failed_runs"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(counts, [(2, 0), (16, 4)]);
+    let out = cli()
+        .args(["reproduce", "b5c", "--quick", "--strict"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 fn binary() -> std::process::Command {
