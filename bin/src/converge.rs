@@ -11,6 +11,7 @@ use crate::run::{read_scene, Overrides};
 use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::output::chart::{line_plot, Axis, LinePlot, Scale, Series, SeriesStyle};
+use psmpm::scene::Scene;
 use psmpm::simulation::{self, RunError};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -68,7 +69,9 @@ pub struct Level {
 }
 
 /// Runs the study.
-pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
+/// The scenes of the study, validated before any runs: per basis (and mass), its
+/// levels in order.
+fn levels(args: &ConvergeArgs) -> Result<(Scene, Vec<Vec<Scene>>), CliError> {
     if args.levels == 0 || args.levels > 7 {
         return Err(CliError::Input(format!(
             "--levels must be between 1 and 7, got {}",
@@ -84,17 +87,37 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     }
     let masses: Vec<String> = args.mass.iter().cloned().collect();
     let bases = variants(&base, &args.basis, &masses, &args.overrides)?;
+    let levels = bases
+        .iter()
+        .map(|scene| {
+            (0..args.levels)
+                .map(|level| {
+                    scene
+                        .refined(level)
+                        .map_err(|e| CliError::Input(format!("level {level}: {e}")))
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((base, levels))
+}
+
+/// Every scene the study would run, validated ([`crate::check`]).
+pub fn prepare(args: &ConvergeArgs) -> Result<Vec<Scene>, CliError> {
+    Ok(levels(args)?.1.into_iter().flatten().collect())
+}
+
+/// Runs the study and prints it.
+pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
+    let (base, levels) = levels(&args)?;
     let mut rows: Vec<Level> = Vec::new();
     let progress =
-        crate::progress::Progress::new((bases.len() * args.levels as usize) as u64, "runs");
-    for scene in &bases {
+        crate::progress::Progress::new(levels.iter().map(Vec::len).sum::<usize>() as u64, "runs");
+    for scenes in &levels {
         let mut previous: Option<(f64, f64)> = None;
-        for level in 0..args.levels {
-            let s = scene
-                .refined(level)
-                .map_err(|e| CliError::Input(format!("level {level}: {e}")))?;
+        for (level, s) in (0..).zip(scenes) {
             let h = s.mesh_size().unwrap_or(f64::NAN);
-            let summary = simulation::run(&s, &mut |_| {})
+            let summary = simulation::run(s, &mut |_| {})
                 .map_err(|e: RunError| CliError::Input(e.to_string()))?;
             let order = match (previous, summary.error) {
                 (Some((h0, e0)), Some(e)) if e > 0.0 && e0 > 0.0 => {
