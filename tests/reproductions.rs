@@ -19,6 +19,35 @@ fn quick_reproductions_are_pinned() {
             .chain(report.findings.iter().map(|f| format!("- {f}\n")))
             .collect();
         insta::assert_snapshot!(format!("quick_{name}"), text);
+        // What `reproduce --strict` judges: the runs made and those failed or
+        // unstable (b4: the consistent mass on the finest mesh and three runs with
+        // few particles per element, b5b: the consistent mass on 1 × 8; their
+        // tables show `false` in `stable`).
+        let (total, failed) = match name {
+            "b2" => (8, 0),
+            "b3" => (2, 0),
+            "b4" => (16, 4),
+            "b5b" => (8, 1),
+            "b5c" => (2, 0),
+            other => panic!("unknown study {other}"),
+        };
+        assert_eq!(
+            (report.runs.total, report.runs.failed),
+            (total, failed),
+            "{name}"
+        );
+        let unstable_rows = report
+            .tables
+            .iter()
+            .filter_map(|t| {
+                t.columns
+                    .iter()
+                    .position(|c| *c == "stable")
+                    .map(|i| (t, i))
+            })
+            .flat_map(|(t, i)| t.rows.iter().filter(move |r| r[i].text == "false"))
+            .count();
+        assert_eq!(unstable_rows, failed, "{name}: rows marked unstable");
         for figure in &report.figures {
             assert!(!figure.plot.series.is_empty(), "{name}: {}", figure.file);
         }

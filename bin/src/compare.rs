@@ -133,16 +133,24 @@ const COLUMNS: [&str; 11] = [
     "seconds",
 ];
 
-/// Runs the comparison and prints it.
-pub fn compare(args: CompareArgs) -> Result<(), CliError> {
+/// The variants of the comparison, validated, and `--jobs` and `--threads` checked
+/// ([`crate::check`]).
+pub fn prepare(args: &CompareArgs) -> Result<Vec<Scene>, CliError> {
     let base = read_scene(&args.scene)?;
     let scenes = variants(&base, &args.basis, &args.mass, &args.overrides)?;
+    if args.jobs == Some(0) {
+        return Err(CliError::Input("--jobs must be at least 1".into()));
+    }
+    crate::run::check_threads(args.threads)?;
+    Ok(scenes)
+}
+
+/// Runs the comparison and prints it.
+pub fn compare(args: CompareArgs) -> Result<(), CliError> {
+    let scenes = prepare(&args)?;
     let jobs = args.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
-    if jobs == 0 {
-        return Err(CliError::Input("--jobs must be at least 1".into()));
-    }
     let pool = crate::run::thread_pool(args.threads)?;
     let results = run_all(&scenes, jobs, &pool);
     let mut summaries = Vec::new();

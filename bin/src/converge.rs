@@ -149,8 +149,9 @@ fn run_level(scene: &Scene) -> Result<(Summary, Option<Final>), CliError> {
     Ok((summary, finished.then_some(particles)))
 }
 
-/// Runs the study.
-pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
+/// The scenes of the study, validated before any runs: per basis (and mass), its
+/// levels in order; and what the errors are measured against.
+fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliError> {
     if args.levels == 0 || args.levels > 7 {
         return Err(CliError::Input(format!(
             "--levels must be between 1 and 7, got {}",
@@ -172,18 +173,38 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     };
     let masses: Vec<String> = args.mass.iter().cloned().collect();
     let bases = variants(&base, &args.basis, &masses, &args.overrides)?;
+    let levels = bases
+        .iter()
+        .map(|scene| {
+            (0..args.levels)
+                .map(|level| {
+                    scene
+                        .refined(level)
+                        .map_err(|e| CliError::Input(format!("level {level}: {e}")))
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((base, against, levels))
+}
+
+/// Every scene the study would run, validated ([`crate::check`]).
+pub fn prepare(args: &ConvergeArgs) -> Result<Vec<Scene>, CliError> {
+    Ok(levels(args)?.2.into_iter().flatten().collect())
+}
+
+/// Runs the study and prints it.
+pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
+    let (base, against, scenes) = levels(&args)?;
     let mut rows: Vec<Level> = Vec::new();
     let mut diagnoses: Vec<Diagnosis> = Vec::new();
     let mut notes: Vec<String> = Vec::new();
     let progress =
-        crate::progress::Progress::new((bases.len() * args.levels as usize) as u64, "runs");
-    for scene in &bases {
+        crate::progress::Progress::new(scenes.iter().map(Vec::len).sum::<usize>() as u64, "runs");
+    for variant in scenes {
         let mut levels = Vec::new();
         let mut finals = Vec::new();
-        for level in 0..args.levels {
-            let s = scene
-                .refined(level)
-                .map_err(|e| CliError::Input(format!("level {level}: {e}")))?;
+        for s in variant {
             let (summary, particles) = run_level(&s)?;
             progress.inc(1);
             levels.push((s, summary));

@@ -1,4 +1,4 @@
-//! Heap bytes in use and their peak, for `mpm-cli throughput`: the program's global
+//! Heap bytes in use and their peak, for `mpm-cli throughput`: the binary's global
 //! allocator is the system's, counting what it hands out (two relaxed atomic
 //! operations per allocation; the time step allocates nothing, so the steps do not
 //! pay for it).

@@ -49,6 +49,10 @@ pub struct ReproduceArgs {
     /// study with its tables) or csv (one block per table).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
+    /// Exit with status 1 when a run of a study failed or is unstable (default: 0,
+    /// the tables mark it).
+    #[arg(long)]
+    strict: bool,
 }
 
 /// Runs the studies and prints their tables.
@@ -77,10 +81,13 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
         Effort::Full
     };
     let cache = cache_dir();
+    let (mut runs, mut failed) = (0, 0);
     for name in &names {
         let clock = std::time::Instant::now();
         let report = reproduce(name, effort, cache.as_deref())
             .map_err(|e: RunError| CliError::Input(e.to_string()))?;
+        runs += report.runs.total;
+        failed += report.runs.failed;
         let mut files = Vec::new();
         for figure in args.out.iter().flat_map(|out| {
             report
@@ -113,6 +120,8 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
                         "tables": tables,
                         "findings": report.findings,
                         "figures": files,
+                        "runs": report.runs.total,
+                        "failed_runs": report.runs.failed,
                     })
                 );
                 continue;
@@ -151,7 +160,13 @@ pub fn run(args: ReproduceArgs) -> Result<(), CliError> {
         for file in &files {
             println!("- figure: `{file}`");
         }
+        if report.runs.failed > 0 {
+            println!(
+                "- {} of {} runs failed or are unstable",
+                report.runs.failed, report.runs.total
+            );
+        }
         println!("\n({name}: {:.0} s)\n", clock.elapsed().as_secs_f64());
     }
-    Ok(())
+    crate::error::study_verdict(args.strict, failed, runs)
 }

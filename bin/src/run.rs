@@ -11,7 +11,7 @@ use psmpm::mass::MassKind;
 use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
-use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS};
+use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
 use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
@@ -402,26 +402,48 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     pool.install(move || run_on_pool(args))
 }
 
+/// `--threads N`: at least 1 and at most [`MAX_THREADS`].
+pub fn check_threads(threads: Option<usize>) -> Result<(), CliError> {
+    match threads {
+        Some(0) => Err(CliError::Input("--threads must be at least 1".into())),
+        Some(n) if n > MAX_THREADS => Err(CliError::Input(format!(
+            "--threads {n} is above the limit of {MAX_THREADS}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// The pool of `--threads N` (`None`: one thread per core).
 pub fn thread_pool(threads: Option<usize>) -> Result<psmpm::threads::ThreadPool, CliError> {
-    if threads == Some(0) {
-        return Err(CliError::Input("--threads must be at least 1".into()));
-    }
+    check_threads(threads)?;
     psmpm::threads::pool(threads)
         .map_err(|e| CliError::Input(format!("--threads: no thread pool ({e})")))
 }
 
-/// [`run`] on the current thread pool.
-fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
-    let s = scene(&args)?;
-    let every = args
-        .diag_every
+/// The rows `run` prints: every this many steps (`--diag-every`, else the scene's
+/// `output.diagnostics_every`, else about 20 rows; 0: none).
+fn diag_every(s: &Scene, args: &RunArgs) -> usize {
+    args.diag_every
         .unwrap_or(if s.output.diagnostics_every > 0 {
             s.output.diagnostics_every
         } else {
             (s.steps() / 20).max(1)
-        });
-    check_sizes(&s, &args, every)?;
+        })
+}
+
+/// The scene of `run` with every option applied and validated, and the sizes the
+/// options control checked, before anything is created or run ([`crate::check`]).
+pub fn prepare(args: &RunArgs) -> Result<Scene, CliError> {
+    check_threads(args.threads)?;
+    let s = scene(args)?;
+    check_sizes(&s, args, diag_every(&s, args))?;
+    Ok(s)
+}
+
+/// [`run`] on the current thread pool.
+fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
+    let s = prepare(&args)?;
+    let every = diag_every(&s, &args);
     let mut recorder = match &args.out {
         Some(dir) => {
             let options = out::OutOptions {

@@ -28,6 +28,8 @@ pub const MAX_FRAMES: usize = 100_000;
 /// Most rows `run --format table` collects (it aligns them at the end); more need
 /// `--format csv` or `json`, which stream.
 pub const MAX_TABLE_ROWS: usize = 100_000;
+/// Most threads `--threads` may ask for.
+pub const MAX_THREADS: usize = 1024;
 /// Largest Gmsh mesh file read, in bytes.
 pub const MAX_MESH_FILE_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest scene file read, in bytes.

@@ -201,11 +201,7 @@ impl Scene {
                 }
             }
         }
-        let particles: f64 = self
-            .bodies
-            .iter()
-            .map(|b| self.estimated_particles(b))
-            .sum();
+        let particles = self.estimated_particle_count();
         if particles > MAX_PARTICLES as f64 {
             return Err(bad(
                 "body[0]",
@@ -443,6 +439,16 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// About how many particles the bodies get together (exact for aligned boxes),
+    /// computed from the scene without building anything (validation bounds it by
+    /// [`MAX_PARTICLES`]).
+    pub fn estimated_particle_count(&self) -> f64 {
+        self.bodies
+            .iter()
+            .map(|b| self.estimated_particles(b))
+            .sum()
     }
 
     /// About how many particles `body` gets (exact for aligned boxes).

@@ -924,8 +924,40 @@ fn mesh_cases() -> Vec<Case> {
             "gmsh-huge-node-count",
             "huge_count.msh",
             &format!(
-                "{}: expected 4 values in a node (tag x y z), found 1: `$EndNodes`",
-                at("bad/huge_count.msh", "$EndNodes")
+                "{}: the number of nodes is 9223372036854775807, above the limit of 10000000",
+                at("bad/huge_count.msh", "9223372036854775807")
+            ),
+        ),
+        bad(
+            "gmsh-huge-element-block",
+            "huge_block.msh",
+            &format!(
+                "{}: the number of elements in the block is 1000000000000, above the limit of 20000000",
+                at("bad/huge_block.msh", "1 1 1 1000000000000")
+            ),
+        ),
+        bad(
+            "gmsh-huge-entity-count",
+            "huge_entities.msh",
+            &format!(
+                "{}: an entity count is 4000000000, above the limit of 1000000",
+                at("bad/huge_entities.msh", "4 4 1 4000000000")
+            ),
+        ),
+        bad(
+            "gmsh-physical-names-beyond-u64",
+            "huge_names.msh",
+            &format!(
+                "{}: the number of physical names is 18446744073709551615, above the limit of 100000",
+                at("bad/huge_names.msh", "18446744073709551615")
+            ),
+        ),
+        bad(
+            "gmsh-huge-tag-count",
+            "huge_tags.msh",
+            &format!(
+                "{}: the number of element tags is 1000000, above the limit of 1000",
+                at("bad/huge_tags.msh", "100 2 1000000 5 1 27 28 37")
             ),
         ),
         bad(
@@ -1105,6 +1137,13 @@ fn project_names_the_bad_mesh_and_its_line() {
             "bad/truncated_v22.msh",
             ":201: unexpected end of file, expected an element (tag type numTags tags… nodes…)"
                 .into(),
+        ),
+        (
+            "bad/huge_block.msh",
+            format!(
+                ":{}: the number of elements in the block is 1000000000000, above the limit of 20000000",
+                line_of(&data.join("bad/huge_block.msh"), "1 1 1 1000000000000")
+            ),
         ),
         (
             "bad/nonplanar.msh",

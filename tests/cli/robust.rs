@@ -402,6 +402,10 @@ fn command_line_cases() -> Vec<Case> {
         args_case("reproduce-study-with-escape", None, &["reproduce", "b9\u{1b}[1m"], "unknown study `b9\\u{1b}[1m`"),
         args_case("stability-case-with-escape", None, &["stability", "--dir", concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/stability"), "--cases", "b2\u{1b}"], "unknown case `b2\\u{1b}`"),
         args_case("project-mesh-directory", None, &["project", "--mesh", "/tmp"], "/tmp: cannot read"),
+        args_case("threads-over-the-limit", None, &["run", "vibrating-bar", "--threads", "5000"], "--threads 5000 is above the limit of 1024"),
+        args_case("compare-threads-over-the-limit", None, &["compare", "vibrating-bar", "--threads", "100000000"], "--threads 100000000 is above the limit of 1024"),
+        args_case("stability-threads-over-the-limit", None, &["stability", "--threads", "2000"], "--threads 2000 is above the limit of 1024"),
+        args_case("converge-level-refused-before-any-run", None, &["converge", "vibrating-bar", "--levels", "7", "--blocks", "1024x1"], "level 3: mesh.blocks: each count must be in 1..=4096, got [8192, 1]"),
     ]
 }
 
@@ -550,6 +554,7 @@ fn the_exit_status_rule_is_in_the_help() {
         vec!["--help"],
         vec!["run", "--help"],
         vec!["compare", "--help"],
+        vec!["reproduce", "--help"],
     ] {
         let out = cli().args(&args).output().unwrap();
         assert!(out.status.success());
@@ -595,6 +600,62 @@ fn a_study_with_failed_variants_exits_0_unless_strict() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn reproduce_exits_0_with_unstable_runs_unless_strict() {
+    // The quick b4 has 4 unstable runs of 16 (its tables mark them), b5c none.
+    let out = cli().args(["reproduce", "b4", "--quick"]).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("- 4 of 16 runs failed or are unstable"),
+        "{stdout}"
+    );
+    let out = cli()
+        .args([
+            "reproduce",
+            "b5c,b4",
+            "--quick",
+            "--strict",
+            "--format",
+            "json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "error: --strict: 4 of 18 variants failed or are unstable (see the table)\n"
+    );
+    // Both studies were printed before the verdict, with their counts.
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let counts: Vec<(u64, u64)> = stdout
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            (
+                v["runs"].as_u64().unwrap(),
+                v["failed_runs"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(counts, [(2, 0), (16, 4)]);
+    let out = cli()
+        .args(["reproduce", "b5c", "--quick", "--strict"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 fn binary() -> std::process::Command {
@@ -718,4 +779,60 @@ fn sigterm_stops_a_run_with_130_and_says_so() {
     let (code, stderr) = interrupt("TERM", &[]);
     assert_eq!(code, Some(130), "{stderr}");
     assert!(stderr.contains("error: interrupted"), "{stderr}");
+}
+
+/// `mpm_cli::check` (what the `cli_args` fuzz target drives) validates a command
+/// line as the command would, without running it.
+#[test]
+fn check_validates_command_lines_without_running_them() {
+    use mpm_cli::{check, Checked};
+    let checked = |args: &[&str]| check(std::iter::once("mpm-cli").chain(args.iter().copied()));
+    match checked(&["run", "vibrating-bar", "--dt", "1e-4", "--blocks", "8x1"]) {
+        Ok(Checked::Run(s)) => {
+            assert_eq!(s.time.dt, Some(1e-4));
+            assert_eq!(s.blocks(), Some([8, 1]));
+        }
+        other => panic!("{other:?}"),
+    }
+    match checked(&["compare", "vibrating-bar", "--mass", "lumped,consistent"]) {
+        Ok(Checked::Scenes(s)) => assert_eq!(s.len(), 4),
+        other => panic!("{other:?}"),
+    }
+    match checked(&[
+        "converge",
+        "vibrating-bar",
+        "--levels",
+        "2",
+        "--basis",
+        "ps",
+    ]) {
+        Ok(Checked::Scenes(s)) => {
+            assert_eq!(s.len(), 2);
+            assert_eq!(s[1].blocks().unwrap()[0], 2 * s[0].blocks().unwrap()[0]);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(checked(&["scenes"]), Ok(Checked::Parsed)));
+    for (args, fragment) in [
+        (&["run", "vibrating-bar", "--dt=-1"][..], "time.dt"),
+        (
+            &["run", "vibrating-bar", "--threads", "0"],
+            "--threads must be at least 1",
+        ),
+        (&["run", "vibrating-bar", "--bogus"], "--bogus"),
+        (&["--help"], "Usage"),
+        (
+            &["compare", "vibrating-bar", "--jobs", "0"],
+            "--jobs must be at least 1",
+        ),
+        (&["run", "no-such-scene"], "unknown scene"),
+    ] {
+        match checked(args) {
+            Err(e) => {
+                assert_eq!(e.exit_code(), 2, "{args:?}: {e}");
+                assert!(e.to_string().contains(fragment), "{args:?}: {e}");
+            }
+            Ok(other) => panic!("{args:?}: {other:?}"),
+        }
+    }
 }

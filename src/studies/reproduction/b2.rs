@@ -1,14 +1,15 @@
 //! B2 (thesis §4.1): the vibrating bar, small deformation.
 
-use super::{builtin, log_log, opt, order, row, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, log_log, opt, order, row, sci, setup, Effort, Figure, Report, Table, Tally};
 use crate::bases::BasisKind;
 use crate::output::chart::Series;
-use crate::simulation::{self, RunError};
+use crate::simulation::RunError;
 use crate::studies::published::THESIS_TABLES_4_2_AND_4_3;
 
 /// B2 (thesis §4.1): E_u of the thesis variant against Tables 4.2–4.3, and orders of
 /// the default variant.
 pub(super) fn b2(effort: Effort) -> Result<Report, RunError> {
+    let mut tally = Tally::default();
     let printed = &THESIS_TABLES_4_2_AND_4_3;
     let limit = if effort == Effort::Quick { 5 } else { 33 };
     let mut table = Table {
@@ -25,14 +26,14 @@ pub(super) fn b2(effort: Effort) -> Result<Report, RunError> {
             let mut variant = builtin("vibrating-bar-thesis")?;
             variant.basis = basis;
             setup(variant.set_blocks(n_x - 1, 1))?;
-            let thesis_run = simulation::run(&variant, &mut |_| {})?;
+            let thesis_run = tally.run(&variant, &mut |_| {})?;
             let mut default = builtin("vibrating-bar")?;
             default.basis = basis;
             setup(default.set_blocks(n_x - 1, 1))?;
             default.set_particles_per_block([16, 14]);
             default.set_dt(1e-5);
             default.time.t_end = 0.02;
-            let default_run = simulation::run(&default, &mut |_| {})?;
+            let default_run = tally.run(&default, &mut |_| {})?;
             let e = default_run.error.unwrap_or(f64::NAN);
             table.rows.push(row![
                 basis.name(),
@@ -66,6 +67,7 @@ pub(super) fn b2(effort: Effort) -> Result<Report, RunError> {
     }
     Ok(Report {
         benchmark: "b2",
+        runs: tally,
         tables: vec![table],
         figures: vec![Figure {
             file: "b2-convergence.svg".into(),

@@ -1,17 +1,18 @@
 //! B3 (paper §4.1): the vibrating bar, large deformation, against the UL-FEM
 //! reference.
 
-use super::{builtin, opt, row, run_2d, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, opt, row, run_2d, sci, setup, Effort, Figure, Report, Table, Tally};
 use crate::bases::BasisKind;
 use crate::output::chart::{LinePlot, Series};
 use crate::scene::Reference;
-use crate::simulation::{self, RunError};
+use crate::simulation::RunError;
 use crate::studies::ulfem::{self, End, InitialVelocity, UlFemConfig, UlMass};
 use std::path::Path;
 
 /// B3 (paper §4.1): energies of the large-deformation bar against the UL-FEM
 /// reference.
 pub(super) fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunError> {
+    let mut tally = Tally::default();
     let t_end = if effort == Effort::Quick { 2.0 } else { 20.0 };
     let base = builtin("bar-large")?;
     let (length, width) = (1.0, 0.05);
@@ -97,7 +98,7 @@ pub(super) fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErro
         let basis = BasisKind::Ps;
         let mut s = setup(base.with_basis(basis))?;
         s.time.t_end = t_end;
-        let run = run_2d(&s, 20)?;
+        let run = run_2d(&mut tally, &s, 20)?;
         let sum = &run.outcome.summary;
         // First time the kinetic (k = 0) or total (k = 1) energy is off by 1 % of E(0).
         let first_off = |k: usize| {
@@ -162,7 +163,7 @@ pub(super) fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErro
     let mut small = base.clone();
     small.reference = Some(Reference::VibratingBar { v0: 0.001 });
     small.time.t_end = t_end.min(5.0);
-    let s = simulation::run(&small, &mut |_| {})?;
+    let s = tally.run(&small, &mut |_| {})?;
     let amplitude = 0.001 / (std::f64::consts::PI * (50.0f64 / 25.0).sqrt() / length);
     let volume = length * width;
     let relative = s.error.unwrap_or(f64::NAN) / (amplitude * (0.5 * volume).sqrt());
@@ -181,6 +182,7 @@ pub(super) fn b3(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErro
     });
     Ok(Report {
         benchmark: "b3",
+        runs: tally,
         tables: vec![table],
         figures,
         findings,

@@ -1,6 +1,6 @@
 //! B4 (paper §4.2): the axis-aligned manufactured solution.
 
-use super::{builtin, log_log, opt, order, row, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, log_log, opt, order, row, sci, setup, Effort, Figure, Report, Table, Tally};
 use crate::bases::BasisKind;
 use crate::mass::MassKind;
 use crate::output::chart::{LinePlot, Series};
@@ -40,6 +40,7 @@ fn roughness(v: &[f64]) -> f64 {
 /// B4 (paper §4.2): convergence of the manufactured solution in h and in particles
 /// per element, and the grid-crossing comparison.
 pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
+    let mut tally = Tally::default();
     let base = builtin("axis-aligned")?;
     // Particles per axis on the coarsest mesh; finer meshes scale them with 1/h so
     // that the particles per element stay about constant (about 16 and 65).
@@ -89,7 +90,7 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
                 let scaled = (count as f64 * edges[0] / edge).round() as usize;
                 set_polygon(&mut s, edge, scaled)?;
                 let triangles = simulation::triangulation(&s)?.num_triangles();
-                let sum = simulation::run(&s, &mut |_| {})?;
+                let sum = tally.run(&s, &mut |_| {})?;
                 let e = completed_error(&sum);
                 table.rows.push(row![
                     basis.name(),
@@ -169,7 +170,7 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
             s.set_dt(dt);
             set_polygon(&mut s, ppe_edge, count)?;
             let triangles = simulation::triangulation(&s)?.num_triangles();
-            let sum = simulation::run(&s, &mut |_| {})?;
+            let sum = tally.run(&s, &mut |_| {})?;
             let e = completed_error(&sum);
             let ppe = sum.particles as f64 / triangles as f64;
             ppe_table.rows.push(row![
@@ -222,7 +223,7 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
         let mut s = setup(base.with_basis(basis))?;
         s.time.t_end = t_cross;
         s.output.tracked = vec![vec![0.25, 0.47]];
-        let out = simulation::run_2d(&s, &mut |_| {})?;
+        let out = tally.run_2d(&s, &mut |_| {})?;
         let t = &out.tracked[0];
         let vx: Vec<f64> = t.velocity.iter().map(|v| v[0]).collect();
         let exact = crate::studies::exact::AxisAligned {
@@ -246,7 +247,7 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
         // σ_xx at t = 0.016 against the exact field.
         let mut s16 = s.clone();
         s16.time.t_end = 0.016;
-        let at16 = simulation::run_2d(&s16, &mut |_| {})?;
+        let at16 = tally.run_2d(&s16, &mut |_| {})?;
         let (mut worst, mut scale) = (0.0f64, 0.0f64);
         let p = &at16.particles;
         // The particle row nearest y⁰ = 0.47 (the tracked particle's row).
@@ -278,6 +279,7 @@ pub(super) fn b4(effort: Effort) -> Result<Report, RunError> {
     }
     Ok(Report {
         benchmark: "b4",
+        runs: tally,
         tables: vec![table, ppe_table, cross_table],
         figures: vec![
             Figure {

@@ -1,10 +1,10 @@
 //! B5 (paper §4.3, thesis §4.4 and 5): the column under self-weight, large
 //! deformation (B5b, against the UL-FEM reference) and damped to equilibrium (B5c).
 
-use super::{builtin, opt, row, run_2d, sci, setup, Effort, Figure, Report, Table};
+use super::{builtin, opt, row, run_2d, sci, setup, Effort, Figure, Report, Table, Tally};
 use crate::mass::MassKind;
 use crate::output::chart::{LinePlot, Scale, Series};
-use crate::simulation::{self, RunError, Summary};
+use crate::simulation::{RunError, Summary};
 use crate::studies::ulfem::{self, End, InitialVelocity, UlFemConfig, UlMass};
 use std::path::Path;
 
@@ -31,6 +31,7 @@ pub fn sigma_yy_roughness(particles: &crate::particles::Particles<f64, 2>, sigma
 
 /// B5b (paper §4.3, thesis §4.4 and 5): mass strategies on three grids.
 pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunError> {
+    let mut tally = Tally::default();
     let base = builtin("column-large")?;
     let t_end = if effort == Effort::Quick { 0.5 } else { 2.5 };
     // (label, blocks of the mesh: the column's blocks plus the empty band above).
@@ -120,7 +121,7 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
             s.time.allow_above_critical = true;
             s.output.condition = true;
             s.output.tracked = vec![vec![0.05, 0.5]];
-            let run = run_2d(&s, 10)?;
+            let run = run_2d(&mut tally, &s, 10)?;
             let sum: &Summary = &run.outcome.summary;
             let t = &run.outcome.tracked[0];
             let mid_error = t
@@ -164,6 +165,7 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
     }
     Ok(Report {
         benchmark: "b5b",
+        runs: tally,
         tables: vec![table],
         figures: vec![
             Figure {
@@ -181,6 +183,7 @@ pub(super) fn b5b(effort: Effort, cache: Option<&Path>) -> Result<Report, RunErr
 
 /// B5c (paper eqs. (48)–(49)): the damped column's equilibrium stress.
 pub(super) fn b5c(effort: Effort) -> Result<Report, RunError> {
+    let mut tally = Tally::default();
     let base = builtin("column-damped")?;
     let t_end = if effort == Effort::Quick { 1.0 } else { 10.0 };
     let (height, density, g, young) = (1.0, 1e3, 9.81, 1e5);
@@ -221,7 +224,7 @@ pub(super) fn b5c(effort: Effort) -> Result<Report, RunError> {
         s.mass = mass;
         s.time.t_end = t_end;
         let mut kinetic = 0.0;
-        let out = simulation::run_2d(&s, &mut |r| kinetic = r.kinetic)?;
+        let out = tally.run_2d(&s, &mut |r| kinetic = r.kinetic)?;
         let p = &out.particles;
         let (mut linear, mut paper) = (0.0f64, 0.0f64);
         let mut points = Vec::new();
@@ -248,6 +251,7 @@ pub(super) fn b5c(effort: Effort) -> Result<Report, RunError> {
     }
     Ok(Report {
         benchmark: "b5c",
+        runs: tally,
         tables: vec![table],
         figures: vec![Figure {
             file: "b5c-sigma.svg".into(),

@@ -150,6 +150,52 @@ pub struct Report {
     pub figures: Vec<Figure>,
     /// Measured findings, one sentence each.
     pub findings: Vec<String>,
+    /// The runs of the study and those of them that failed or are unstable
+    /// (`mpm-cli reproduce --strict` exits with status 1 when any did).
+    pub runs: Tally,
+}
+
+/// How many runs a study made and how many of them failed or are unstable (a
+/// failed run is also unstable, so `failed` counts the runs whose verdict is not
+/// stable). The study's tables show which ones.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Tally {
+    /// Runs made.
+    pub total: usize,
+    /// Runs that failed numerically or whose verdict is unstable.
+    pub failed: usize,
+}
+
+impl Tally {
+    /// Counts the run of `summary`.
+    fn note(&mut self, summary: &simulation::Summary) {
+        self.total += 1;
+        if !summary.stable || summary.failure.is_some() {
+            self.failed += 1;
+        }
+    }
+
+    /// [`simulation::run`], counted.
+    fn run(
+        &mut self,
+        scene: &Scene,
+        on_step: &mut dyn FnMut(&crate::driver::StepReport),
+    ) -> Result<simulation::Summary, RunError> {
+        let summary = simulation::run(scene, on_step)?;
+        self.note(&summary);
+        Ok(summary)
+    }
+
+    /// [`simulation::run_2d`], counted.
+    fn run_2d(
+        &mut self,
+        scene: &Scene,
+        on_step: &mut dyn FnMut(&crate::driver::StepReport),
+    ) -> Result<Outcome<2>, RunError> {
+        let outcome = simulation::run_2d(scene, on_step)?;
+        self.note(&outcome.summary);
+        Ok(outcome)
+    }
 }
 
 /// The studies, in order.
@@ -213,9 +259,9 @@ struct Run {
     condition: Vec<(f64, f64)>,
 }
 
-fn run_2d(scene: &Scene, every: usize) -> Result<Run, RunError> {
+fn run_2d(tally: &mut Tally, scene: &Scene, every: usize) -> Result<Run, RunError> {
     let (mut energy, mut condition) = (Vec::new(), Vec::new());
-    let outcome = simulation::run_2d(scene, &mut |r| {
+    let outcome = tally.run_2d(scene, &mut |r| {
         if r.step % every.max(1) == 0 {
             energy.push((r.time, r.kinetic, r.strain, r.total_energy()));
         }

@@ -17,6 +17,12 @@
 //!   down, −z) is flipped to counter-clockwise; a mix of orientations is an error
 //!   of the mesh validation ([`MeshError::InvertedTriangle`]).
 //!
+//! Every count read from the file (physical names, entities, entity blocks, nodes,
+//! elements, tags) is checked against a limit ([`MAX_NODES`], [`MAX_ELEMENTS`], …)
+//! before anything is allocated or read for it; a count above its limit is a syntax
+//! error at its line naming the value and the limit (`mesh.msh:13: the number of
+//! nodes is 9223372036854775807, above the limit of 10000000`).
+//!
 //! Every error names the file; syntax errors also give the 1-based line and what
 //! was expected there (`mesh.msh:17: expected 4 values in a $Elements entity block
 //! header (…), found 3: `2 1 2``). Binary files are rejected with a hint to save
@@ -33,6 +39,21 @@ mod v41;
 use super::{MeshError, TriMesh, Vec2};
 use std::collections::HashMap;
 use std::path::Path;
+
+/// Most nodes a file may hold: in one `$Nodes` count, one entity block, and all
+/// blocks together. A 256 MiB file (the largest `psmpm` reads) holds fewer.
+pub const MAX_NODES: usize = 10_000_000;
+/// Most elements (points, lines, triangles) a file may hold: in one `$Elements`
+/// count, one entity block, and all blocks together.
+pub const MAX_ELEMENTS: usize = 20_000_000;
+/// Most entity blocks of a format 4.1 `$Nodes` or `$Elements` section.
+pub const MAX_ENTITY_BLOCKS: usize = 1_000_000;
+/// Most entities of each dimension in a format 4.1 `$Entities` section.
+pub const MAX_ENTITIES: usize = 1_000_000;
+/// Most entries of `$PhysicalNames`.
+pub const MAX_PHYSICAL_NAMES: usize = 100_000;
+/// Most tags of one element (format 2.2) or physical tags of one curve (format 4.1).
+pub const MAX_TAGS: usize = 1_000;
 
 /// An error reading a `.msh` file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -141,6 +162,50 @@ impl<'a> Reader<'a> {
             .map_err(|_| self.error(format!("{what} must be non-negative, found {v}")))
     }
 
+    /// A count of at most `limit`, checked before anything is read or allocated for it.
+    /// A number of digits too large for any integer type is above the limit too.
+    fn bounded(&self, s: &str, what: &str, limit: usize) -> Result<usize, GmshError> {
+        let digits = s.strip_prefix('+').unwrap_or(s);
+        let n = if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+            digits.parse::<usize>().ok()
+        } else {
+            Some(self.count(s, what)?)
+        };
+        match n {
+            Some(n) if n <= limit => Ok(n),
+            _ => {
+                let shown = if digits.len() > 40 {
+                    format!("{}… ({} digits)", &digits[..20], digits.len())
+                } else {
+                    digits.to_string()
+                };
+                Err(self.error(format!("{what} is {shown}, above the limit of {limit}")))
+            }
+        }
+    }
+
+    /// Adds `n` more items (read for `what`) to `total` and checks the sum against `limit`.
+    fn add_total(
+        &self,
+        total: &mut usize,
+        n: usize,
+        what: &str,
+        limit: usize,
+    ) -> Result<(), GmshError> {
+        *total = total.saturating_add(n);
+        if *total > limit {
+            return Err(self.error(format!(
+                "{what} in all is {total}, above the limit of {limit}"
+            )));
+        }
+        Ok(())
+    }
+
+    /// The number of lines not read yet (an upper bound on the items still to come).
+    fn remaining(&self) -> usize {
+        self.lines.len().saturating_sub(self.pos)
+    }
+
     fn float(&self, s: &str, what: &str) -> Result<f64, GmshError> {
         match s.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
@@ -203,6 +268,9 @@ struct Contents {
     triangles: Vec<([i64; 3], usize)>,
     /// Lines in a physical group: node ids, physical tag, line read on.
     lines: Vec<([i64; 2], i64, usize)>,
+    /// Nodes and elements announced so far (over all blocks and sections).
+    node_total: usize,
+    element_total: usize,
     seen_nodes: bool,
     seen_elements: bool,
 }
@@ -291,7 +359,7 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
             }
             "$PhysicalNames" => {
                 let f = r.fields("the $PhysicalNames count", 1, false)?;
-                let n = r.count(f[0], "the number of physical names")?;
+                let n = r.bounded(f[0], "the number of physical names", MAX_PHYSICAL_NAMES)?;
                 for _ in 0..n {
                     let line = r.next("a physical name")?;
                     let mut parts = line.splitn(3, char::is_whitespace);
@@ -714,6 +782,30 @@ $EndElements
             }
             other => panic!("expected a content error, got {other}"),
         }
+    }
+
+    #[test]
+    fn totals_over_blocks_and_sections_are_bounded() {
+        let r = Reader {
+            file: "t.msh",
+            lines: vec!["a", "b", "c"],
+            pos: 2,
+        };
+        let mut total = 0;
+        r.add_total(&mut total, MAX_NODES - 1, "the number of nodes", MAX_NODES)
+            .unwrap();
+        r.add_total(&mut total, 1, "the number of nodes", MAX_NODES)
+            .unwrap();
+        let err = r
+            .add_total(&mut total, 1, "the number of nodes", MAX_NODES)
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "t.msh:2: the number of nodes in all is 10000001, above the limit of 10000000"
+        );
+        r.add_total(&mut total, usize::MAX, "x", MAX_NODES)
+            .unwrap_err();
+        assert_eq!(r.remaining(), 1);
     }
 
     #[test]

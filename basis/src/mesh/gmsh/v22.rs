@@ -1,12 +1,13 @@
 //! The layout of Gmsh format 2.2: `$Nodes` as `id x y z` lines, `$Elements` as
 //! `id type numTags tags… nodes…` lines whose first tag is the physical group.
 
-use super::{Contents, GmshError, Reader};
+use super::{Contents, GmshError, Reader, MAX_ELEMENTS, MAX_NODES, MAX_TAGS};
 
 /// Reads the body of `$Nodes`: a count, then one node per line.
 pub(super) fn read_nodes(r: &mut Reader, c: &mut Contents) -> Result<(), GmshError> {
     let f = r.fields("the $Nodes count", 1, false)?;
-    let n = r.count(f[0], "the number of nodes")?;
+    let n = r.bounded(f[0], "the number of nodes", MAX_NODES)?;
+    r.add_total(&mut c.node_total, n, "the number of nodes", MAX_NODES)?;
     for _ in 0..n {
         let f = r.fields("a node (tag x y z)", 4, false)?;
         let id = r.int(f[0], "a node id")?;
@@ -24,11 +25,17 @@ pub(super) fn read_nodes(r: &mut Reader, c: &mut Contents) -> Result<(), GmshErr
 /// group 0 means none).
 pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), GmshError> {
     let f = r.fields("the $Elements count", 1, false)?;
-    let n = r.count(f[0], "the number of elements")?;
+    let n = r.bounded(f[0], "the number of elements", MAX_ELEMENTS)?;
+    r.add_total(
+        &mut c.element_total,
+        n,
+        "the number of elements",
+        MAX_ELEMENTS,
+    )?;
     for _ in 0..n {
         let f = r.fields("an element (tag type numTags tags… nodes…)", 3, true)?;
         let kind = r.int(f[1], "an element type")?;
-        let ntags = r.count(f[2], "the number of element tags")?;
+        let ntags = r.bounded(f[2], "the number of element tags", MAX_TAGS)?;
         if f.len() - 3 < ntags {
             return Err(r.error("element lists fewer tags than it announces"));
         }
@@ -68,6 +75,44 @@ mod tests {
         let (line, msg) = syntax_line(&GOOD_22.replace("\n4\n1 0 0 0", "\n-4\n1 0 0 0"));
         assert_eq!(line, line_of(GOOD_22, "$Nodes") + 1);
         assert!(msg.contains("non-negative"), "{msg}");
+        // Counts above their limits are refused at their line.
+        let (line, msg) = syntax_line(&GOOD_22.replace("\n4\n1 0 0 0", "\n10000001\n1 0 0 0"));
+        assert_eq!(line, line_of(GOOD_22, "$Nodes") + 1);
+        assert_eq!(
+            msg,
+            "the number of nodes is 10000001, above the limit of 10000000"
+        );
+        let (line, msg) = syntax_line(&GOOD_22.replace("\n6\n1 1", "\n20000001\n1 1"));
+        assert_eq!(line, line_of(GOOD_22, "$Elements") + 1);
+        assert_eq!(
+            msg,
+            "the number of elements is 20000001, above the limit of 20000000"
+        );
+        let (_, msg) =
+            syntax_line(&GOOD_22.replace("\n4\n1 0 0 0", "\n18446744073709551616\n1 0 0 0"));
+        assert_eq!(
+            msg,
+            "the number of nodes is 18446744073709551616, above the limit of 10000000"
+        );
+        let (_, msg) = syntax_line(
+            &GOOD_22.replace("\n4\n1 0 0 0", &format!("\n+{}\n1 0 0 0", "9".repeat(50))),
+        );
+        assert_eq!(
+            msg,
+            "the number of nodes is 99999999999999999999… (50 digits), above the limit of 10000000"
+        );
+        let (line, msg) = syntax_line(&GOOD_22.replace("\n1\n1 7", "\n100001\n1 7"));
+        assert_eq!(line, line_of(GOOD_22, "$PhysicalNames") + 1);
+        assert_eq!(
+            msg,
+            "the number of physical names is 100001, above the limit of 100000"
+        );
+        let (line, msg) = syntax_line(&GOOD_22.replace("5 2 2 1 1 1 2 3", "5 2 1001 1 1 1 2 3"));
+        assert_eq!(line, line_of(GOOD_22, "5 2 2 1 1 1 2 3"));
+        assert_eq!(
+            msg,
+            "the number of element tags is 1001, above the limit of 1000"
+        );
         let (line, msg) = syntax_line(&GOOD_22.replace("4 0 1 0\n", "3 0 1 0\n"));
         assert_eq!(line, line_of(GOOD_22, "4 0 1 0"));
         assert!(msg.contains("node 3 is defined twice"), "{msg}");

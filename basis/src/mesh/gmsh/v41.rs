@@ -2,7 +2,9 @@
 //! and `$Nodes` and `$Elements` in entity blocks, where a line element's physical
 //! group is that of its curve.
 
-use super::{Contents, GmshError, Reader};
+use super::{
+    Contents, GmshError, Reader, MAX_ELEMENTS, MAX_ENTITIES, MAX_ENTITY_BLOCKS, MAX_NODES, MAX_TAGS,
+};
 
 /// Reads the body of `$Entities`: the first physical tag of each curve.
 pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), GmshError> {
@@ -13,7 +15,7 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
     )?;
     let counts: Vec<usize> = f
         .iter()
-        .map(|s| r.count(s, "an entity count"))
+        .map(|s| r.bounded(s, "an entity count", MAX_ENTITIES))
         .collect::<Result<_, _>>()?;
     for _ in 0..counts[0] {
         r.next("a point entity")?;
@@ -25,7 +27,7 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             true,
         )?;
         let tag = r.int(f[0], "a curve tag")?;
-        let nphys = r.count(f[7], "the number of physical tags")?;
+        let nphys = r.bounded(f[7], "the number of physical tags", MAX_TAGS)?;
         if f.len() - 8 < nphys {
             return Err(r.error("curve entity lists fewer physical tags than it announces"));
         }
@@ -46,7 +48,8 @@ pub(super) fn read_nodes(r: &mut Reader, c: &mut Contents) -> Result<(), GmshErr
         4,
         false,
     )?;
-    let blocks = r.count(f[0], "the number of node blocks")?;
+    let blocks = r.bounded(f[0], "the number of node blocks", MAX_ENTITY_BLOCKS)?;
+    r.bounded(f[1], "the number of nodes", MAX_NODES)?;
     for _ in 0..blocks {
         let f = r.fields(
             "a $Nodes entity block header (entityDim entityTag parametric numNodesInBlock)",
@@ -57,8 +60,10 @@ pub(super) fn read_nodes(r: &mut Reader, c: &mut Contents) -> Result<(), GmshErr
         if parametric != 0 {
             return Err(r.error("parametric nodes are not supported"));
         }
-        let n = r.count(f[3], "the number of nodes in the block")?;
-        let mut ids = Vec::with_capacity(n.min(1 << 16));
+        let n = r.bounded(f[3], "the number of nodes in the block", MAX_NODES)?;
+        r.add_total(&mut c.node_total, n, "the number of nodes", MAX_NODES)?;
+        // Each node takes a line: the file's length bounds the allocation too.
+        let mut ids = Vec::with_capacity(n.min(r.remaining()));
         for _ in 0..n {
             let f = r.fields("a node tag", 1, false)?;
             ids.push(r.int(f[0], "a node tag")?);
@@ -83,7 +88,8 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
         4,
         false,
     )?;
-    let blocks = r.count(f[0], "the number of element blocks")?;
+    let blocks = r.bounded(f[0], "the number of element blocks", MAX_ENTITY_BLOCKS)?;
+    r.bounded(f[1], "the number of elements", MAX_ELEMENTS)?;
     for _ in 0..blocks {
         let f = r.fields(
             "a $Elements entity block header (entityDim entityTag elementType numElementsInBlock)",
@@ -92,7 +98,13 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
         )?;
         let entity = r.int(f[1], "an entity tag")?;
         let kind = r.int(f[2], "an element type")?;
-        let n = r.count(f[3], "the number of elements in the block")?;
+        let n = r.bounded(f[3], "the number of elements in the block", MAX_ELEMENTS)?;
+        r.add_total(
+            &mut c.element_total,
+            n,
+            "the number of elements",
+            MAX_ELEMENTS,
+        )?;
         // Name an unsupported type at the block header.
         super::supported_element(r, kind)?;
         let physical = if kind == 1 {
@@ -150,12 +162,70 @@ mod tests {
         let (line, msg) = syntax_line(cut);
         assert_eq!(line, cut.lines().count() + 1);
         assert!(msg.contains("end of file, expected a node tag"), "{msg}");
-        // Huge counts run into the end of the file, not out of memory.
-        let (_, msg) = syntax_line(
-            &GOOD_41.replace("4 5 1 0\n", "4 5 9223372036854775807 9223372036854775807\n"),
-        );
-        assert!(msg.contains("end of file"), "{msg}");
-        let (_, msg) = syntax_line(&GOOD_41.replace("2 1 0 4", "2 1 0 9223372036854775807"));
+        // Counts above their limits are refused at their line, before anything is read.
+        let huge = "9223372036854775807";
+        for (from, to, message) in [
+            (
+                "4 5 1 0",
+                format!("4 5 {huge} {huge}"),
+                format!("an entity count is {huge}, above the limit of 1000000"),
+            ),
+            (
+                "2 5 10 40",
+                format!("2 {huge} 10 40"),
+                format!("the number of nodes is {huge}, above the limit of 10000000"),
+            ),
+            (
+                "2 5 10 40",
+                "1000001 5 10 40".into(),
+                "the number of node blocks is 1000001, above the limit of 1000000".into(),
+            ),
+            (
+                "2 1 0 4",
+                format!("2 1 0 {huge}"),
+                format!("the number of nodes in the block is {huge}, above the limit of 10000000"),
+            ),
+            (
+                "2 1 0 4",
+                "2 1 0 10000000".into(),
+                "the number of nodes in all is 10000001, above the limit of 10000000".into(),
+            ),
+            (
+                "2 1 0 4",
+                "2 1 0 10000001".into(),
+                "the number of nodes in the block is 10000001, above the limit of 10000000".into(),
+            ),
+            (
+                "7 9 1 9",
+                "7 20000001 1 9".into(),
+                "the number of elements is 20000001, above the limit of 20000000".into(),
+            ),
+            (
+                "7 9 1 9",
+                "1000001 9 1 9".into(),
+                "the number of element blocks is 1000001, above the limit of 1000000".into(),
+            ),
+            (
+                "2 1 2 2",
+                format!("2 1 2 {huge}"),
+                format!(
+                    "the number of elements in the block is {huge}, above the limit of 20000000"
+                ),
+            ),
+            (
+                "1 0 0 0 1 0 0 1 7 2 1 -2",
+                "1 0 0 0 1 0 0 1001 7 2 1 -2".into(),
+                "the number of physical tags is 1001, above the limit of 1000".into(),
+            ),
+        ] {
+            let (line, msg) =
+                syntax_line(&GOOD_41.replacen(&format!("\n{from}\n"), &format!("\n{to}\n"), 1));
+            assert_eq!(line, line_of(GOOD_41, from), "{to}");
+            assert_eq!(msg, message);
+        }
+        // A count that keeps the total at its limit is read (and runs into the coordinates).
+        let (line, msg) = syntax_line(&GOOD_41.replace("\n2 1 0 4\n", "\n2 1 0 9999999\n"));
+        assert_eq!(line, line_of(GOOD_41, "1 0 0"));
         assert!(
             msg.contains("expected 1 value in a node tag, found 3"),
             "{msg}"
