@@ -1,10 +1,11 @@
-//! The layout of Gmsh format 4.1: `$Entities` (the physical group of each curve),
+//! The layout of Gmsh format 4.1: `$Entities` (the physical group of each curve
+//! and surface),
 //! and `$Nodes` and `$Elements` in entity blocks, where a line element's physical
 //! group is that of its curve.
 
 use super::{Contents, GmshError, Reader};
 
-/// Reads the body of `$Entities`: the first physical tag of each curve.
+/// Reads the body of `$Entities`: the first physical tag of each curve and surface.
 pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), GmshError> {
     let f = r.fields(
         "the $Entities header (numPoints numCurves numSurfaces numVolumes)",
@@ -33,8 +34,24 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             c.curve_physical.insert(tag, r.int(f[8], "a physical tag")?);
         }
     }
-    for _ in 0..counts[2].saturating_add(counts[3]) {
-        r.next("a surface or volume entity")?;
+    for _ in 0..counts[2] {
+        let f = r.fields(
+            "a surface entity (tag minX minY minZ maxX maxY maxZ numPhysicalTags …)",
+            8,
+            true,
+        )?;
+        let tag = r.int(f[0], "a surface tag")?;
+        let nphys = r.count(f[7], "the number of physical tags")?;
+        if f.len() - 8 < nphys {
+            return Err(r.error("surface entity lists fewer physical tags than it announces"));
+        }
+        if nphys > 0 {
+            c.surface_physical
+                .insert(tag, r.int(f[8], "a physical tag")?);
+        }
+    }
+    for _ in 0..counts[3] {
+        r.next("a volume entity")?;
     }
     Ok(())
 }
@@ -95,10 +112,10 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
         let n = r.count(f[3], "the number of elements in the block")?;
         // Name an unsupported type at the block header.
         super::supported_element(r, kind)?;
-        let physical = if kind == 1 {
-            c.curve_physical.get(&entity).copied()
-        } else {
-            None
+        let physical = match kind {
+            1 => c.curve_physical.get(&entity).copied(),
+            2 => c.surface_physical.get(&entity).copied(),
+            _ => None,
         };
         for _ in 0..n {
             let f = r.fields("an element (tag nodes…)", 2, true)?;
@@ -150,11 +167,14 @@ mod tests {
         let (line, msg) = syntax_line(cut);
         assert_eq!(line, cut.lines().count() + 1);
         assert!(msg.contains("end of file, expected a node tag"), "{msg}");
-        // Huge counts run into the end of the file, not out of memory.
+        // Huge counts run into the end of the section, not out of memory.
         let (_, msg) = syntax_line(
             &GOOD_41.replace("4 5 1 0\n", "4 5 9223372036854775807 9223372036854775807\n"),
         );
-        assert!(msg.contains("end of file"), "{msg}");
+        assert!(
+            msg.contains("a surface entity") && msg.contains("`$EndEntities`"),
+            "{msg}"
+        );
         let (_, msg) = syntax_line(&GOOD_41.replace("2 1 0 4", "2 1 0 9223372036854775807"));
         assert!(
             msg.contains("expected 1 value in a node tag, found 3"),
