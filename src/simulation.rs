@@ -312,6 +312,8 @@ struct Tally {
     interrupted: bool,
     seconds: f64,
     max_rotation: f64,
+    /// The largest rotation of the particles of the paper's non-objective law.
+    max_rotation_non_objective: f64,
 }
 
 /// The tracked particles: the particle nearest each of the scene's tracked points.
@@ -377,6 +379,9 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
+    let mut max_rotation_non_objective = driver
+        .material()
+        .max_rotation_of_non_objective(&driver.particles.f);
     let mut interrupted = false;
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
@@ -411,6 +416,11 @@ where
         }
         if r.step % ROTATION_EVERY == 0 {
             max_rotation = max_rotation.max(crate::material::max_rotation(&driver.particles.f));
+            max_rotation_non_objective = max_rotation_non_objective.max(
+                driver
+                    .material()
+                    .max_rotation_of_non_objective(&driver.particles.f),
+            );
         }
         on_step(&r, driver.particles.view());
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
@@ -443,6 +453,7 @@ where
         interrupted,
         seconds: clock.elapsed().as_secs_f64(),
         max_rotation,
+        max_rotation_non_objective,
     }
 }
 
@@ -510,12 +521,14 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let max_rotation = tally
         .max_rotation
         .max(crate::material::max_rotation(&driver.particles.f));
-    let warnings = match scene.material.model {
-        crate::scene::MaterialModel::LinearElastic => {
-            crate::material::rotation_warning(max_rotation)
-        }
-        _ => None,
-    };
+    // The warning concerns the particles of the paper's non-objective law only.
+    let warnings = crate::material::rotation_warning(
+        tally.max_rotation_non_objective.max(
+            driver
+                .material()
+                .max_rotation_of_non_objective(&driver.particles.f),
+        ),
+    );
     Outcome {
         summary: Summary {
             scene: scene.name.clone(),

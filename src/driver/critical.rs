@@ -1,13 +1,13 @@
 //! The critical time step of the explicit update for the basis and mass strategy in
 //! use: `Δt_crit = 2 / ω_max` with `ω_max² = λ_max(M⁻¹ K)`, `M` the system the mass
 //! strategy solves (its own inverse, walls included) and `K` the small-strain
-//! stiffness `K v = Σ_p V_p σ(∇v_p) ∇phi_i` with the material's Lamé constants at
+//! stiffness `K v = Σ_p V_p σ(∇v_p) ∇phi_i` with each particle's Lamé constants at
 //! the current particle positions. `λ_max` by power iteration: a lower bound, so the
 //! estimate is an upper bound on `Δt_crit` that tightens with the iterations.
 
 use super::{phases, Driver, StepError};
 use crate::mass::MassStrategy;
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
 use psmpm_basis::Basis;
@@ -20,7 +20,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// The critical time step at the current state (see the module doc). Uses the
     /// step's own buffers; call before a step (e.g. at the start of a run).
@@ -28,7 +28,6 @@ where
         self.locate_and_evaluate()?;
         self.assemble_mass();
         self.factorize()?;
-        let (lambda, mu) = self.material.elastic().lame(D);
         let n = self.basis.num_functions();
         // Start: a fixed, non-smooth field (excites the highest modes).
         let mut v: Vec<Vec<T>> = (0..D)
@@ -61,7 +60,14 @@ where
             v.iter_mut()
                 .flat_map(|c| c.iter_mut())
                 .for_each(|a| *a /= T::of(nv));
-            stiffness_product(&self.evals, &self.particles.volume, lambda, mu, &v, &mut f);
+            let material = &self.material;
+            stiffness_product(
+                &self.evals,
+                &self.particles.volume,
+                |p| material.elastic(p).lame(D),
+                &v,
+                &mut f,
+            );
             for k in 0..D {
                 if let Err(source) = self.mass.solve(k, &mut f[k]) {
                     return Err(self.mass_failure(source));
@@ -82,17 +88,20 @@ where
 }
 
 /// `f_i = Σ_p V_p σ(∇v_p) ∇phi_i(x_p)` with the small-strain law
-/// `σ = λ tr(ε) I + 2 μ ε`, `ε = sym ∇v` (the stiffness applied to `v`).
+/// `σ = λ_p tr(ε) I + 2 μ_p ε`, `ε = sym ∇v`, and the Lamé constants `lame(p)` of
+/// each particle's material (the stiffness applied to `v`; with bodies of several
+/// materials, each particle's own, so the estimate is that of the stiffest mode of
+/// the whole system).
 fn stiffness_product<T: Scalar, const D: usize>(
     evals: &phases::Evaluations<T, D>,
     volume: &[T],
-    lambda: f64,
-    mu: f64,
+    lame: impl Fn(usize) -> (f64, f64),
     v: &[Vec<T>],
     f: &mut [Vec<T>],
 ) {
     phases::zero(f);
     for p in 0..volume.len() {
+        let (lambda, mu) = lame(p);
         let mut grad = SMatrix::<T, D, D>::zeros();
         for s in evals.range(p) {
             let i = evals.index[s];
@@ -178,8 +187,7 @@ mod tests {
             stiffness_product(
                 &driver.evals,
                 &driver.particles.volume,
-                lambda,
-                mu,
+                |_| (lambda, mu),
                 &v,
                 &mut f,
             );

@@ -4,7 +4,7 @@
 
 use super::{phases, to_f64_point, Driver, UNDER_SUPPORTED_COVERAGE};
 use crate::mass::{MassError, MassStrategy, SupportFacts};
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use psmpm_basis::Basis;
 use psmpm_basis::BasisError;
@@ -14,7 +14,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// What the driver can see around a failing particle, and the fix that fits.
     pub(super) fn diagnose_particle(&self, particle: usize) -> String {
