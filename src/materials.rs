@@ -77,6 +77,13 @@ impl MaterialTable {
     /// `laws[law_of[p]]` for particle `p`; equal laws are merged, and one law left
     /// makes the table [`MaterialTable::uniform`].
     pub fn new(laws: &[AnyMaterial], law_of: &[usize]) -> Result<Self, TableError> {
+        let Some(&first) = laws.first() else {
+            return Err(TableError {
+                particle: 0,
+                law: 0,
+                laws: 0,
+            });
+        };
         if let Some((particle, &law)) = law_of.iter().enumerate().find(|(_, &l)| l >= laws.len()) {
             return Err(TableError {
                 particle,
@@ -98,9 +105,7 @@ impl MaterialTable {
         let used: Vec<u32> = law_of.iter().map(|&l| merged[l]).collect();
         if distinct.len() <= 1 || used.windows(2).all(|w| w[0] == w[1]) {
             let one = used.first().map_or(0, |&l| l as usize);
-            return Ok(MaterialTable::uniform(
-                *distinct.get(one).unwrap_or(&laws[0]),
-            ));
+            return Ok(MaterialTable::uniform(*distinct.get(one).unwrap_or(&first)));
         }
         Ok(MaterialTable {
             laws: distinct,
@@ -123,15 +128,18 @@ impl MaterialTable {
     }
 
     /// The largest rotation angle of the particles whose law is not objective (the
-    /// paper's `linear-elastic`), 0 when no particle has such a law.
+    /// paper's `linear-elastic`), 0 when no particle has such a law; `all` is the
+    /// largest angle of all particles ([`crate::material::max_rotation`] of `fs`),
+    /// the answer when every particle has such a law.
     pub fn max_rotation_of_non_objective<T: Scalar, const D: usize>(
         &self,
         fs: &[SMatrix<T, D, D>],
+        all: f64,
     ) -> f64 {
         if self.laws.iter().all(|l| l.is_objective()) {
             0.0
         } else if self.law_of.is_empty() {
-            crate::material::max_rotation(fs)
+            all
         } else {
             fs.iter()
                 .enumerate()
@@ -192,13 +200,22 @@ mod tests {
         let (c, s) = (0.3f64.cos(), 0.3f64.sin());
         let turned = Matrix2::new(c, -s, s, c);
         let fs = [turned, Matrix2::identity(), turned, Matrix2::identity()];
-        assert_eq!(table.max_rotation_of_non_objective(&fs), 0.0);
+        assert_eq!(table.max_rotation_of_non_objective(&fs, 0.3), 0.0);
         let fs = [
             Matrix2::identity(),
             turned,
             Matrix2::identity(),
             Matrix2::identity(),
         ];
-        assert!((table.max_rotation_of_non_objective(&fs) - 0.3).abs() < 1e-12);
+        assert!((table.max_rotation_of_non_objective(&fs, 0.3) - 0.3).abs() < 1e-12);
+        assert_eq!(
+            MaterialTable::uniform(stiff).max_rotation_of_non_objective(&fs, 0.3),
+            0.3
+        );
+        assert_eq!(
+            MaterialTable::uniform(soft).max_rotation_of_non_objective(&fs, 0.3),
+            0.0
+        );
+        assert!(MaterialTable::new(&[], &[]).is_err());
     }
 }

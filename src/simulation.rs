@@ -381,7 +381,7 @@ where
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
     let mut max_rotation_non_objective = driver
         .material()
-        .max_rotation_of_non_objective(&driver.particles.f);
+        .max_rotation_of_non_objective(&driver.particles.f, max_rotation);
     let mut interrupted = false;
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
@@ -415,11 +415,12 @@ where
             rms.finish_step();
         }
         if r.step % ROTATION_EVERY == 0 {
-            max_rotation = max_rotation.max(crate::material::max_rotation(&driver.particles.f));
+            let now = crate::material::max_rotation(&driver.particles.f);
+            max_rotation = max_rotation.max(now);
             max_rotation_non_objective = max_rotation_non_objective.max(
                 driver
                     .material()
-                    .max_rotation_of_non_objective(&driver.particles.f),
+                    .max_rotation_of_non_objective(&driver.particles.f, now),
             );
         }
         on_step(&r, driver.particles.view());
@@ -518,15 +519,14 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
         && energy_growth < STABLE_ENERGY_GROWTH
         && max_condition.is_none_or(|c| c < STABLE_CONDITION);
     let driver = run.driver;
-    let max_rotation = tally
-        .max_rotation
-        .max(crate::material::max_rotation(&driver.particles.f));
+    let now = crate::material::max_rotation(&driver.particles.f);
+    let max_rotation = tally.max_rotation.max(now);
     // The warning concerns the particles of the paper's non-objective law only.
     let warnings = crate::material::rotation_warning(
         tally.max_rotation_non_objective.max(
             driver
                 .material()
-                .max_rotation_of_non_objective(&driver.particles.f),
+                .max_rotation_of_non_objective(&driver.particles.f, now),
         ),
     );
     Outcome {

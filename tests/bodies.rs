@@ -492,3 +492,27 @@ fn a_1d_scene_has_intervals_only() {
     assert_eq!(e.field, "initial_velocity.kind", "{e}");
     assert!(e.message.contains("needs a 2D scene"), "{e}");
 }
+
+/// The rotation warning of a run with a spinning disk of law `disk` next to a block
+/// at rest of law `block`.
+fn rotation_warnings(disk: &str, block: &str) -> Vec<String> {
+    let mut s = scene(
+        &format!(
+            "[[body]]\nshape = \"disk\"\ncentre = [1.5, 1.5]\nradius = 0.5\ncount = [8, 8]\nmaterial = {{ model = \"{disk}\", young = 1e4, poisson = 0.3, density = 1.0 }}\ninitial_velocity = {{ kind = \"rigid-rotation\", omega = 4.0, centre = [1.5, 1.5] }}\n\n[[body]]\nmin = [3.0, 3.0]\nmax = [3.5, 3.5]\ncount = [2, 2]\nmaterial = {{ model = \"{block}\", young = 1e4, poisson = 0.3, density = 1.0 }}"
+        ),
+        "",
+    );
+    s.time.t_end = 0.03;
+    let summary = simulation::run(&s, &mut |_| {}).unwrap();
+    assert!(summary.failure.is_none(), "{:?}", summary.failure);
+    assert!(summary.max_rotation > 0.1, "{}", summary.max_rotation);
+    summary.warnings
+}
+
+#[test]
+fn the_rotation_warning_concerns_the_bodies_of_the_papers_law_only() {
+    let warned = rotation_warnings("linear-elastic", "corotational");
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(warned[0].contains("not objective"), "{warned:?}");
+    assert!(rotation_warnings("corotational", "linear-elastic").is_empty());
+}
