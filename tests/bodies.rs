@@ -516,3 +516,23 @@ fn the_rotation_warning_concerns_the_bodies_of_the_papers_law_only() {
     assert!(warned[0].contains("not objective"), "{warned:?}");
     assert!(rotation_warnings("corotational", "linear-elastic").is_empty());
 }
+
+#[test]
+fn scenes_with_shaped_bodies_and_own_materials_round_trip() {
+    let text = scene_text(
+        &format!(
+            "[[body]]\nshape = \"polygon\"\noutline = [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]\nholes = [[[1.7, 1.2], [1.9, 1.2], [1.9, 1.4]]]\nspacing = [0.1, 0.1]\nmaterial = {{ young = 2e4, density = 3.0 }}\n\n[[body]]\nshape = \"disk\"\ncentre = [3.0, 3.0]\nradius = 0.5\ncount = [8, 8]\njitter = 0.2\nmaterial = {{ model = \"neo-hookean\", young = 1e3, poisson = 0.2, density = 1.0 }}\ninitial_velocity = {{ kind = \"rigid-rotation\", omega = 1.0, centre = [3.0, 3.0] }}\n\n[[body]]\nshape = \"gmsh\"\nfile = \"{}\"\nsurface = 10\nmaterial = {{ young = 5e3, density = 1.0 }}",
+            two_surfaces()
+        ),
+        "",
+    )
+    .replace("[material]\nyoung = 1e4\npoisson = 0.3\ndensity = 1.0\n", "");
+    let scene = Scene::from_toml(&text, "shapes.toml").unwrap();
+    // Without [material], the first body's is the scene's (unused) default.
+    assert_eq!(scene.material, scene.bodies[0].material.unwrap());
+    let back = Scene::from_toml(&scene.to_toml(), "back.toml").unwrap();
+    assert_eq!(back, scene);
+    let l = particle_lattice(&scene).unwrap();
+    assert_eq!(l.body_sizes.len(), 3);
+    assert_eq!(l.body_sizes[2], 6);
+}
