@@ -184,6 +184,24 @@ fn a_gmsh_surface_gets_quadrature_points_whose_volumes_sum_to_its_area() {
     ));
     assert_eq!(by_tag.positions.len(), 6);
     assert_eq!(by_tag.bounds, vec![([0.5, 0.0], [1.0, 1.0])]);
+    // Split twice: 16 pieces per triangle, one particle each, the same area.
+    let split = lattice(&format!(
+        "[[body]]\nshape = \"gmsh\"\nfile = \"{}\"\nsurface = \"left\"\nper_triangle = 1\nsubdivide = 2",
+        two_surfaces()
+    ));
+    assert_eq!(split.positions.len(), 32);
+    assert!((total(&split) - 0.5).abs() < 1e-15);
+    assert!(split
+        .volumes
+        .iter()
+        .all(|&v| (v - 0.25 / 16.0).abs() < 1e-15));
+    let mut xs: Vec<[f64; 2]> = split.positions.clone();
+    xs.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    xs.dedup();
+    assert_eq!(xs.len(), 32);
+    assert!(xs
+        .iter()
+        .all(|p| p[0] > 0.0 && p[0] < 0.5 && p[1] > 0.0 && p[1] < 1.0));
     // Both halves as two bodies side by side: they touch, they do not overlap.
     let both = lattice(&format!(
         "[[body]]\nshape = \"gmsh\"\nfile = \"{f}\"\nsurface = \"left\"\n\n[[body]]\nshape = \"gmsh\"\nfile = \"{f}\"\nsurface = \"right\"",
@@ -393,6 +411,18 @@ fn bad_bodies_are_errors_naming_the_field() {
             "body[0].surface",
             ErrorKind::Unknown,
             "no physical surface `middle` with triangles (it has: left, right)",
+        ),
+        (
+            scene_text(
+                &format!(
+                    "[[body]]\nshape = \"gmsh\"\nfile = \"{}\"\nsurface = \"left\"\nsubdivide = 9",
+                    two_surfaces()
+                ),
+                "",
+            ),
+            "body[0].subdivide",
+            ErrorKind::Value,
+            "must be in 0..=8",
         ),
         (
             scene_text(

@@ -17,6 +17,10 @@ const LATTICE: [BodyShape; 3] = [BodyShape::Box, BodyShape::Polygon, BodyShape::
 /// Particles a Gmsh body places per triangle when it does not say.
 pub const DEFAULT_PER_TRIANGLE: usize = 3;
 
+/// Most times a Gmsh body's triangles may be split into four (`4^8 = 65 536`
+/// pieces per triangle).
+pub const MAX_SUBDIVIDE: u32 = 8;
+
 impl Scene {
     /// Checks every body; the error names the field (`body[1].radius`).
     pub(super) fn validate_bodies(&self) -> Result<(), SceneError> {
@@ -91,7 +95,7 @@ impl Scene {
                 ),
             ));
         }
-        let present: [(&str, bool, &[BodyShape]); 14] = [
+        let present: [(&str, bool, &[BodyShape]); 15] = [
             ("min", !body.min.is_empty(), &[BodyShape::Box]),
             ("max", !body.max.is_empty(), &[BodyShape::Box]),
             ("outline", !body.outline.is_empty(), &[BodyShape::Polygon]),
@@ -105,6 +109,7 @@ impl Scene {
                 body.per_triangle.is_some(),
                 &[BodyShape::Gmsh],
             ),
+            ("subdivide", body.subdivide.is_some(), &[BodyShape::Gmsh]),
             ("per_block", body.per_block.is_some(), &LATTICE),
             ("count", body.count.is_some(), &LATTICE),
             ("spacing", body.spacing.is_some(), &LATTICE),
@@ -227,6 +232,14 @@ impl Scene {
                         return Err(bad(
                             field("per_triangle"),
                             format!("must be 1 or 3, got {n}"),
+                        ));
+                    }
+                }
+                if let Some(k) = body.subdivide {
+                    if k > MAX_SUBDIVIDE {
+                        return Err(bad(
+                            field("subdivide"),
+                            format!("must be in 0..={MAX_SUBDIVIDE}, got {k}"),
                         ));
                     }
                 }

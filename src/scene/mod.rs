@@ -77,7 +77,7 @@ mod names;
 mod validate;
 
 pub use annotate::annotate;
-pub use bodies::{region_polygon, DEFAULT_PER_TRIANGLE};
+pub use bodies::{region_polygon, DEFAULT_PER_TRIANGLE, MAX_SUBDIVIDE};
 pub use builtin::BUILTIN;
 pub use limits::{MAX_BLOCKS, MAX_PARTICLES};
 pub use names::{parse_split, split_to_str};
@@ -323,6 +323,11 @@ pub struct Body {
     /// default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub per_triangle: Option<usize>,
+    /// Gmsh: split each triangle this many times into four (at its edge midpoints)
+    /// before placing `per_triangle` particles in each piece: `4^subdivide` times as
+    /// many particles, for a file whose triangles are coarse for the scene's mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subdivide: Option<u32>,
     /// Particles per mesh block along each axis (block and interval meshes): the
     /// lattice spacing is the block size divided by this.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -156,7 +156,13 @@ fn check_overlaps(lattice: &Lattice, regions: &[Region]) -> Result<(), SceneErro
             if i == j {
                 continue;
             }
-            if let Some(p) = particles.iter().find(|&&p| region.contains(p)) {
+            // Only particles in the other region's bounding box can lie in it.
+            let (lo, hi) = lattice.bounds[i];
+            let in_box = |p: &[f64; 2]| (0..2).all(|k| lo[k] <= p[k] && p[k] <= hi[k]);
+            if let Some(p) = particles
+                .iter()
+                .find(|&&p| in_box(&p) && region.contains(p))
+            {
                 let (a, b) = (i.min(j), i.max(j));
                 return Err(SceneError::new(
                     format!("body[{b}]"),

@@ -5,7 +5,9 @@
 //! for the overlap check.
 
 use crate::scene::limits::{read_bounded, MAX_MESH_FILE_BYTES, MAX_PARTICLES};
-use crate::scene::{region_polygon, Body, BodyShape, ErrorKind, SceneError, DEFAULT_PER_TRIANGLE};
+use crate::scene::{
+    region_polygon, Body, BodyShape, ErrorKind, SceneError, DEFAULT_PER_TRIANGLE, MAX_SUBDIVIDE,
+};
 use psmpm_basis::mesh::generators::PolygonDomain;
 use psmpm_basis::mesh::gmsh::parse_msh_with_surfaces;
 use psmpm_basis::Vec2;
@@ -138,8 +140,10 @@ pub(crate) fn fill_lattice(
 }
 
 /// The particles of Gmsh body `b`: `per_triangle` points of a quadrature rule in
-/// every triangle of its physical surface, each with volume weight × area (so the
-/// volumes sum to the surface's area), and the surface's triangles as its region.
+/// every triangle of its physical surface (in each of its `4^subdivide` pieces
+/// after `subdivide` splits at the edge midpoints), each with volume weight × area
+/// (so the volumes sum to the surface's area), and the surface's triangles as its
+/// region.
 pub(crate) fn fill_surface(
     b: usize,
     body: &Body,
@@ -189,22 +193,49 @@ pub(crate) fn fill_surface(
     let chosen: Vec<usize> = (0..mesh.num_triangles())
         .filter(|&t| surfaces.of_triangle[t] == Some(tag))
         .collect();
-    if chosen.len().saturating_mul(rule.len()) > room {
+    let splits = body.subdivide.unwrap_or(0).min(MAX_SUBDIVIDE);
+    let count = chosen
+        .len()
+        .saturating_mul(rule.len())
+        .saturating_mul(1usize << (2 * splits));
+    if count > room {
         return Err(too_many(b, body));
     }
     let mut filled = Filled {
-        positions: Vec::with_capacity(chosen.len() * rule.len()),
-        volumes: Vec::with_capacity(chosen.len() * rule.len()),
+        positions: Vec::with_capacity(count),
+        volumes: Vec::with_capacity(count),
         bounds: ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
     };
     let mut triangles = Vec::with_capacity(chosen.len());
+    let mut pieces = Vec::new();
     for &t in &chosen {
         let corners = mesh.triangle_points(t);
-        let area = mesh.area(t);
-        for bary in rule {
-            let p = corners[0] * bary[0] + corners[1] * bary[1] + corners[2] * bary[2];
-            filled.positions.push([p.x, p.y]);
-            filled.volumes.push(weight * area);
+        // The pieces of `splits` midpoint splits, depth first (the triangle itself
+        // without splits).
+        pieces.push((corners, splits));
+        while let Some((c, depth)) = pieces.pop() {
+            if depth > 0 {
+                let m = [
+                    (c[0] + c[1]) * 0.5,
+                    (c[1] + c[2]) * 0.5,
+                    (c[2] + c[0]) * 0.5,
+                ];
+                pieces.push(([m[0], m[1], m[2]], depth - 1));
+                pieces.push(([m[2], m[1], c[2]], depth - 1));
+                pieces.push(([m[0], c[1], m[1]], depth - 1));
+                pieces.push(([c[0], m[0], m[2]], depth - 1));
+                continue;
+            }
+            let area = if depth == splits {
+                mesh.area(t)
+            } else {
+                psmpm_basis::mesh::signed_area(c[0], c[1], c[2]).abs()
+            };
+            for bary in rule {
+                let p = c[0] * bary[0] + c[1] * bary[1] + c[2] * bary[2];
+                filled.positions.push([p.x, p.y]);
+                filled.volumes.push(weight * area);
+            }
         }
         for c in &corners {
             let (lo, hi) = &mut filled.bounds;

@@ -404,7 +404,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .expect("material.young_modulus: unknown field `young_modulus`, expected one of `model`, `young`, `poisson`, `density`"),
         case("unknown-field-in-body", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, 4]\n@@speed = 1.0")
-            .expect("body[0].speed: unknown field `speed`, expected one of `shape`, `min`, `max`, `outline`, `holes`, `centre`, `radius`, `file`, `surface`, `per_triangle`, `per_block`, `count`, `spacing`, `jitter`, `seed`, `material`, `initial_velocity`"),
+            .expect("body[0].speed: unknown field `speed`, expected one of `shape`, `min`, `max`, `outline`, `holes`, `centre`, `radius`, `file`, `surface`, `per_triangle`, `subdivide`, `per_block`, `count`, `spacing`, `jitter`, `seed`, `material`, `initial_velocity`"),
         case("unknown-field-in-boundary", BAR)
             .edit("tag = \"right\"", "tag = \"right\"\n@@fixed = true")
             .expect("boundary[1].fixed: unknown field `fixed`, expected `tag` or `fix`"),
