@@ -462,6 +462,15 @@ fn bad_bodies_are_errors_naming_the_field() {
         ),
         (
             scene_text(
+                "[[body]]\nshape = \"disk\"\ncentre = [2.0, 2.0]\nradius = 1e-200\nspacing = [1e-200, 1e-200]",
+                "",
+            ),
+            "body[0].spacing",
+            ErrorKind::Value,
+            "would have mass 0e0",
+        ),
+        (
+            scene_text(
                 "[[body]]\nshape = \"disk\"\ncentre = [2.0, 2.0]\nradius = 0.1\nspacing = [0.5, 0.5]",
                 "",
             ),

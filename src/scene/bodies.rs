@@ -63,7 +63,17 @@ impl Scene {
             let mass = density * volume;
             if !(mass > 0.0 && mass.is_finite()) {
                 let field = if !(volume > 0.0 && volume.is_finite()) {
-                    format!("body[{b}].max")
+                    // The lattice cell: the box's extent, or the lattice's field.
+                    let lattice = if body.shape.is_box() {
+                        "max"
+                    } else if body.spacing.is_some() {
+                        "spacing"
+                    } else if body.count.is_some() {
+                        "count"
+                    } else {
+                        "per_block"
+                    };
+                    format!("body[{b}].{lattice}")
                 } else if body.material.is_some() {
                     format!("body[{b}].material.density")
                 } else {
