@@ -185,6 +185,11 @@ mod tests {
         assert_eq!(s(0), Material::<f64, 2>::stress(&soft, &f));
         assert_eq!(s(1), Material::<f64, 2>::stress(&stiff, &f));
         assert_eq!(s(2), s(0));
+        // The strain energy of each particle is that of its own law.
+        let w = |p| ParticleMaterials::<f64, 2>::energy_density(&table, p, &f);
+        assert_eq!(w(0), Material::<f64, 2>::energy_density(&soft, &f));
+        assert_eq!(w(1), Material::<f64, 2>::energy_density(&stiff, &f));
+        assert!(w(1) > 50.0 * w(0));
         assert_eq!(ParticleMaterials::<f64, 2>::elastic(&table, 3).young, 100.0);
         // One law in use: no per-particle lookup.
         assert_eq!(
