@@ -6,6 +6,9 @@
 //! phase timers: `cargo run --release -p mpm-cli -- run column-small --blocks 4x32
 //! --particles 8x10 --t-end 0.01 --basis ps --diag-every 0` prints it.
 //!
+//! Materials: the `materials` group steps the same particles with one law, a
+//! one-law table and a two-law table (`cargo bench --bench step -- materials`).
+//!
 //! Threads: the `threads` group steps about 1e5 particles (8 × 64 blocks, 8 × 24
 //! particles per block: 98 304) with PL lumped, PS lumped, PS consistent and PS
 //! with the default mass, on a pool of one thread and on one of all cores
@@ -20,7 +23,8 @@ use psmpm::basis::{Basis, TriMesh};
 use psmpm::driver::{Driver, Fix};
 use psmpm::effect::{Effect, Gravity};
 use psmpm::mass::{Consistent, Lumped, MassKind, MassStrategy};
-use psmpm::material::{Elastic, LinearElastic};
+use psmpm::material::{AnyMaterial, Corotational, Elastic, LinearElastic};
+use psmpm::materials::{MaterialTable, ParticleMaterials};
 use psmpm::particles::Particles;
 
 const BLOCKS: (usize, usize) = (4, 32);
@@ -68,6 +72,16 @@ fn driver_with<B: Basis<f64, 2>, M: MassStrategy<f64>>(
     mass: M,
     particles: Particles<f64, 2>,
 ) -> Driver<f64, 2, B, M, LinearElastic> {
+    let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
+    driver_of(basis, mass, particles, material)
+}
+
+fn driver_of<B: Basis<f64, 2>, M: MassStrategy<f64>, Mat: ParticleMaterials<f64, 2>>(
+    basis: B,
+    mass: M,
+    particles: Particles<f64, 2>,
+    material: Mat,
+) -> Driver<f64, 2, B, M, Mat> {
     let fixes = [
         Fix {
             tag: "bottom".into(),
@@ -89,7 +103,6 @@ fn driver_with<B: Basis<f64, 2>, M: MassStrategy<f64>>(
     let effects: Vec<Box<dyn Effect<f64, 2>>> = vec![Box::new(Gravity {
         g: Vector2::new(0.0, -9.81),
     })];
-    let material = LinearElastic::new(Elastic::new(5e4, 0.0, 1.0).unwrap(), 2);
     Driver::new(basis, particles, material, mass, &fixes, effects, 1e-5).unwrap()
 }
 
@@ -164,6 +177,46 @@ mod threads {
     #[divan::bench(args = thread_counts(), sample_count = 10, sample_size = 1)]
     fn ps_default(bencher: divan::Bencher, threads: usize) {
         bench_on(bencher, threads, ps(), "default");
+    }
+}
+
+/// The cost of the law of each particle: a PS lumped step of the 10 240 particles
+/// with the scene's law as one `AnyMaterial` (before bodies had their own
+/// materials), as a one-law `MaterialTable` (what a single-material scene runs
+/// now), and as a two-law table (the upper half of the column ten times stiffer).
+mod materials {
+    use super::*;
+
+    fn law(young: f64) -> AnyMaterial {
+        AnyMaterial::Corotational(Corotational::new(Elastic::new(young, 0.0, 1.0).unwrap(), 2))
+    }
+
+    fn bench_with<Mat: ParticleMaterials<f64, 2>>(bencher: divan::Bencher, material: Mat) {
+        let ps = PowellSabin::<f64>::new(mesh(), SplitPoint::Incentre).unwrap();
+        let mut d = driver_of(ps, Lumped::default(), particles(), material);
+        bencher.bench_local(|| d.step().unwrap());
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn one_law(bencher: divan::Bencher) {
+        bench_with(bencher, law(5e4));
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn uniform_table(bencher: divan::Bencher) {
+        bench_with(bencher, MaterialTable::uniform(law(5e4)));
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn two_law_table(bencher: divan::Bencher) {
+        let p = particles();
+        let law_of: Vec<usize> = (0..p.len())
+            .map(|i| usize::from(p.x[i][1] > 12.5))
+            .collect();
+        bench_with(
+            bencher,
+            MaterialTable::new(&[law(5e4), law(5e5)], &law_of).unwrap(),
+        );
     }
 }
 

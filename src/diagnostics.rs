@@ -4,7 +4,7 @@
 
 use crate::effect::Effect;
 use crate::mass::MassReport;
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::particles::Particles;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
@@ -105,7 +105,7 @@ pub struct Energies {
 }
 
 /// The energies and momentum of `parts` under `material` and `effects`.
-pub fn energies<T: Scalar, const D: usize, Mat: Material<T, D>>(
+pub fn energies<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     parts: &Particles<T, D>,
     material: &Mat,
     effects: &[Box<dyn Effect<T, D>>],
@@ -122,7 +122,7 @@ pub fn energies<T: Scalar, const D: usize, Mat: Material<T, D>>(
 /// (1 or 0), `m`, `m v` (up to two components). Computed apart (in parallel by the
 /// driver) and summed by [`energies_from_terms`] in particle order, the sums are
 /// those of [`energies`], bit for bit.
-pub fn particle_terms<T: Scalar, const D: usize, Mat: Material<T, D>>(
+pub fn particle_terms<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     parts: &Particles<T, D>,
     material: &Mat,
     p: usize,
@@ -132,7 +132,7 @@ pub fn particle_terms<T: Scalar, const D: usize, Mat: Material<T, D>>(
     let mut terms = [0.0; 8];
     terms[0] = 0.5 * m * speed2;
     terms[1] = speed2.sqrt();
-    terms[2] = parts.volume0[p].to_f64() * material.energy_density(&parts.f[p]).to_f64();
+    terms[2] = parts.volume0[p].to_f64() * material.energy_density(p, &parts.f[p]).to_f64();
     if parts.sigma0[p] != SMatrix::<T, D, D>::zeros() {
         // First-order work of the initial stress: V⁰ σ⁰ : (sym F − I).
         let f = &parts.f[p];

@@ -65,6 +65,7 @@ pub mod driver;
 pub mod effect;
 pub mod mass;
 pub mod material;
+pub mod materials;
 pub mod output;
 pub mod particles;
 pub mod scene;

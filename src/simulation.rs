@@ -314,6 +314,8 @@ struct Tally {
     interrupted: bool,
     seconds: f64,
     max_rotation: f64,
+    /// The largest rotation of the particles of the paper's non-objective law.
+    max_rotation_non_objective: f64,
 }
 
 /// The tracked particles: the particle nearest each of the scene's tracked points.
@@ -380,6 +382,9 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
+    let mut max_rotation_non_objective = driver
+        .material()
+        .max_rotation_of_non_objective(&driver.particles.f, max_rotation);
     let mut interrupted = false;
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
@@ -414,7 +419,13 @@ where
             rms.finish_step();
         }
         if r.step % ROTATION_EVERY == 0 {
-            max_rotation = max_rotation.max(crate::material::max_rotation(&driver.particles.f));
+            let now = crate::material::max_rotation(&driver.particles.f);
+            max_rotation = max_rotation.max(now);
+            max_rotation_non_objective = max_rotation_non_objective.max(
+                driver
+                    .material()
+                    .max_rotation_of_non_objective(&driver.particles.f, now),
+            );
         }
         on_step(&r, driver.particles.view());
         scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
@@ -447,6 +458,7 @@ where
         interrupted,
         seconds: clock.elapsed().as_secs_f64(),
         max_rotation,
+        max_rotation_non_objective,
     }
 }
 
@@ -511,15 +523,16 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
         && energy_growth < STABLE_ENERGY_GROWTH
         && max_condition.is_none_or(|c| c < STABLE_CONDITION);
     let driver = run.driver;
-    let max_rotation = tally
-        .max_rotation
-        .max(crate::material::max_rotation(&driver.particles.f));
-    let warnings = match scene.material.model {
-        crate::scene::MaterialModel::LinearElastic => {
-            crate::material::rotation_warning(max_rotation)
-        }
-        _ => None,
-    };
+    let now = crate::material::max_rotation(&driver.particles.f);
+    let max_rotation = tally.max_rotation.max(now);
+    // The warning concerns the particles of the paper's non-objective law only.
+    let warnings = crate::material::rotation_warning(
+        tally.max_rotation_non_objective.max(
+            driver
+                .material()
+                .max_rotation_of_non_objective(&driver.particles.f, now),
+        ),
+    );
     Outcome {
         summary: Summary {
             scene: scene.name.clone(),

@@ -28,9 +28,7 @@ fn bar_1d(effects: Vec<EffectSpec>, t_end: f64) -> Scene {
         min: vec![0.0],
         max: vec![1.0],
         per_block: Some(vec![4]),
-        count: None,
-        jitter: 0.0,
-        seed: None,
+        ..Body::default()
     }];
     s.initial_velocity = InitialVelocity::Rest {};
     s.boundaries = vec![BoundaryCondition {

@@ -71,6 +71,16 @@ const PROBES: &[(&str, bool, &str)] = &[
         "[initial_velocity]\nkind = \"exact\"\nzzz = 0",
     ),
     (
+        "### `[initial_velocity]` with `kind = \"rigid-rotation\"`",
+        true,
+        "[initial_velocity]\nkind = \"rigid-rotation\"\nomega = 1.0\ncentre = [0.0, 0.0]\nzzz = 0",
+    ),
+    (
+        "### `[initial_velocity]` with `kind = \"linear\"`",
+        true,
+        "[initial_velocity]\nkind = \"linear\"\nvalue = [0.0, 0.0]\norigin = [0.0, 0.0]\ngradient = [[0.0, 0.0], [0.0, 0.0]]\nzzz = 0",
+    ),
+    (
         "## `[[boundary]]`",
         false,
         "[[boundary]]\ntag = \"bottom\"\nfix = [\"y\"]\nzzz = 0",

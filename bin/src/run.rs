@@ -12,7 +12,7 @@ use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
 use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
-use psmpm::scene::{parse_split, BlockLayout, MeshSpec, Scene, SceneError};
+use psmpm::scene::{parse_split, BlockLayout, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
 use std::io::Write;
@@ -236,8 +236,8 @@ pub fn run_error(scene: &str, e: RunError) -> CliError {
     }
 }
 
-/// Reads a scene: a built-in name or a `.toml` file (a relative Gmsh path in it is
-/// taken relative to the file).
+/// Reads a scene: a built-in name or a `.toml` file (relative Gmsh paths in it, of
+/// the mesh and of bodies, are taken relative to the file).
 pub fn read_scene(name: &str) -> Result<Scene, CliError> {
     if name.ends_with(".toml") {
         use psmpm::scene::limits::{echo, read_bounded, MAX_SCENE_FILE_BYTES};
@@ -250,13 +250,8 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
             ))
         })?;
         let mut s = Scene::from_toml(&text, name).map_err(|e| CliError::Input(e.to_string()))?;
-        if let MeshSpec::Gmsh { file } = &mut s.mesh {
-            let path = std::path::Path::new(file.as_str());
-            if path.is_relative() {
-                if let Some(dir) = std::path::Path::new(name).parent() {
-                    *file = dir.join(path).to_string_lossy().into_owned();
-                }
-            }
+        if let Some(dir) = std::path::Path::new(name).parent() {
+            s.resolve_paths(dir);
         }
         Ok(s)
     } else {

@@ -1,13 +1,13 @@
 //! The critical time step of the explicit update for the basis and mass strategy in
 //! use: `Δt_crit = 2 / ω_max` with `ω_max² = λ_max(M⁻¹ K)`, `M` the system the mass
 //! strategy solves (its own inverse, walls included) and `K` the small-strain
-//! stiffness `K v = Σ_p V_p σ(∇v_p) ∇phi_i` with the material's Lamé constants at
+//! stiffness `K v = Σ_p V_p σ(∇v_p) ∇phi_i` with each particle's Lamé constants at
 //! the current particle positions. `λ_max` by power iteration: a lower bound, so the
 //! estimate is an upper bound on `Δt_crit` that tightens with the iterations.
 
 use super::{phases, Driver, StepError};
 use crate::mass::MassStrategy;
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
 use psmpm_basis::Basis;
@@ -20,7 +20,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// The critical time step at the current state (see the module doc). Uses the
     /// step's own buffers; call before a step (e.g. at the start of a run).
@@ -28,7 +28,33 @@ where
         self.locate_and_evaluate()?;
         self.assemble_mass();
         self.factorize()?;
-        let (lambda, mu) = self.material.elastic().lame(D);
+        let critical = self.power_iteration(None)?;
+        self.dt_critical = Some(critical);
+        Ok(critical)
+    }
+
+    /// The critical time step with the row-sum lumped mass `m_i = Σ_p m_p phi_i(x_p)`
+    /// in place of the strategy's system, at the state of the last
+    /// [`Driver::critical_time_step`] (whose evaluations it reuses). A strategy's
+    /// step far below this one (the consistent mass's is typically within a factor
+    /// of 2–4) means its mass matrix is nearly singular: too few particles for the
+    /// functions it solves for, or functions with almost no support.
+    pub fn lumped_critical_time_step(&mut self) -> Result<f64, StepError> {
+        let n = self.basis.num_functions();
+        let mut lumped = vec![0.0; n];
+        for p in 0..self.particles.len() {
+            let m = self.particles.mass[p].to_f64();
+            for s in self.evals.range(p) {
+                lumped[self.evals.index[s]] += m * self.evals.phi[s].to_f64();
+            }
+        }
+        self.power_iteration(Some(&lumped))
+    }
+
+    /// `2 / √λ_max(M⁻¹K)` by power iteration, `M` the strategy's system (`None`) or
+    /// the diagonal `lumped` (its zero entries, functions without particles, left
+    /// out).
+    fn power_iteration(&mut self, lumped: Option<&[f64]>) -> Result<f64, StepError> {
         let n = self.basis.num_functions();
         // Start: a fixed, non-smooth field (excites the highest modes).
         let mut v: Vec<Vec<T>> = (0..D)
@@ -61,38 +87,57 @@ where
             v.iter_mut()
                 .flat_map(|c| c.iter_mut())
                 .for_each(|a| *a /= T::of(nv));
-            stiffness_product(&self.evals, &self.particles.volume, lambda, mu, &v, &mut f);
-            for k in 0..D {
-                if let Err(source) = self.mass.solve(k, &mut f[k]) {
-                    return Err(self.mass_failure(source));
+            let material = &self.material;
+            stiffness_product(
+                &self.evals,
+                &self.particles.volume,
+                |p| material.elastic(p).lame(D),
+                &v,
+                &mut f,
+            );
+            match lumped {
+                None => {
+                    for k in 0..D {
+                        if let Err(source) = self.mass.solve(k, &mut f[k]) {
+                            return Err(self.mass_failure(source));
+                        }
+                    }
+                }
+                Some(m) => {
+                    for fk in f.iter_mut() {
+                        for (fi, &mi) in fk.iter_mut().zip(m) {
+                            *fi = if mi > 0.0 { *fi / T::of(mi) } else { T::zero() };
+                        }
+                    }
                 }
             }
             self.constraints.project(&mut f);
             estimate = norm(&f);
             std::mem::swap(&mut v, &mut f);
         }
-        let critical = if estimate > 0.0 {
+        Ok(if estimate > 0.0 {
             2.0 / estimate.sqrt()
         } else {
             f64::INFINITY
-        };
-        self.dt_critical = Some(critical);
-        Ok(critical)
+        })
     }
 }
 
 /// `f_i = Σ_p V_p σ(∇v_p) ∇phi_i(x_p)` with the small-strain law
-/// `σ = λ tr(ε) I + 2 μ ε`, `ε = sym ∇v` (the stiffness applied to `v`).
+/// `σ = λ_p tr(ε) I + 2 μ_p ε`, `ε = sym ∇v`, and the Lamé constants `lame(p)` of
+/// each particle's material (the stiffness applied to `v`; with bodies of several
+/// materials, each particle's own, so the estimate is that of the stiffest mode of
+/// the whole system).
 fn stiffness_product<T: Scalar, const D: usize>(
     evals: &phases::Evaluations<T, D>,
     volume: &[T],
-    lambda: f64,
-    mu: f64,
+    lame: impl Fn(usize) -> (f64, f64),
     v: &[Vec<T>],
     f: &mut [Vec<T>],
 ) {
     phases::zero(f);
     for p in 0..volume.len() {
+        let (lambda, mu) = lame(p);
         let mut grad = SMatrix::<T, D, D>::zeros();
         for s in evals.range(p) {
             let i = evals.index[s];
@@ -178,8 +223,7 @@ mod tests {
             stiffness_product(
                 &driver.evals,
                 &driver.particles.volume,
-                lambda,
-                mu,
+                |_| (lambda, mu),
                 &v,
                 &mut f,
             );

@@ -5,7 +5,7 @@
 use super::{phases, Driver, StepError};
 use crate::diagnostics::{energies, energies_from_terms, particle_terms, Energies, StepReport};
 use crate::mass::MassStrategy;
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use psmpm_basis::Basis;
 use rayon::prelude::*;
@@ -15,7 +15,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// [`energies`] of the current state, the per-particle terms computed in
     /// parallel and summed in particle order (the same sums, bit for bit).

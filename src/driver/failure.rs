@@ -3,8 +3,13 @@
 //! critical one, an inversion below it.
 
 use super::{phases, to_f64_point, Driver, UNDER_SUPPORTED_COVERAGE};
+
+/// A strategy's critical step this many times below the lumped mass's means its
+/// mass matrix is nearly singular (an invertible particle mass matrix stays within
+/// a factor of about 2–4 of its row sums' step).
+pub const NEARLY_SINGULAR: f64 = 10.0;
 use crate::mass::{MassError, MassStrategy, SupportFacts};
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use psmpm_basis::Basis;
 use psmpm_basis::BasisError;
@@ -14,7 +19,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// The worst-covered function with particles in its support, when it is covered
     /// below [`UNDER_SUPPORTED_COVERAGE`] and the mass strategy treated no function at
@@ -62,6 +67,31 @@ where
     /// matrix summed from `n` particle outer products has rank at most `n`), or a
     /// function with almost no particle support that the strategy solves for.
     pub fn singular_mass_cause(&self) -> Option<String> {
+        self.singular_mass_cause_with(None)
+    }
+
+    /// [`Driver::singular_mass_cause`], and, when `critical` (the strategy's
+    /// critical step) is [`NEARLY_SINGULAR`] times or more below `lumped_critical`
+    /// (the lumped mass's), that ratio as the cause when no other is seen.
+    pub fn singular_mass_cause_with(&self, critical: Option<(f64, f64)>) -> Option<String> {
+        if let Some(cause) = self.singular_mass_cause_seen() {
+            return Some(cause);
+        }
+        let (critical, lumped) = critical?;
+        let ratio = lumped / critical;
+        (ratio >= NEARLY_SINGULAR).then(|| {
+            let occupied = (0..self.basis.num_elements())
+                .filter(|&e| self.bins.occupied(e))
+                .count()
+                .max(1);
+            format!(
+                "its critical step is {ratio:.1e} times below the lumped mass's ({lumped:.3e}; an invertible mass stays within a few times of it): {:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`",
+                self.particles.len() as f64 / occupied as f64
+            )
+        })
+    }
+
+    fn singular_mass_cause_seen(&self) -> Option<String> {
         let report = &self.last_report;
         let consistent = report.active.saturating_sub(report.treated());
         let particles = self.particles.len();
@@ -144,15 +174,34 @@ where
 
     /// The error of a failed mass solve, with what the strategy reported.
     pub(super) fn mass_failure(&self, source: MassError) -> StepError {
-        let hint = match (self.last_report.worst_coverage, &self.inputs.support) {
-            (Some((i, c)), _) => format!(
-                "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
-                point(&to_f64_point(&self.basis.function_point(i)))
-            ),
-            _ => format!(
-                "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended`), or `partial` / `lumped`",
+        let treated = self.last_report.treated();
+        let hint = if let Some(cause) = self.singular_mass_cause() {
+            cause
+        } else if treated > 0 {
+            // The strategy already treats functions (extension, lumped rows or
+            // deactivation): suggesting it again would not help.
+            let worst = match self.last_report.worst_coverage {
+                Some((i, c)) => format!(
+                    "; the worst-covered function it solves for is {i} at {}, covered to {c:.1e} of its support",
+                    point(&to_f64_point(&self.basis.function_point(i)))
+                ),
+                None => String::new(),
+            };
+            format!(
+                "`{}` treated {treated} functions and the rest is still singular{worst}: use more particles per element (`per_block` or `count`; `--particles`), or `extended-hybrid`, which also lumps the rows of functions covered below 0.75",
                 self.mass.spec()
-            ),
+            )
+        } else {
+            match self.last_report.worst_coverage {
+                Some((i, c)) => format!(
+                    "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                    point(&to_f64_point(&self.basis.function_point(i)))
+                ),
+                None => format!(
+                    "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended`), or `partial` / `lumped`",
+                    self.mass.spec()
+                ),
+            }
         };
         StepError::MassNotPositiveDefinite {
             step: self.step + 1,

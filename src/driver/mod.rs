@@ -40,7 +40,7 @@ use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{
     Constraints, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
 };
-use crate::material::Material;
+use crate::materials::ParticleMaterials;
 use crate::particles::Particles;
 use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::SVector;
@@ -75,7 +75,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// The basis.
     pub basis: B,
@@ -131,7 +131,7 @@ where
     T: Scalar,
     B: Basis<T, D>,
     M: MassStrategy<T>,
-    Mat: Material<T, D>,
+    Mat: ParticleMaterials<T, D>,
 {
     /// Sets up a run: the mass strategy's symbolic work and the basis facts it
     /// asks for, Dirichlet sets, particle location, initial stress from the
@@ -180,7 +180,7 @@ where
                     })
                 }
             }
-            particles.sigma[p] = particles.sigma0[p] + material.stress(&particles.f[p]);
+            particles.sigma[p] = particles.sigma0[p] + material.stress(p, &particles.f[p]);
         }
         let scratch = |needed: bool| {
             if needed {

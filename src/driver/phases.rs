@@ -19,7 +19,8 @@
 //! ([`Gather`]). Every sum therefore has one fixed order, whatever the threads.
 //! The binning and the gathers are in `driver/binning.rs`.
 
-use crate::material::{det, Material};
+use crate::material::det;
+use crate::materials::ParticleMaterials;
 use crate::particles::Particles;
 use crate::sparse::Scalar;
 use nalgebra::{SMatrix, SVector};
@@ -253,7 +254,7 @@ pub fn update_deformation_gradient<T: Scalar, const D: usize>(
 /// positions and displacements `x_p += Δt Σ_i v̂_i phi_i(x_p)` (eqs. (30)–(31)).
 /// [`CHUNK`] particles per task; on failure, that of the first failing particle
 /// (the particles of other chunks are updated all the same).
-pub fn update_particles<T: Scalar, const D: usize, Mat: Material<T, D>>(
+pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     evals: &Evaluations<T, D>,
     velocity: &[Vec<T>],
     dt: T,
@@ -296,7 +297,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: Material<T, D>>(
                     });
                 }
                 fs[q] = f;
-                sigma[q] = sigma0[q] + material.stress(&f);
+                sigma[q] = sigma0[q] + material.stress(p, &f);
                 volume[q] = volume0[q] * j;
                 x[q] += v_hat * dt;
                 u[q] += v_hat * dt;

@@ -98,6 +98,12 @@ pub fn annotate(text: &str) -> String {
         let key = trimmed.split(" = ").next().unwrap_or("").trim();
         let plain = trimmed.contains(" = ") && !trimmed.contains('#') && !trimmed.starts_with('#');
         if plain {
+            // A body's own `[body.material]` and `[body.initial_velocity]` take the
+            // keys of the scene's tables.
+            let table = match table.strip_prefix("body.") {
+                Some(own @ ("material" | "initial_velocity")) => own,
+                _ => table.as_str(),
+            };
             let found = entries
                 .iter()
                 .find(|e| e.table == table && e.key == key && e.kind == kind)
@@ -148,5 +154,15 @@ mod tests {
             shown.contains("# acceleration; finite [length / time²]"),
             "{shown}"
         );
+    }
+
+    #[test]
+    fn a_bodys_own_material_and_velocity_are_annotated_like_the_scenes() {
+        let text = "[[body]]\nshape = \"disk\"\nradius = 0.5\n\n[body.material]\nyoung = 1e4\n\n[body.initial_velocity]\nkind = \"rigid-rotation\"\nomega = 2.0\n";
+        let shown = annotate(text);
+        for line in shown.lines().filter(|l| l.contains(" = ")) {
+            assert!(line.contains('#'), "`{line}` has no comment:\n{shown}");
+        }
+        assert!(shown.contains("Young's modulus"), "{shown}");
     }
 }

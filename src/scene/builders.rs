@@ -1,7 +1,7 @@
 //! Changes to a scene made by the command line, comparisons (a basis with its own
 //! resolution) and refinement studies.
 
-use super::{bad, conflict, BlockLayout, MeshSpec, Scene, SceneError};
+use super::{bad, conflict, BlockLayout, BodyShape, MeshSpec, Scene, SceneError};
 use crate::bases::BasisKind;
 
 impl Scene {
@@ -25,11 +25,34 @@ impl Scene {
         Ok(())
     }
 
-    /// Sets the particles per block of every body (the first `dim` entries of `p`).
+    /// Sets the particles per block of every lattice body (the first `dim` entries
+    /// of `p`; Gmsh bodies keep their particles).
     pub fn set_particles_per_block(&mut self, p: [usize; 2]) {
         for body in &mut self.bodies {
-            body.per_block = Some(p[..self.dim].to_vec());
-            body.count = None;
+            if body.shape != BodyShape::Gmsh {
+                body.per_block = Some(p[..self.dim].to_vec());
+                body.count = None;
+                body.spacing = None;
+            }
+        }
+    }
+
+    /// Takes the relative paths of the scene's files (the Gmsh mesh, Gmsh bodies)
+    /// relative to `dir`, the directory of the scene file.
+    pub fn resolve_paths(&mut self, dir: &std::path::Path) {
+        let resolve = |file: &mut String| {
+            let path = std::path::Path::new(file.as_str());
+            if path.is_relative() {
+                *file = dir.join(path).to_string_lossy().into_owned();
+            }
+        };
+        if let MeshSpec::Gmsh { file } = &mut self.mesh {
+            resolve(file);
+        }
+        for body in &mut self.bodies {
+            if let Some(file) = &mut body.file {
+                resolve(file);
+            }
         }
     }
 
@@ -60,9 +83,10 @@ impl Scene {
                 }
             }
             if let Some(p) = &r.per_block {
-                for body in &mut s.bodies {
+                for body in s.bodies.iter_mut().filter(|b| b.shape != BodyShape::Gmsh) {
                     body.per_block = Some(p.clone());
                     body.count = None;
+                    body.spacing = None;
                 }
             }
         }
@@ -94,6 +118,9 @@ impl Scene {
                 for body in &mut s.bodies {
                     if let Some(c) = &mut body.count {
                         c.iter_mut().for_each(|n| *n *= factor);
+                    }
+                    if let Some(h) = &mut body.spacing {
+                        h.iter_mut().for_each(|h| *h /= factor as f64);
                     }
                 }
             }

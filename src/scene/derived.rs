@@ -1,16 +1,72 @@
-//! Values derived from a scene: lattice spacing, gravity, time step and step count,
+//! Values derived from a scene: a body's bounding box, material and initial
+//! velocity, lattice spacing, wave speed, gravity, time step and step count,
 //! mesh size and block counts.
 
-use super::{Body, EffectSpec, MeshSpec, Scene};
+use super::{Body, BodyShape, EffectSpec, InitialVelocity, MaterialSpec, MeshSpec, Scene};
+
+impl Body {
+    /// The bounding box `(min, max)` of the body's region (the second entries 0 in
+    /// 1D); `None` for a Gmsh body (its box is known once the file is read) or an
+    /// incomplete shape.
+    pub fn bounds(&self) -> Option<([f64; 2], [f64; 2])> {
+        match self.shape {
+            BodyShape::Box => {
+                let (mut lo, mut hi) = ([0.0; 2], [0.0; 2]);
+                if self.min.is_empty() || self.min.len() > 2 || self.min.len() != self.max.len() {
+                    return None;
+                }
+                lo[..self.min.len()].copy_from_slice(&self.min);
+                hi[..self.max.len()].copy_from_slice(&self.max);
+                Some((lo, hi))
+            }
+            BodyShape::Polygon => {
+                let first = *self.outline.first()?;
+                Some(self.outline.iter().fold((first, first), |(lo, hi), p| {
+                    (
+                        [lo[0].min(p[0]), lo[1].min(p[1])],
+                        [hi[0].max(p[0]), hi[1].max(p[1])],
+                    )
+                }))
+            }
+            BodyShape::Disk => {
+                let (c, r) = (self.centre?, self.radius?);
+                Some(([c[0] - r, c[1] - r], [c[0] + r, c[1] + r]))
+            }
+            BodyShape::Gmsh => None,
+        }
+    }
+}
 
 impl Scene {
-    /// The lattice spacing of `body` along axis `k`: the box extent over `count`, or
-    /// the mesh's block size over `per_block` (`None` when `per_block` is given on a
-    /// mesh without blocks).
+    /// The material of body `b`: its own, or the scene's.
+    pub fn body_material(&self, b: usize) -> &MaterialSpec {
+        self.bodies
+            .get(b)
+            .and_then(|body| body.material.as_ref())
+            .unwrap_or(&self.material)
+    }
+
+    /// The initial velocity of body `b`: its own, or the scene's.
+    pub fn body_velocity(&self, b: usize) -> &InitialVelocity {
+        self.bodies
+            .get(b)
+            .and_then(|body| body.initial_velocity.as_ref())
+            .unwrap_or(&self.initial_velocity)
+    }
+
+    /// The lattice spacing of `body` along axis `k`: `spacing`, the extent of the
+    /// box (of the bounding box of a polygon or disk) over `count`, or the mesh's
+    /// block size over `per_block` (`None` when `per_block` is given on a mesh without
+    /// blocks, and for Gmsh bodies).
     pub fn lattice_spacing(&self, body: &Body, k: usize) -> Option<f64> {
-        let extent = body.max[k] - body.min[k];
+        if let Some(h) = &body.spacing {
+            return h.get(k).copied();
+        }
         match (&body.count, &body.per_block) {
-            (Some(c), _) => Some(extent / c[k] as f64),
+            (Some(c), _) => {
+                let (lo, hi) = body.bounds()?;
+                Some((hi[k] - lo[k]) / *c.get(k)? as f64)
+            }
             (None, Some(per)) => {
                 let blocks = self.blocks()?;
                 let (lo, hi) = match (&self.mesh, k) {
@@ -20,7 +76,7 @@ impl Scene {
                     (MeshSpec::Blocks { y, .. }, _) => (y[0], y[1]),
                     _ => return None,
                 };
-                Some((hi - lo) / blocks[k] as f64 / per[k] as f64)
+                Some((hi - lo) / blocks[k] as f64 / *per.get(k)? as f64)
             }
             (None, None) => None,
         }
@@ -40,18 +96,24 @@ impl Scene {
     pub fn dt(&self, h: f64) -> f64 {
         match (self.time.dt, self.time.courant) {
             (Some(dt), _) => dt,
-            (None, Some(c)) => {
-                let m = &self.material;
+            (None, Some(c)) => c * self.basis.wave_length(h) / self.wave_speed(),
+            (None, None) => f64::NAN,
+        }
+    }
+
+    /// The fastest P-wave speed `√((λ + 2μ) / ρ)` of the bodies' materials.
+    pub fn wave_speed(&self) -> f64 {
+        (0..self.bodies.len().max(1))
+            .map(|b| {
+                let m = self.body_material(b);
                 let e = crate::material::Elastic {
                     young: m.young,
                     poisson: m.poisson,
                     density: m.density,
                 };
-                let speed = (e.p_modulus(self.dim) / m.density).sqrt();
-                c * self.basis.wave_length(h) / speed
-            }
-            (None, None) => f64::NAN,
-        }
+                (e.p_modulus(self.dim) / m.density).sqrt()
+            })
+            .fold(0.0, f64::max)
     }
 
     /// Steps to reach `t_end` with a fixed `dt` (rounded to the nearest integer); for

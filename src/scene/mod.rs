@@ -67,6 +67,7 @@ use psmpm_basis::basis::powell_sabin::SplitPoint;
 use serde::{Deserialize, Serialize};
 
 mod annotate;
+mod bodies;
 mod builders;
 mod builtin;
 mod derived;
@@ -76,6 +77,7 @@ mod names;
 mod validate;
 
 pub use annotate::annotate;
+pub use bodies::{region_polygon, DEFAULT_PER_TRIANGLE, MAX_SUBDIVIDE};
 pub use builtin::BUILTIN;
 pub use limits::{MAX_BLOCKS, MAX_PARTICLES};
 pub use names::{parse_split, split_to_str};
@@ -103,12 +105,14 @@ pub struct Scene {
     pub mass: MassKind,
     /// The mesh.
     pub mesh: MeshSpec,
-    /// The material.
+    /// The material of the bodies that do not give their own. A file may leave it
+    /// out when every body has its own material; the scene then takes the first
+    /// body's material here (see [`Scene::from_toml`]).
     pub material: MaterialSpec,
-    /// Bodies: boxes filled with particles.
+    /// Bodies: regions filled with particles.
     #[serde(rename = "body")]
     pub bodies: Vec<Body>,
-    /// Initial velocity of the particles.
+    /// Initial velocity of the particles of the bodies that do not give their own.
     #[serde(default)]
     pub initial_velocity: InitialVelocity,
     /// Homogeneous Dirichlet conditions per boundary tag.
@@ -267,22 +271,74 @@ pub enum MaterialModel {
     NeoHookean,
 }
 
-/// A body: the box `[min, max]` filled with particles at the cell centres of a
-/// regular lattice; the particle volume is the cell volume.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A body: a region filled with particles, with its own material and initial
+/// velocity or the scene's.
+///
+/// The region is given by `shape` (a box when absent, the only shape in 1D):
+/// - `box`: `[min, max]`;
+/// - `polygon`: `outline`, with optional `holes`;
+/// - `disk`: `centre`, `radius`;
+/// - `gmsh`: the triangles of the physical surface `surface` of the mesh `file`.
+///
+/// Box, polygon and disk bodies are filled from a regular lattice over their
+/// bounding box (spacing from `per_block`, `count` or `spacing`): a cell's particle,
+/// at its centre, is kept when the centre lies inside the region, with the cell's
+/// volume. A region whose boundary cuts cells is so approximated by whole cells: the
+/// total volume differs from the region's area by at most the area of the cells the
+/// boundary crosses (about `perimeter × spacing / 2` in the mean, going to zero with
+/// the spacing). A Gmsh body gets `per_triangle` particles in each triangle, at the
+/// points of a quadrature rule, each with volume weight × triangle area, so its total
+/// volume is the surface's area exactly.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Body {
-    /// Lower corner (`dim` entries).
+    /// The region's shape; absent means a box.
+    #[serde(default, skip_serializing_if = "BodyShape::is_box")]
+    pub shape: BodyShape,
+    /// Box: lower corner (`dim` entries).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub min: Vec<f64>,
-    /// Upper corner (`dim` entries).
+    /// Box: upper corner (`dim` entries).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub max: Vec<f64>,
+    /// Polygon: corners of the outline (either orientation, closed implicitly).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outline: Vec<[f64; 2]>,
+    /// Polygon: holes, each a list of corners.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub holes: Vec<Vec<[f64; 2]>>,
+    /// Disk: centre.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centre: Option<[f64; 2]>,
+    /// Disk: radius.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Gmsh: the `.msh` file (a relative path is relative to the scene file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// Gmsh: the physical surface, by name or by number.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<SurfaceRef>,
+    /// Gmsh: particles per triangle, 1 (centroid) or 3 (the degree-2 rule; the
+    /// default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_triangle: Option<usize>,
+    /// Gmsh: split each triangle this many times into four (at its edge midpoints)
+    /// before placing `per_triangle` particles in each piece: `4^subdivide` times as
+    /// many particles, for a file whose triangles are coarse for the scene's mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subdivide: Option<u32>,
     /// Particles per mesh block along each axis (block and interval meshes): the
     /// lattice spacing is the block size divided by this.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub per_block: Option<Vec<usize>>,
-    /// Particles along each axis of the box.
+    /// Particles along each axis of the box (of the bounding box for a polygon or
+    /// a disk).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub count: Option<Vec<usize>>,
+    /// Lattice spacing along each axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<Vec<f64>>,
     /// Moves each particle off its cell centre by a uniform random offset of up to
     /// this fraction of the lattice cell along each axis (`0 ≤ jitter < 0.5`, so
     /// particles stay in their cells); 0: the regular lattice.
@@ -292,6 +348,64 @@ pub struct Body {
     /// the same seed gives the same particles.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// The body's material; absent: the scene's `[material]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<MaterialSpec>,
+    /// The body's initial velocity; absent: the scene's `[initial_velocity]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_velocity: Option<InitialVelocity>,
+}
+
+/// The shape of a body's region.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BodyShape {
+    /// The box `[min, max]` (an interval in 1D).
+    #[default]
+    Box,
+    /// A polygon with holes.
+    Polygon,
+    /// A disk.
+    Disk,
+    /// A physical surface of a Gmsh mesh.
+    Gmsh,
+}
+
+impl BodyShape {
+    /// Whether the shape is a box (the default, not written out).
+    pub fn is_box(&self) -> bool {
+        *self == BodyShape::Box
+    }
+
+    /// The name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            BodyShape::Box => "box",
+            BodyShape::Polygon => "polygon",
+            BodyShape::Disk => "disk",
+            BodyShape::Gmsh => "gmsh",
+        }
+    }
+}
+
+/// A physical surface of a Gmsh file: its name, or its number.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum SurfaceRef {
+    /// The name from `$PhysicalNames`.
+    Name(String),
+    /// The physical tag.
+    Tag(i64),
+}
+
+impl SurfaceRef {
+    /// As text: the name, or the tag's digits.
+    pub fn text(&self) -> String {
+        match self {
+            SurfaceRef::Name(n) => n.clone(),
+            SurfaceRef::Tag(t) => t.to_string(),
+        }
+    }
 }
 
 /// The seed of a body's jitter when the scene gives none.
@@ -315,13 +429,32 @@ pub enum InitialVelocity {
         /// Velocity (`dim` entries).
         value: Vec<f64>,
     },
-    /// `v_x = v0 sin(π (x − x_min) / L)` over the first body's extent `L` along x.
+    /// `v_x = v0 sin(π (x − x_min) / L)` over the extent `[x_min, x_min + L]` along
+    /// x of the body's region (the scene-level velocity: of the first body, whichever
+    /// body it applies to).
     SineMode {
         /// Amplitude.
         v0: f64,
     },
     /// The velocity of the scene's reference solution at `t = 0`.
     Exact {},
+    /// A rigid rotation with angular velocity `omega` (radians per unit time,
+    /// counter-clockwise) about `centre`: `v = ω × (x − c) = ω (−(y − c_y), x − c_x)`.
+    RigidRotation {
+        /// Angular velocity `ω`.
+        omega: f64,
+        /// Centre of rotation `c`.
+        centre: [f64; 2],
+    },
+    /// A linear field `v = v0 + G (x − x0)`: `value` at `origin`, plus `gradient`.
+    Linear {
+        /// `v0` (`dim` entries).
+        value: Vec<f64>,
+        /// `x0` (`dim` entries).
+        origin: Vec<f64>,
+        /// `G` by rows, `G[i][j] = ∂v_i/∂x_j` (`dim` rows of `dim` entries).
+        gradient: Vec<Vec<f64>>,
+    },
 }
 
 impl Default for InitialVelocity {
@@ -578,21 +711,70 @@ fn conflict(field: impl Into<String>, message: impl Into<String>) -> SceneError 
 
 impl Scene {
     /// Parses and validates a scene file (`file` names it in errors).
+    ///
+    /// A file without `[material]` must give every body its own `material` (the
+    /// error names the first body without one); the scene then takes the first
+    /// body's material as [`Scene::material`], which no body uses.
     pub fn from_toml(text: &str, file: &str) -> Result<Self, SceneFileError> {
-        let scene: Scene = toml::from_str(text).map_err(|e| {
-            let (at, field, message) = locate::parse_error(text, &e);
-            let (line, column) = locate::line_column(text, at);
-            SceneFileError {
-                file: file.to_string(),
-                line,
-                column,
-                field,
-                kind: None,
-                message,
+        let scene: Scene = match toml::from_str(text) {
+            Ok(scene) => scene,
+            // Missing fields are reported after every present field parsed, so the
+            // rest of the file is valid here.
+            Err(e) if e.message().trim() == "missing field `material`" => {
+                match Self::with_first_body_material(text) {
+                    Ok(Some(scene)) => scene,
+                    Ok(None) => return Err(Self::parse_error(text, file, &e)),
+                    Err(e) => return Err(e.in_file(text, file)),
+                }
             }
-        })?;
+            Err(e) => return Err(Self::parse_error(text, file, &e)),
+        };
         scene.validate().map_err(|e| e.in_file(text, file))?;
         Ok(scene)
+    }
+
+    /// The scene of a file without `[material]` whose bodies all have their own,
+    /// with the first body's material as the scene's; `None` when the file has no
+    /// bodies (the missing `[material]` is then the error), an error naming the first
+    /// body without a material.
+    fn with_first_body_material(text: &str) -> Result<Option<Scene>, SceneError> {
+        let Ok(mut table) = text.parse::<toml::Table>() else {
+            return Ok(None);
+        };
+        let first = {
+            let Some(bodies) = table.get("body").and_then(|b| b.as_array()) else {
+                return Ok(None);
+            };
+            if let Some(b) = bodies
+                .iter()
+                .position(|b| b.as_table().is_none_or(|t| !t.contains_key("material")))
+            {
+                return Err(conflict(
+                    format!("body[{b}].material"),
+                    format!("the scene has no [material] for the bodies without their own, and body[{b}] has no `material` table: give it one, or add a scene-level [material]"),
+                ));
+            }
+            match bodies.first().and_then(|b| b.get("material")) {
+                Some(m) => m.clone(),
+                None => return Ok(None),
+            }
+        };
+        table.insert("material".into(), first);
+        Ok(toml::Value::Table(table).try_into::<Scene>().ok())
+    }
+
+    /// A TOML parse error, located in the file.
+    fn parse_error(text: &str, file: &str, e: &toml::de::Error) -> SceneFileError {
+        let (at, field, message) = locate::parse_error(text, e);
+        let (line, column) = locate::line_column(text, at);
+        SceneFileError {
+            file: file.to_string(),
+            line,
+            column,
+            field,
+            kind: None,
+            message,
+        }
     }
 
     /// The scene as TOML that [`Scene::from_toml`] reads back.

@@ -1,12 +1,10 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_PARTICLES,
-    MAX_STEPS, MAX_TRIANGLES,
+    MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
 };
 use super::{
-    bad, conflict, Body, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec,
-    Reference, Scene, SceneError,
+    bad, conflict, Component, EffectSpec, MaterialModel, MeshSpec, Reference, Scene, SceneError,
 };
 
 impl Scene {
@@ -127,122 +125,9 @@ impl Scene {
                 check_elements("mesh.elements", *elements)?;
             }
         }
-        crate::material::Elastic::new(
-            self.material.young,
-            self.material.poisson,
-            self.material.density,
-        )
-        .map_err(|e| {
-            let field = match &e {
-                crate::material::MaterialError::OutOfRange { name, .. } => {
-                    format!("material.{name}")
-                }
-            };
-            bad(field, e.to_string())
-        })?;
-        if self.bodies.is_empty() {
-            return Err(bad("body", "a scene needs at least one [[body]]"));
-        }
-        for (b, body) in self.bodies.iter().enumerate() {
-            let field = |f: &str| format!("body[{b}].{f}");
-            vector(&field("min"), &body.min)?;
-            vector(&field("max"), &body.max)?;
-            for k in 0..d {
-                if body.min[k] >= body.max[k] {
-                    return Err(bad(
-                        field("max"),
-                        format!(
-                            "needs min < max on every axis, got min = {:?}, max = {:?}",
-                            body.min, body.max
-                        ),
-                    ));
-                }
-            }
-            if !(0.0..0.5).contains(&body.jitter) {
-                return Err(bad(
-                    field("jitter"),
-                    format!(
-                        "must be in [0, 0.5) (a fraction of the lattice cell), got {}",
-                        body.jitter
-                    ),
-                ));
-            }
-            match (&body.per_block, &body.count) {
-                (Some(p), None) => {
-                    if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
-                        return Err(bad(
-                            field("per_block"),
-                            format!("needs {d} counts in 1..=1000, got {p:?}"),
-                        ));
-                    }
-                    if !matches!(
-                        self.mesh,
-                        MeshSpec::Blocks { .. } | MeshSpec::Interval { .. }
-                    ) {
-                        return Err(conflict(
-                            field("per_block"),
-                            "needs a `blocks` or `interval` mesh; use `count` on other meshes",
-                        ));
-                    }
-                }
-                (None, Some(c)) => {
-                    if c.len() != d || c.iter().any(|&n| n == 0 || n > 100_000) {
-                        return Err(bad(
-                            field("count"),
-                            format!("needs {d} counts in 1..=100000, got {c:?}"),
-                        ));
-                    }
-                }
-                _ => {
-                    return Err(conflict(
-                        field("per_block"),
-                        "give exactly one of `per_block` and `count`",
-                    ))
-                }
-            }
-        }
-        let particles = self.estimated_particle_count();
-        if particles > MAX_PARTICLES as f64 {
-            return Err(bad(
-                "body[0]",
-                format!(
-                    "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
-                ),
-            ));
-        }
-        for (b, body) in self.bodies.iter().enumerate() {
-            // The particle mass is ρ0 times the lattice cell volume: reject a density
-            // or a lattice so small that the product underflows to zero.
-            let volume: f64 = (0..d)
-                .map(|k| self.lattice_spacing(body, k).unwrap_or(1.0))
-                .product();
-            let mass = self.material.density * volume;
-            if !(mass > 0.0 && mass.is_finite()) {
-                let field = if volume > 0.0 && volume.is_finite() {
-                    "material.density".to_string()
-                } else {
-                    format!("body[{b}].max")
-                };
-                return Err(bad(
-                    field,
-                    format!(
-                        "the particles of body[{b}] would have mass {mass:e} (density {} times particle volume {volume:e}); it must be positive and finite",
-                        self.material.density
-                    ),
-                ));
-            }
-        }
-        match &self.initial_velocity {
-            InitialVelocity::Uniform { value } => vector("initial_velocity.value", value)?,
-            InitialVelocity::SineMode { v0 } => finite("initial_velocity.v0", *v0)?,
-            InitialVelocity::Exact {} if self.reference.is_none() => {
-                return Err(conflict(
-                    "initial_velocity.kind",
-                    "`exact` needs a [reference] solution",
-                ))
-            }
-            _ => {}
-        }
+        super::bodies::validate_material("material", &self.material)?;
+        self.validate_bodies()?;
+        self.validate_velocity("initial_velocity", &self.initial_velocity)?;
         for (i, bc) in self.boundaries.iter().enumerate() {
             if bc.fix.is_empty() {
                 return Err(bad(format!("boundary[{i}].fix"), "lists no component"));
@@ -360,7 +245,10 @@ impl Scene {
             }
             Some(Reference::AxisAligned { u0 }) => {
                 finite("reference.u0", u0)?;
-                if d != 2 || self.material.model != MaterialModel::NeoHookean {
+                if d != 2
+                    || (0..self.bodies.len())
+                        .any(|b| self.body_material(b).model != MaterialModel::NeoHookean)
+                {
                     return Err(conflict(
                         "reference.kind",
                         "`axis-aligned` is a 2D neo-Hookean solution",
@@ -368,6 +256,12 @@ impl Scene {
                 }
             }
             _ => {}
+        }
+        if self.reference.is_some() && !self.bodies[0].shape.is_box() {
+            return Err(conflict(
+                "body[0].shape",
+                "a [reference] solution is over the first body's box: body[0] must be a `box`",
+            ));
         }
         if self.steps() == 0 {
             return Err(conflict("time.t_end", "is shorter than one time step"));
@@ -439,26 +333,6 @@ impl Scene {
             }
         }
         Ok(())
-    }
-
-    /// About how many particles the bodies get together (exact for aligned boxes),
-    /// computed from the scene without building anything (validation bounds it by
-    /// [`MAX_PARTICLES`]).
-    pub fn estimated_particle_count(&self) -> f64 {
-        self.bodies
-            .iter()
-            .map(|b| self.estimated_particles(b))
-            .sum()
-    }
-
-    /// About how many particles `body` gets (exact for aligned boxes).
-    fn estimated_particles(&self, body: &Body) -> f64 {
-        (0..self.dim)
-            .map(|k| {
-                self.lattice_spacing(body, k)
-                    .map_or(1.0, |h| (body.max[k] - body.min[k]) / h)
-            })
-            .product()
     }
 }
 

@@ -10,6 +10,7 @@
 mod effects;
 mod mesh;
 mod particles;
+mod regions;
 mod solution;
 
 pub use effects::build_effects;
@@ -22,17 +23,19 @@ pub(crate) use solution::Solution;
 use crate::driver::{Driver, Fix, SetupError};
 use crate::effect::Effect;
 use crate::mass::MassStrategy;
+use crate::material::MaterialError;
 use crate::material::{AnyMaterial, Corotational, Elastic, LinearElastic, NeoHookean};
+use crate::materials::MaterialTable;
 use crate::particles::Particles;
-use crate::scene::{ErrorKind, MaterialModel, Scene, SceneError};
+use crate::scene::{ErrorKind, MaterialModel, MaterialSpec, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SVector;
 use psmpm_basis::Basis;
 
-/// The driver of a scene's run: the mass strategy and the material are chosen by
-/// the scene, at run time.
+/// The driver of a scene's run: the mass strategy and the materials (of its bodies)
+/// are chosen by the scene, at run time.
 pub type SceneDriver<const D: usize, B> =
-    Driver<f64, D, B, Box<dyn MassStrategy<f64>>, AnyMaterial>;
+    Driver<f64, D, B, Box<dyn MassStrategy<f64>>, MaterialTable>;
 
 /// A scene's basis (in one of its typed choices, or chosen), its smallest mesh
 /// length and the unit normals of its slip walls.
@@ -61,7 +64,8 @@ pub(crate) struct Prepared<const D: usize, B: Basis<f64, D>> {
     pub positions: Vec<[f64; 2]>,
     /// The reference solution.
     pub solution: Option<Solution>,
-    /// The lower corner of the first body (the origin of the reference solutions).
+    /// The lower corner of the first body's bounding box (the origin of the
+    /// reference solutions).
     pub origin: [f64; 2],
 }
 
@@ -71,13 +75,13 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     domain: Domain<B>,
 ) -> Result<Prepared<D, B>, RunError> {
-    let (material, density) = material::<D>(scene)?;
     let solution = Solution::new(scene);
-    let mut origin = [0.0; 2];
-    origin[..D].copy_from_slice(&scene.bodies[0].min[..D]);
     let lattice = particle_lattice(scene)?;
-    let mut particles = particles::place::<D>(&lattice, density);
-    particles::apply_initial_states(scene, &lattice.positions, solution, origin, &mut particles);
+    let material = materials::<D>(scene, &lattice)?;
+    let mut origin = [0.0; 2];
+    origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
+    let mut particles = particles::place::<D>(scene, &lattice);
+    particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles);
     let effects = build_effects(scene, &particles)?;
     let Domain { basis, h, walls } = domain;
     let functions = basis.num_functions();
@@ -109,7 +113,10 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         scene.time.allow_above_critical,
     ) {
         if dt > critical {
-            let cause = driver.singular_mass_cause();
+            // The lumped mass's step tells a nearly singular system from a step that
+            // is simply too long.
+            let lumped = driver.lumped_critical_time_step().ok();
+            let cause = driver.singular_mass_cause_with(lumped.map(|l| (critical, l)));
             return Err(above_critical(scene, dt, critical, cause).into());
         }
     }
@@ -125,17 +132,31 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     })
 }
 
-/// The scene's material law in `D` dimensions, and its density.
-fn material<const D: usize>(scene: &Scene) -> Result<(AnyMaterial, f64), RunError> {
-    let m = &scene.material;
-    let elastic = Elastic::new(m.young, m.poisson, m.density)
-        .map_err(|e| SceneError::new("material", ErrorKind::Value, e.to_string()))?;
-    let material = match m.model {
+/// The law of every particle of `lattice` in `D` dimensions: its body's material.
+fn materials<const D: usize>(scene: &Scene, lattice: &Lattice) -> Result<MaterialTable, RunError> {
+    let laws = (0..scene.bodies.len())
+        .map(|b| {
+            let field = if scene.bodies[b].material.is_some() {
+                format!("body[{b}].material")
+            } else {
+                "material".to_string()
+            };
+            law::<D>(scene.body_material(b))
+                .map_err(|e| SceneError::new(field, ErrorKind::Value, e.to_string()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    MaterialTable::new(&laws, &lattice.body_of_particles())
+        .map_err(|e| SceneError::new("body", ErrorKind::Value, e.to_string()).into())
+}
+
+/// The law a material declares, in `D` dimensions.
+fn law<const D: usize>(m: &MaterialSpec) -> Result<AnyMaterial, MaterialError> {
+    let elastic = Elastic::new(m.young, m.poisson, m.density)?;
+    Ok(match m.model {
         MaterialModel::LinearElastic => AnyMaterial::Linear(LinearElastic::new(elastic, D)),
         MaterialModel::NeoHookean => AnyMaterial::NeoHookean(NeoHookean::new(elastic, D)),
         MaterialModel::Corotational => AnyMaterial::Corotational(Corotational::new(elastic, D)),
-    };
-    Ok((material, elastic.density))
+    })
 }
 
 /// The one place a scene's driver is built: fixes from the boundary conditions,
@@ -146,7 +167,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     basis: B,
     particles: Particles<f64, D>,
-    material: AnyMaterial,
+    material: MaterialTable,
     effects: Vec<Box<dyn Effect<f64, D>>>,
     dt: f64,
     walls: &[(String, [f64; 2])],
@@ -184,10 +205,14 @@ fn driver<const D: usize, B: Basis<f64, D>>(
                     particle < first
                 })
                 .unwrap_or(0);
+            let field = match scene.bodies.get(body) {
+                Some(b) if b.shape.is_box() => format!("body[{body}].max"),
+                _ => format!("body[{body}]"),
+            };
             SceneError::new(
-                format!("body[{body}].max"),
+                field,
                 ErrorKind::Conflict,
-                format!("the particle at {position:?} lies outside the mesh; the body's box must lie inside the meshed domain"),
+                format!("the particle at {position:?} lies outside the mesh; the body must lie inside the meshed domain"),
             )
         }
         SetupError::Boundary { tag, message } => SceneError::new(

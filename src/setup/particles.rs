@@ -1,10 +1,13 @@
-//! The particles of a scene: the lattice filling its bodies, and the initial states
-//! (velocity, initial stress) applied to them before the run.
+//! The particles of a scene: the lattice filling its box bodies, the other shapes
+//! (regions.rs), no two bodies overlapping, and the initial states (velocity,
+//! initial stress) applied to them before the run, per body.
 
+use super::regions::{self, Region};
 use super::{to_vec, Solution};
 use crate::effect::{Geostatic, InitialStress};
 use crate::particles::Particles;
-use crate::scene::{EffectSpec, ErrorKind, InitialVelocity, Scene, SceneError};
+use crate::scene::limits::MAX_PARTICLES;
+use crate::scene::{BodyShape, EffectSpec, ErrorKind, InitialVelocity, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SMatrix;
 use std::f64::consts::PI;
@@ -13,15 +16,50 @@ use std::f64::consts::PI;
 /// fraction of one.
 const WHOLE_CELLS: f64 = 1e-6;
 
-/// Particle positions and volumes of the scene's bodies, block by block for
-/// `per_block` layouts (the order of the seeds' codes), row by row otherwise; a
-/// body's `jitter` moves each particle inside its cell (deterministic, see
-/// [`crate::scene::Body::jitter`]).
+/// Particle positions and volumes of the scene's bodies, body by body. A box is
+/// filled block by block for `per_block` layouts (the order of the seeds' codes),
+/// row by row otherwise; polygons and disks row by row over their bounding box, Gmsh
+/// surfaces triangle by triangle (see [`crate::scene::Body`]). A body's `jitter`
+/// moves each particle inside its cell (deterministic, see
+/// [`crate::scene::Body::jitter`]). Bodies must not overlap: a particle of one body
+/// inside another's region is an error naming both.
 pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
     let d = scene.dim;
     let mut lattice = Lattice::default();
+    let mut regions = Vec::with_capacity(scene.bodies.len());
     for (b, body) in scene.bodies.iter().enumerate() {
         let first = lattice.positions.len();
+        let room = MAX_PARTICLES.saturating_sub(first);
+        if body.shape != BodyShape::Box {
+            let (filled, region) = if body.shape == BodyShape::Gmsh {
+                regions::fill_surface(b, body, room)?
+            } else {
+                let region = Region::of(body, d).ok_or_else(|| {
+                    SceneError::new(format!("body[{b}]"), ErrorKind::Value, "has no region")
+                })?;
+                let mut h = [1.0; 2];
+                for (k, h) in h.iter_mut().enumerate().take(d) {
+                    *h = scene.lattice_spacing(body, k).ok_or_else(|| {
+                        SceneError::new(
+                            format!("body[{b}].per_block"),
+                            ErrorKind::Conflict,
+                            "the mesh has no blocks",
+                        )
+                    })?;
+                }
+                let mut rng = jitter_rng(body, b);
+                let filled = regions::fill_lattice(b, body, &region, h, room, || {
+                    2.0 * rng.next_f64() - 1.0
+                })?;
+                (filled, region)
+            };
+            lattice.positions.extend(filled.positions);
+            lattice.volumes.extend(filled.volumes);
+            lattice.bounds.push(filled.bounds);
+            lattice.body_sizes.push(lattice.positions.len() - first);
+            regions.push(region);
+            continue;
+        }
         let mut spacing = [1.0; 2];
         let mut cells = [1usize; 2];
         let mut group = [1usize; 2];
@@ -34,7 +72,7 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
                     "the mesh has no blocks",
                 )
             })?;
-            let n = if let Some(per) = &body.per_block {
+            let n = if body.per_block.is_some() || body.spacing.is_some() {
                 let n = extent / h;
                 if (n - n.round()).abs() > WHOLE_CELLS * n.max(1.0) || n.round() < 1.0 {
                     return Err(SceneError::new(
@@ -44,8 +82,10 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
                     )
                     .into());
                 }
-                group[k] = per[k];
-                n.round() as usize
+                let n = n.round() as usize;
+                // `per_block`: block by block; `spacing`: row by row.
+                group[k] = body.per_block.as_ref().map_or(n, |per| per[k]);
+                n
             } else {
                 let c = body.count.as_ref().map_or(1, |c| c[k]);
                 group[k] = c;
@@ -57,11 +97,7 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
         let volume: f64 = spacing[..d].iter().product();
         // Jitter: a uniform offset in [-jitter, jitter) cells per axis, drawn in the
         // order the particles are made, from a generator seeded per body.
-        let mut rng = psmpm_basis::rng::SplitMix64(
-            body.seed
-                .unwrap_or(crate::scene::DEFAULT_JITTER_SEED)
-                .wrapping_add(b as u64),
-        );
+        let mut rng = jitter_rng(body, b);
         let groups = [cells[0].div_ceil(group[0]), cells[1].div_ceil(group[1])];
         for gj in 0..groups[1] {
             for gi in 0..groups[0] {
@@ -87,8 +123,59 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
             }
         }
         lattice.body_sizes.push(lattice.positions.len() - first);
+        let bounds = body.bounds().unwrap_or_default();
+        lattice.bounds.push(bounds);
+        regions.push(Region::Box {
+            min: bounds.0,
+            max: bounds.1,
+            dim: d,
+        });
     }
+    check_overlaps(&lattice, &regions)?;
     Ok(lattice)
+}
+
+/// The generator of a body's jitter, seeded per body.
+fn jitter_rng(body: &crate::scene::Body, b: usize) -> psmpm_basis::rng::SplitMix64 {
+    psmpm_basis::rng::SplitMix64(
+        body.seed
+            .unwrap_or(crate::scene::DEFAULT_JITTER_SEED)
+            .wrapping_add(b as u64),
+    )
+}
+
+/// Bodies do not overlap: no particle of one body lies inside another's region
+/// (bodies that only touch along a boundary are fine: their particles sit inside
+/// their own cells). Two overlapping bodies would put two materials, and twice the
+/// mass, in one place.
+fn check_overlaps(lattice: &Lattice, regions: &[Region]) -> Result<(), SceneError> {
+    let mut first = 0;
+    for (j, &n) in lattice.body_sizes.iter().enumerate() {
+        let particles = &lattice.positions[first..first + n];
+        for (i, region) in regions.iter().enumerate() {
+            if i == j {
+                continue;
+            }
+            // Only particles in the other region's bounding box can lie in it.
+            let (lo, hi) = lattice.bounds[i];
+            let in_box = |p: &[f64; 2]| (0..2).all(|k| lo[k] <= p[k] && p[k] <= hi[k]);
+            if let Some(p) = particles
+                .iter()
+                .find(|&&p| in_box(&p) && region.contains(p))
+            {
+                let (a, b) = (i.min(j), i.max(j));
+                return Err(SceneError::new(
+                    format!("body[{b}]"),
+                    ErrorKind::Conflict,
+                    format!(
+                        "body[{a}] and body[{b}] overlap: the particle of body[{j}] at {p:?} lies inside body[{i}]; bodies must not overlap (they may touch)"
+                    ),
+                ));
+            }
+        }
+        first += n;
+    }
+    Ok(())
 }
 
 /// The particles of a scene's bodies before the run: positions, volumes, and how
@@ -101,73 +188,130 @@ pub struct Lattice {
     pub volumes: Vec<f64>,
     /// Particles per body.
     pub body_sizes: Vec<usize>,
+    /// Bounding box `(min, max)` of each body's region (the second entries 0 in 1D).
+    pub bounds: Vec<([f64; 2], [f64; 2])>,
 }
 
-/// The particles of `lattice` with density `density`, at rest and unstressed.
-pub(crate) fn place<const D: usize>(lattice: &Lattice, density: f64) -> Particles<f64, D> {
-    Particles::<f64, D>::new(
+impl Lattice {
+    /// The body of every particle.
+    pub fn body_of_particles(&self) -> Vec<usize> {
+        self.body_sizes
+            .iter()
+            .enumerate()
+            .flat_map(|(b, &n)| std::iter::repeat_n(b, n))
+            .collect()
+    }
+}
+
+/// The particles of `lattice`, at rest and unstressed, each with the density of its
+/// body's material (`m_p = ρ_b V_p⁰`).
+pub(crate) fn place<const D: usize>(scene: &Scene, lattice: &Lattice) -> Particles<f64, D> {
+    let mut particles = Particles::<f64, D>::new(
         lattice.positions.iter().map(|&p| to_vec::<D>(p)).collect(),
         lattice.volumes.clone(),
-        density,
-    )
+        scene.body_material(0).density,
+    );
+    for (p, b) in lattice.body_of_particles().into_iter().enumerate() {
+        particles.mass[p] = lattice.volumes[p] * scene.body_material(b).density;
+    }
+    particles
 }
 
-/// Applies the scene's initial states to the particles placed at `positions`: the
+/// Applies the scene's initial states to the particles of `lattice`: each body's
 /// initial velocity, and the geostatic initial stress (declared among the effects,
 /// but no effect: it adds no force during the run, it sets `σ⁰` of the particles).
 pub(crate) fn apply_initial_states<const D: usize>(
     scene: &Scene,
-    positions: &[[f64; 2]],
+    lattice: &Lattice,
     solution: Option<Solution>,
     origin: [f64; 2],
     particles: &mut Particles<f64, D>,
 ) {
-    initial_velocity(scene, positions, solution, origin, particles);
-    initial_stress(scene, particles);
+    let mut first = 0;
+    for (b, &n) in lattice.body_sizes.iter().enumerate() {
+        // A body's own sine mode spans its own extent, the scene's that of the
+        // first body.
+        let extent = if scene.bodies[b].initial_velocity.is_some() {
+            lattice.bounds[b]
+        } else {
+            lattice.bounds[0]
+        };
+        for p in first..first + n {
+            let v = initial_velocity(
+                scene.body_velocity(b),
+                lattice.positions[p],
+                extent,
+                solution,
+                origin,
+                D,
+            );
+            particles.v[p] = to_vec::<D>(v);
+        }
+        first += n;
+    }
+    initial_stress(scene, lattice, particles);
 }
 
-/// `v` of every particle from the scene's `initial_velocity`.
-fn initial_velocity<const D: usize>(
-    scene: &Scene,
-    positions: &[[f64; 2]],
+/// The velocity `kind` gives at `x0` (the second entry 0 in 1D); `extent` is the
+/// bounding box a sine mode spans.
+fn initial_velocity(
+    kind: &InitialVelocity,
+    x0: [f64; 2],
+    extent: ([f64; 2], [f64; 2]),
     solution: Option<Solution>,
     origin: [f64; 2],
-    particles: &mut Particles<f64, D>,
-) {
-    for (p, &x0) in positions.iter().enumerate() {
-        let v = match &scene.initial_velocity {
-            InitialVelocity::Rest {} => [0.0; 2],
-            InitialVelocity::Uniform { value } => {
-                let mut v = [0.0; 2];
-                v[..D].copy_from_slice(&value[..D]);
-                v
+    d: usize,
+) -> [f64; 2] {
+    match kind {
+        InitialVelocity::Rest {} => [0.0; 2],
+        InitialVelocity::Uniform { value } => {
+            let mut v = [0.0; 2];
+            v[..d].copy_from_slice(&value[..d]);
+            v
+        }
+        InitialVelocity::SineMode { v0 } => {
+            let (min, max) = extent;
+            let length = max[0] - min[0];
+            [v0 * (PI * (x0[0] - min[0]) / length).sin(), 0.0]
+        }
+        InitialVelocity::Exact {} => solution.map_or([0.0; 2], |s| s.velocity(x0, origin, d, 0.0)),
+        InitialVelocity::RigidRotation { omega, centre } => {
+            [-omega * (x0[1] - centre[1]), omega * (x0[0] - centre[0])]
+        }
+        InitialVelocity::Linear {
+            value,
+            origin: x_ref,
+            gradient,
+        } => {
+            let mut v = [0.0; 2];
+            for i in 0..d {
+                v[i] = value[i];
+                for j in 0..d {
+                    v[i] += gradient[i][j] * (x0[j] - x_ref[j]);
+                }
             }
-            InitialVelocity::SineMode { v0 } => {
-                let body = &scene.bodies[0];
-                let length = body.max[0] - body.min[0];
-                [v0 * (PI * (x0[0] - body.min[0]) / length).sin(), 0.0]
-            }
-            InitialVelocity::Exact {} => {
-                solution.map_or([0.0; 2], |s| s.velocity(x0, origin, D, 0.0))
-            }
-        };
-        particles.v[p] = to_vec::<D>(v);
+            v
+        }
     }
 }
 
 /// `σ⁰` of every particle from the scene's geostatic stress states, with the density
-/// of the particles and `g` of the gravity effect.
-fn initial_stress<const D: usize>(scene: &Scene, particles: &mut Particles<f64, D>) {
+/// of the particle's body and `g` of the gravity effect.
+fn initial_stress<const D: usize>(
+    scene: &Scene,
+    lattice: &Lattice,
+    particles: &mut Particles<f64, D>,
+) {
     for spec in &scene.effects {
         if let EffectSpec::GeostaticStress { surface, k0 } = spec {
             let g = scene.gravity().map_or(0.0, |g| g[D - 1]);
-            let state = Geostatic {
-                surface: *surface,
-                density: scene.material.density,
-                gravity: g,
-                k0: *k0,
-            };
-            for p in 0..particles.len() {
+            for (p, b) in lattice.body_of_particles().into_iter().enumerate() {
+                let state = Geostatic {
+                    surface: *surface,
+                    density: scene.body_material(b).density,
+                    gravity: g,
+                    k0: *k0,
+                };
                 let s: SMatrix<f64, D, D> = state.sigma0(&particles.x0[p]);
                 particles.sigma0[p] += s;
             }

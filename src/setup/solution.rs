@@ -20,19 +20,20 @@ pub(crate) enum Solution {
 
 impl Solution {
     pub(crate) fn new(scene: &Scene) -> Option<Self> {
-        let m = &scene.material;
-        let body = &scene.bodies[0];
+        let m = scene.body_material(0);
+        // The references are over the first body's box (validation requires one).
+        let (min, max) = scene.bodies.first()?.bounds()?;
         let d = scene.dim;
         let gravity = scene.gravity().map_or(0.0, |g| g[d - 1]);
         Some(match scene.reference? {
             Reference::VibratingBar { v0 } => Solution::Bar(exact::VibratingBar {
-                length: body.max[0] - body.min[0],
+                length: max[0] - min[0],
                 young: m.young,
                 density: m.density,
                 v0,
             }),
             Reference::ColumnSelfWeight {} => Solution::Column(exact::ColumnSelfWeight {
-                height: body.max[d - 1] - body.min[d - 1],
+                height: max[d - 1] - min[d - 1],
                 young: m.young,
                 density: m.density,
                 gravity,
@@ -44,7 +45,7 @@ impl Solution {
                 density: m.density,
             }),
             Reference::ColumnEquilibrium {} => Solution::Equilibrium {
-                height: body.max[d - 1] - body.min[d - 1],
+                height: max[d - 1] - min[d - 1],
                 density: m.density,
                 gravity,
                 young: m.young,

@@ -404,7 +404,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .expect("material.young_modulus: unknown field `young_modulus`, expected one of `model`, `young`, `poisson`, `density`"),
         case("unknown-field-in-body", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, 4]\n@@speed = 1.0")
-            .expect("body[0].speed: unknown field `speed`, expected one of `min`, `max`, `per_block`, `count`, `jitter`, `seed`"),
+            .expect("body[0].speed: unknown field `speed`, expected one of `shape`, `min`, `max`, `outline`, `holes`, `centre`, `radius`, `file`, `surface`, `per_triangle`, `subdivide`, `per_block`, `count`, `spacing`, `jitter`, `seed`, `material`, `initial_velocity`"),
         case("unknown-field-in-boundary", BAR)
             .edit("tag = \"right\"", "tag = \"right\"\n@@fixed = true")
             .expect("boundary[1].fixed: unknown field `fixed`, expected `tag` or `fix`"),
@@ -509,7 +509,7 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("reference.kind: unknown variant `pendulum`, expected one of `vibrating-bar`, `column-self-weight`, `axis-aligned`, `column-equilibrium`"),
         case("unknown-initial-velocity-kind", BAR)
             .edit("kind = \"exact\"", "kind = @@\"spinning\"")
-            .expect("initial_velocity.kind: unknown variant `spinning`, expected one of `rest`, `uniform`, `sine-mode`, `exact`"),
+            .expect("initial_velocity.kind: unknown variant `spinning`, expected one of `rest`, `uniform`, `sine-mode`, `exact`, `rigid-rotation`, `linear`"),
         case("unknown-material-model", BAR)
             .edit("model = \"linear-elastic\"", "model = @@\"plastic\"")
             .expect("material.model: unknown variant `plastic`, expected one of `linear-elastic`, `paper-linear`, `corotated`, `corotational`, `neo-hookean`"),
@@ -665,14 +665,14 @@ fn inconsistent_cases() -> Vec<Case> {
             .expect("body[1].max: needs min < max on every axis, got min = [1.0, 1.0], max = [2.0, 1.0]"),
         case("per-block-and-count", BAR)
             .edit("per_block = [4, 4]", "per_block = @@[4, 4]\ncount = [8, 2]")
-            .expect("body[0].per_block: give exactly one of `per_block` and `count`"),
+            .expect("body[0].per_block: give exactly one of `per_block`, `count` and `spacing`"),
         case("neither-per-block-nor-count", BAR)
             .edit("[[body]]", "@@[[body]]")
             .edit("per_block = [4, 4]\n", "")
-            .expect("body[0].per_block: give exactly one of `per_block` and `count`"),
+            .expect("body[0].per_block: give exactly one of `per_block`, `count` and `spacing`"),
         case("per-block-on-a-polygon-mesh", SQUARE)
             .edit("count = [16, 16]", "per_block = @@[2, 2]")
-            .expect("body[0].per_block: needs a `blocks` or `interval` mesh; use `count` on other meshes"),
+            .expect("body[0].per_block: needs a `blocks` or `interval` mesh; use `count` or `spacing` on other meshes"),
         case("component-y-in-1d", BAR_1D)
             .edit("fix = [\"x\"]", "fix = @@[\"y\"]")
             .expect("boundary[0].fix: component `y` does not exist in 1D"),
@@ -728,7 +728,7 @@ fn inconsistent_cases() -> Vec<Case> {
             .at(21, 7).expect("boundary[0].tag: unknown boundary tag `wall`; the mesh has tags [\"bottom\", \"right\", \"top\", \"left\"]"),
         case("body-outside-the-mesh", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 2.0]")
-            .at(22, 1).at(24, 7).expect("body[0].max: the particle at [0.125, 1.125] lies outside the mesh; the body's box must lie inside the meshed domain"),
+            .at(22, 1).at(24, 7).expect("body[0].max: the particle at [0.125, 1.125] lies outside the mesh; the body must lie inside the meshed domain"),
         case("body-not-a-whole-number-of-cells", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 0.9]")
             .at(24, 7).expect("body[0].max: the body's extent 0.9 along axis 1 is not a whole number of lattice cells of size 0.25"),
@@ -755,9 +755,9 @@ fn missing_cases() -> Vec<Case> {
             .edit("name = \"bar\"\n", "")
             .expect("missing field `name`"),
         case("missing-material", BAR)
-            .edit("# A small", "@@# A small")
             .edit("[material]\nmodel = \"linear-elastic\"\nyoung = 100.0\npoisson = 0.25\ndensity = 1.0\n", "")
-            .expect("missing field `material`"),
+            .edit("[[body]]", "@@[[body]]")
+            .expect("body[0].material: the scene has no [material] for the bodies without their own, and body[0] has no `material` table: give it one, or add a scene-level [material]"),
         case("missing-body", BAR)
             .edit("# A small", "@@# A small")
             .edit("[[body]]\nmin = [0.0, 0.0]\nmax = [4.0, 1.0]\nper_block = [4, 4]\n", "")

@@ -236,3 +236,38 @@ fn scene_files_run_and_bad_ones_name_file_line_and_column() {
         );
     }
 }
+
+/// A fixed `dt` above a critical step that a nearly singular mass makes tiny (the
+/// column refined to 2 × 20 blocks with 3 × 3 particles each: 2.25 per triangle for
+/// the 9 PS functions of each) names that cause and its fix, not a smaller step.
+#[test]
+fn too_few_particles_per_element_is_named_as_the_cause_of_a_tiny_critical_step() {
+    for mass in ["default", "consistent"] {
+        let out = cli()
+            .args([
+                "run",
+                "column-large",
+                "--blocks",
+                "2x20",
+                "--particles",
+                "3x3",
+                "--mass",
+                mass,
+                "--t-end",
+                "0.01",
+            ])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{mass}");
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        for part in [
+            "time.dt: the time step 0.001 is above the critical step",
+            "times below the lumped mass's (2.273e-3",
+            "2.2 particles per occupied element are too few",
+            "use more particles per element",
+        ] {
+            assert!(stderr.contains(part), "{mass}: {part}: {stderr}");
+        }
+        assert!(!stderr.contains("lower `time.dt`"), "{stderr}");
+    }
+}

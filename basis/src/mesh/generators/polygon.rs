@@ -36,6 +36,12 @@ impl PolygonDomain {
         }
     }
 
+    /// Whether `p` lies inside the outer polygon and outside every hole (crossing
+    /// number; a point exactly on the boundary may fall either way).
+    pub fn contains(&self, p: Vec2) -> bool {
+        inside_polygon(p, &self.outer) && !self.holes.iter().any(|(h, _)| inside_polygon(p, h))
+    }
+
     /// All segments with their tags.
     fn segments(&self) -> Vec<(Vec2, Vec2, &str)> {
         let mut s = Vec::new();
@@ -300,6 +306,30 @@ pub fn polygon_mesh(domain: &PolygonDomain, target_edge_length: f64) -> Result<T
     });
     mesh.require_tagged_boundary()?;
     Ok(mesh)
+}
+
+#[cfg(test)]
+mod contains_tests {
+    use super::*;
+
+    #[test]
+    fn contains_is_inside_the_outline_and_outside_the_holes() {
+        let mut d = PolygonDomain::rectangle(0.0, 4.0, 0.0, 4.0);
+        d.holes.push((
+            vec![
+                Vec2::new(1.0, 1.0),
+                Vec2::new(2.0, 1.0),
+                Vec2::new(2.0, 2.0),
+                Vec2::new(1.0, 2.0),
+            ],
+            "hole".into(),
+        ));
+        assert!(d.contains(Vec2::new(0.5, 0.5)));
+        assert!(d.contains(Vec2::new(3.5, 1.5)));
+        assert!(!d.contains(Vec2::new(1.5, 1.5)));
+        assert!(!d.contains(Vec2::new(4.5, 1.5)));
+        assert!(!d.contains(Vec2::new(-0.5, 1.5)));
+    }
 }
 
 #[cfg(test)]

@@ -11,6 +11,9 @@
 //!   they cover, by the group's name from `$PhysicalNames` (or its number as a
 //!   string when unnamed). When a curve is in several physical groups, the first
 //!   one listed is used. Lines on interior curves tag nothing.
+//! - Triangles in a physical surface are reported by
+//!   [`parse_msh_with_surfaces`] ([`PhysicalSurfaces`]: the group of every triangle,
+//!   by the name from `$PhysicalNames` or the number), for placing material points.
 //! - Nodes used by no triangle are dropped and the rest renumbered in file order.
 //! - All nodes must lie in one plane `z = const` (usually `z = 0`).
 //! - A mesh whose triangles are all clockwise (a surface whose normal points
@@ -261,11 +264,14 @@ struct Contents {
     names: HashMap<(i64, i64), String>,
     /// The physical tag of each curve entity that has one (4.1 `$Entities`).
     curve_physical: HashMap<i64, i64>,
+    /// The physical tag of each surface entity that has one (4.1 `$Entities`).
+    surface_physical: HashMap<i64, i64>,
     nodes: HashMap<i64, [f64; 3]>,
     /// Node ids in file order.
     node_order: Vec<i64>,
-    /// Triangles (node ids) with the line they were read on.
-    triangles: Vec<([i64; 3], usize)>,
+    /// Triangles (node ids) with the line they were read on and their physical
+    /// surface, if any.
+    triangles: Vec<([i64; 3], usize, Option<i64>)>,
     /// Lines in a physical group: node ids, physical tag, line read on.
     lines: Vec<([i64; 2], i64, usize)>,
     /// Nodes and elements announced so far (over all blocks and sections).
@@ -286,7 +292,8 @@ impl Contents {
     }
 
     /// Records an element of type `kind` with node tags `nodes_of`, read on the
-    /// current line: triangles always, lines when in a physical group, points never.
+    /// current line: triangles always (with their physical surface), lines when in a
+    /// physical group, points never.
     fn add_element(
         &mut self,
         r: &Reader,
@@ -311,7 +318,9 @@ impl Contents {
                     self.lines.push(([ids[0], ids[1]], p, r.pos));
                 }
             }
-            2 => self.triangles.push(([ids[0], ids[1], ids[2]], r.pos)),
+            2 => self
+                .triangles
+                .push(([ids[0], ids[1], ids[2]], r.pos, physical)),
             _ => {} // points
         }
         Ok(())
@@ -320,6 +329,51 @@ impl Contents {
 
 /// Parses the text of a `.msh` file; `source` names it in errors.
 pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
+    parse_msh_with_surfaces(text, source).map(|(mesh, _)| mesh)
+}
+
+/// The physical surfaces of a mesh file: the group of every triangle (in the order
+/// of [`TriMesh::triangles`]) and the names of the groups.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PhysicalSurfaces {
+    /// Physical surface tag of each triangle (`None` outside every group).
+    pub of_triangle: Vec<Option<i64>>,
+    /// Names of the physical surfaces by tag (from `$PhysicalNames`).
+    pub names: HashMap<i64, String>,
+}
+
+impl PhysicalSurfaces {
+    /// The tag of the physical surface `name`: a name from `$PhysicalNames`, or the
+    /// tag itself written as a number, if some triangle belongs to it.
+    pub fn find(&self, name: &str) -> Option<i64> {
+        let by_name = self
+            .names
+            .iter()
+            .filter(|(_, n)| n.as_str() == name)
+            .map(|(&t, _)| t)
+            .min();
+        let tag = by_name.or_else(|| name.trim().parse::<i64>().ok())?;
+        self.of_triangle.contains(&Some(tag)).then_some(tag)
+    }
+
+    /// The surfaces that have triangles, as their names (or tags when unnamed),
+    /// sorted: for messages.
+    pub fn listed(&self) -> Vec<String> {
+        let mut tags: Vec<i64> = self.of_triangle.iter().flatten().copied().collect();
+        tags.sort_unstable();
+        tags.dedup();
+        tags.iter()
+            .map(|t| self.names.get(t).cloned().unwrap_or_else(|| t.to_string()))
+            .collect()
+    }
+}
+
+/// [`parse_msh`], and the physical surface of every triangle (4.1: that of its
+/// surface entity in `$Entities`; 2.2: the element's first tag).
+pub fn parse_msh_with_surfaces(
+    text: &str,
+    source: &str,
+) -> Result<(TriMesh, PhysicalSurfaces), GmshError> {
     let mut r = Reader {
         file: source,
         lines: text.lines().collect(),
@@ -416,10 +470,11 @@ pub fn parse_msh(text: &str, source: &str) -> Result<TriMesh, GmshError> {
 }
 
 /// The mesh of the collected contents: used nodes in file order, triangles turned
-/// counter-clockwise if all are clockwise, boundary edges tagged by their lines.
-fn build_mesh(c: Contents, source: &str) -> Result<TriMesh, GmshError> {
+/// counter-clockwise if all are clockwise, boundary edges tagged by their lines; and
+/// the physical surfaces of the triangles.
+fn build_mesh(c: Contents, source: &str) -> Result<(TriMesh, PhysicalSurfaces), GmshError> {
     let Contents {
-        names,
+        mut names,
         nodes,
         node_order,
         triangles,
@@ -450,7 +505,7 @@ fn build_mesh(c: Contents, source: &str) -> Result<TriMesh, GmshError> {
     }
     // Keep used nodes in file order.
     let mut used: HashMap<i64, usize> = HashMap::new();
-    for (tri, line) in &triangles {
+    for (tri, line, _) in &triangles {
         for id in tri {
             if !nodes.contains_key(id) {
                 return Err(undefined(*id, *line));
@@ -478,7 +533,7 @@ fn build_mesh(c: Contents, source: &str) -> Result<TriMesh, GmshError> {
     }
     let mut tris: Vec<[usize; 3]> = triangles
         .iter()
-        .map(|(t, _)| t.map(|id| used[&id]))
+        .map(|(t, _, _)| t.map(|id| used[&id]))
         .collect();
     let area = |t: &[usize; 3]| super::signed_area(vertices[t[0]], vertices[t[1]], vertices[t[2]]);
     if tris.iter().all(|t| area(t) < 0.0) {
@@ -501,7 +556,15 @@ fn build_mesh(c: Contents, source: &str) -> Result<TriMesh, GmshError> {
         // Lines on interior curves tag nothing: only boundary edges carry tags.
         mesh.set_edge_tag(a, b, &name);
     }
-    Ok(mesh)
+    let surfaces = PhysicalSurfaces {
+        of_triangle: triangles.iter().map(|(_, _, p)| *p).collect(),
+        names: names
+            .drain()
+            .filter(|((dim, _), _)| *dim == 2)
+            .map(|((_, tag), name)| (tag, name))
+            .collect(),
+    };
+    Ok((mesh, surfaces))
 }
 
 #[cfg(test)]
@@ -510,6 +573,20 @@ mod tests {
 
     pub(super) fn data(name: &str) -> std::path::PathBuf {
         Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data")).join(name)
+    }
+
+    #[test]
+    fn physical_surfaces_are_read_in_both_formats() {
+        for file in ["square.msh", "square_v22.msh"] {
+            let text = std::fs::read_to_string(data(file)).unwrap();
+            let (mesh, s) = parse_msh_with_surfaces(&text, file).unwrap();
+            assert_eq!(s.of_triangle.len(), mesh.num_triangles(), "{file}");
+            let tag = s.find("domain").unwrap_or_else(|| panic!("{file}: {s:?}"));
+            assert!(s.of_triangle.iter().all(|&t| t == Some(tag)), "{file}");
+            assert_eq!(s.find(&tag.to_string()), Some(tag));
+            assert_eq!(s.find("nowhere"), None);
+            assert_eq!(s.listed(), vec!["domain".to_string()]);
+        }
     }
 
     pub(super) fn area(m: &TriMesh) -> f64 {

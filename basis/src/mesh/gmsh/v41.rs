@@ -1,4 +1,5 @@
-//! The layout of Gmsh format 4.1: `$Entities` (the physical group of each curve),
+//! The layout of Gmsh format 4.1: `$Entities` (the physical group of each curve
+//! and surface),
 //! and `$Nodes` and `$Elements` in entity blocks, where a line element's physical
 //! group is that of its curve.
 
@@ -6,7 +7,7 @@ use super::{
     Contents, GmshError, Reader, MAX_ELEMENTS, MAX_ENTITIES, MAX_ENTITY_BLOCKS, MAX_NODES, MAX_TAGS,
 };
 
-/// Reads the body of `$Entities`: the first physical tag of each curve.
+/// Reads the body of `$Entities`: the first physical tag of each curve and surface.
 pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), GmshError> {
     let f = r.fields(
         "the $Entities header (numPoints numCurves numSurfaces numVolumes)",
@@ -35,8 +36,24 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             c.curve_physical.insert(tag, r.int(f[8], "a physical tag")?);
         }
     }
-    for _ in 0..counts[2].saturating_add(counts[3]) {
-        r.next("a surface or volume entity")?;
+    for _ in 0..counts[2] {
+        let f = r.fields(
+            "a surface entity (tag minX minY minZ maxX maxY maxZ numPhysicalTags …)",
+            8,
+            true,
+        )?;
+        let tag = r.int(f[0], "a surface tag")?;
+        let nphys = r.bounded(f[7], "the number of physical tags", MAX_TAGS)?;
+        if f.len() - 8 < nphys {
+            return Err(r.error("surface entity lists fewer physical tags than it announces"));
+        }
+        if nphys > 0 {
+            c.surface_physical
+                .insert(tag, r.int(f[8], "a physical tag")?);
+        }
+    }
+    for _ in 0..counts[3] {
+        r.next("a volume entity")?;
     }
     Ok(())
 }
@@ -107,10 +124,10 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
         )?;
         // Name an unsupported type at the block header.
         super::supported_element(r, kind)?;
-        let physical = if kind == 1 {
-            c.curve_physical.get(&entity).copied()
-        } else {
-            None
+        let physical = match kind {
+            1 => c.curve_physical.get(&entity).copied(),
+            2 => c.surface_physical.get(&entity).copied(),
+            _ => None,
         };
         for _ in 0..n {
             let f = r.fields("an element (tag nodes…)", 2, true)?;

@@ -1,0 +1,433 @@
+//! Validation of the bodies: each body's shape and only that shape's fields, its
+//! lattice, its material and initial velocity (its own or the scene's), and the
+//! number of particles of all bodies, bounded before any is made.
+
+use super::limits::{MAX_OUTLINE_CORNERS, MAX_PARTICLES};
+use super::{
+    bad, conflict, Body, BodyShape, ErrorKind, InitialVelocity, MaterialSpec, MeshSpec, Scene,
+    SceneError,
+};
+use psmpm_basis::mesh::generators::PolygonDomain;
+use psmpm_basis::Vec2;
+
+/// The fields each shape takes beyond the common ones (`shape`, `material`,
+/// `initial_velocity`); the lattice fields belong to every shape but `gmsh`.
+const LATTICE: [BodyShape; 3] = [BodyShape::Box, BodyShape::Polygon, BodyShape::Disk];
+
+/// Particles a Gmsh body places per triangle when it does not say.
+pub const DEFAULT_PER_TRIANGLE: usize = 3;
+
+/// Most times a Gmsh body's triangles may be split into four (`4^8 = 65 536`
+/// pieces per triangle).
+pub const MAX_SUBDIVIDE: u32 = 8;
+
+impl Scene {
+    /// Checks every body; the error names the field (`body[1].radius`).
+    pub(super) fn validate_bodies(&self) -> Result<(), SceneError> {
+        if self.bodies.is_empty() {
+            return Err(bad("body", "a scene needs at least one [[body]]"));
+        }
+        for (b, body) in self.bodies.iter().enumerate() {
+            self.validate_shape(b, body)?;
+            self.validate_lattice(b, body)?;
+            if let Some(m) = &body.material {
+                validate_material(&format!("body[{b}].material"), m)?;
+            }
+            if let Some(v) = &body.initial_velocity {
+                self.validate_velocity(&format!("body[{b}].initial_velocity"), v)?;
+            }
+        }
+        let particles = self.estimated_particle_count();
+        if particles.is_nan() || particles > MAX_PARTICLES as f64 {
+            return Err(bad(
+                "body[0]",
+                format!(
+                    "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
+                ),
+            ));
+        }
+        for (b, body) in self.bodies.iter().enumerate() {
+            if body.shape == BodyShape::Gmsh {
+                continue;
+            }
+            // The particle mass is ρ0 times the lattice cell volume: reject a density
+            // or a lattice so small that the product underflows to zero.
+            let volume: f64 = (0..self.dim)
+                .map(|k| self.lattice_spacing(body, k).unwrap_or(1.0))
+                .product();
+            let density = self.body_material(b).density;
+            let mass = density * volume;
+            if !(mass > 0.0 && mass.is_finite()) {
+                let field = if !(volume > 0.0 && volume.is_finite()) {
+                    // The lattice cell: the box's extent, or the lattice's field.
+                    let lattice = if body.shape.is_box() {
+                        "max"
+                    } else if body.spacing.is_some() {
+                        "spacing"
+                    } else if body.count.is_some() {
+                        "count"
+                    } else {
+                        "per_block"
+                    };
+                    format!("body[{b}].{lattice}")
+                } else if body.material.is_some() {
+                    format!("body[{b}].material.density")
+                } else {
+                    "material.density".to_string()
+                };
+                return Err(bad(
+                    field,
+                    format!(
+                        "the particles of body[{b}] would have mass {mass:e} (density {density} times particle volume {volume:e}); it must be positive and finite"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The shape: allowed in the scene's dimension, its own fields given and valid,
+    /// no field of another shape.
+    fn validate_shape(&self, b: usize, body: &Body) -> Result<(), SceneError> {
+        let d = self.dim;
+        let field = |f: &str| format!("body[{b}].{f}");
+        let shape = body.shape;
+        if d == 1 && shape != BodyShape::Box {
+            return Err(conflict(
+                field("shape"),
+                format!(
+                    "a 1D scene has intervals only (`box` with `min`, `max`), got `{}`",
+                    shape.name()
+                ),
+            ));
+        }
+        let present: [(&str, bool, &[BodyShape]); 15] = [
+            ("min", !body.min.is_empty(), &[BodyShape::Box]),
+            ("max", !body.max.is_empty(), &[BodyShape::Box]),
+            ("outline", !body.outline.is_empty(), &[BodyShape::Polygon]),
+            ("holes", !body.holes.is_empty(), &[BodyShape::Polygon]),
+            ("centre", body.centre.is_some(), &[BodyShape::Disk]),
+            ("radius", body.radius.is_some(), &[BodyShape::Disk]),
+            ("file", body.file.is_some(), &[BodyShape::Gmsh]),
+            ("surface", body.surface.is_some(), &[BodyShape::Gmsh]),
+            (
+                "per_triangle",
+                body.per_triangle.is_some(),
+                &[BodyShape::Gmsh],
+            ),
+            ("subdivide", body.subdivide.is_some(), &[BodyShape::Gmsh]),
+            ("per_block", body.per_block.is_some(), &LATTICE),
+            ("count", body.count.is_some(), &LATTICE),
+            ("spacing", body.spacing.is_some(), &LATTICE),
+            ("jitter", body.jitter != 0.0, &LATTICE),
+            ("seed", body.seed.is_some(), &LATTICE),
+        ];
+        for (name, given, shapes) in present {
+            if given && !shapes.contains(&shape) {
+                let owners: Vec<&str> = shapes.iter().map(|s| s.name()).collect();
+                return Err(conflict(
+                    field(name),
+                    format!(
+                        "is not a field of a `{}` body (it belongs to {})",
+                        shape.name(),
+                        owners.join(", ")
+                    ),
+                ));
+            }
+        }
+        let finite2 = |f: String, p: [f64; 2]| -> Result<(), SceneError> {
+            if p.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(bad(f, format!("must be finite, got {p:?}")))
+            }
+        };
+        match shape {
+            BodyShape::Box => {
+                for (name, v) in [("min", &body.min), ("max", &body.max)] {
+                    if v.len() != d {
+                        return Err(bad(
+                            field(name),
+                            format!("needs {d} entries, got {}", v.len()),
+                        ));
+                    }
+                    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                        return Err(bad(field(name), format!("must be finite, got {x}")));
+                    }
+                }
+                if (0..d).any(|k| body.min[k] >= body.max[k]) {
+                    return Err(bad(
+                        field("max"),
+                        format!(
+                            "needs min < max on every axis, got min = {:?}, max = {:?}",
+                            body.min, body.max
+                        ),
+                    ));
+                }
+            }
+            BodyShape::Polygon => {
+                if body.outline.len() < 3 {
+                    return Err(bad(
+                        field("outline"),
+                        format!("needs at least 3 corners, got {}", body.outline.len()),
+                    ));
+                }
+                let corners = body.outline.len() + body.holes.iter().map(Vec::len).sum::<usize>();
+                if corners > MAX_OUTLINE_CORNERS {
+                    return Err(bad(
+                        field("outline"),
+                        format!("{corners} corners (outline and holes) is above the limit of {MAX_OUTLINE_CORNERS}"),
+                    ));
+                }
+                for (i, p) in body.outline.iter().enumerate() {
+                    finite2(field(&format!("outline[{i}]")), *p)?;
+                }
+                for (h, hole) in body.holes.iter().enumerate() {
+                    if hole.len() < 3 {
+                        return Err(bad(
+                            field(&format!("holes[{h}]")),
+                            format!("needs at least 3 corners, got {}", hole.len()),
+                        ));
+                    }
+                    for (i, p) in hole.iter().enumerate() {
+                        finite2(field(&format!("holes[{h}][{i}]")), *p)?;
+                    }
+                }
+                // The mesher's domain check: no crossing or touching segments, holes
+                // inside the outline and not nested.
+                region_polygon(body).validate().map_err(|e| {
+                    let message = e.to_string();
+                    let name = if message.contains("hole") {
+                        "holes"
+                    } else {
+                        "outline"
+                    };
+                    bad(field(name), message)
+                })?;
+            }
+            BodyShape::Disk => {
+                let Some(c) = body.centre else {
+                    return Err(bad(field("centre"), "a `disk` body needs `centre`"));
+                };
+                finite2(field("centre"), c)?;
+                match body.radius {
+                    Some(r) if r > 0.0 && r.is_finite() => {}
+                    Some(r) => {
+                        return Err(bad(
+                            field("radius"),
+                            format!("must be positive and finite, got {r}"),
+                        ))
+                    }
+                    None => return Err(bad(field("radius"), "a `disk` body needs `radius`")),
+                }
+            }
+            BodyShape::Gmsh => {
+                match &body.file {
+                    Some(f) if !f.is_empty() => {}
+                    Some(_) => return Err(bad(field("file"), "is empty")),
+                    None => return Err(bad(field("file"), "a `gmsh` body needs `file`")),
+                }
+                if body.surface.is_none() {
+                    return Err(bad(
+                        field("surface"),
+                        "a `gmsh` body needs `surface` (a physical surface's name or number)",
+                    ));
+                }
+                if let Some(n) = body.per_triangle {
+                    if !(n == 1 || n == 3) {
+                        return Err(bad(
+                            field("per_triangle"),
+                            format!("must be 1 or 3, got {n}"),
+                        ));
+                    }
+                }
+                if let Some(k) = body.subdivide {
+                    if k > MAX_SUBDIVIDE {
+                        return Err(bad(
+                            field("subdivide"),
+                            format!("must be in 0..={MAX_SUBDIVIDE}, got {k}"),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The lattice of a box, polygon or disk body: exactly one of `per_block`,
+    /// `count` and `spacing`, within range; `jitter` within a cell.
+    fn validate_lattice(&self, b: usize, body: &Body) -> Result<(), SceneError> {
+        if body.shape == BodyShape::Gmsh {
+            return Ok(());
+        }
+        let d = self.dim;
+        let field = |f: &str| format!("body[{b}].{f}");
+        if !(0.0..0.5).contains(&body.jitter) {
+            return Err(bad(
+                field("jitter"),
+                format!(
+                    "must be in [0, 0.5) (a fraction of the lattice cell), got {}",
+                    body.jitter
+                ),
+            ));
+        }
+        match (&body.per_block, &body.count, &body.spacing) {
+            (Some(p), None, None) => {
+                if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
+                    return Err(bad(
+                        field("per_block"),
+                        format!("needs {d} counts in 1..=1000, got {p:?}"),
+                    ));
+                }
+                if !matches!(
+                    self.mesh,
+                    MeshSpec::Blocks { .. } | MeshSpec::Interval { .. }
+                ) {
+                    return Err(conflict(
+                        field("per_block"),
+                        "needs a `blocks` or `interval` mesh; use `count` or `spacing` on other meshes",
+                    ));
+                }
+            }
+            (None, Some(c), None) => {
+                if c.len() != d || c.iter().any(|&n| n == 0 || n > 100_000) {
+                    return Err(bad(
+                        field("count"),
+                        format!("needs {d} counts in 1..=100000, got {c:?}"),
+                    ));
+                }
+            }
+            (None, None, Some(h)) => {
+                if h.len() != d || h.iter().any(|&x| !(x > 0.0 && x.is_finite())) {
+                    return Err(bad(
+                        field("spacing"),
+                        format!("needs {d} positive finite lengths, got {h:?}"),
+                    ));
+                }
+            }
+            _ => {
+                return Err(conflict(
+                    field("per_block"),
+                    "give exactly one of `per_block`, `count` and `spacing`",
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// An initial velocity (the scene's or a body's, `field` its path).
+    pub(super) fn validate_velocity(
+        &self,
+        field: &str,
+        v: &InitialVelocity,
+    ) -> Result<(), SceneError> {
+        let d = self.dim;
+        let sub = |f: &str| format!("{field}.{f}");
+        let vector = |f: String, v: &[f64]| -> Result<(), SceneError> {
+            if v.len() != d {
+                return Err(bad(f, format!("needs {d} entries, got {}", v.len())));
+            }
+            match v.iter().find(|x| !x.is_finite()) {
+                Some(x) => Err(bad(f, format!("must be finite, got {x}"))),
+                None => Ok(()),
+            }
+        };
+        match v {
+            InitialVelocity::Uniform { value } => vector(sub("value"), value)?,
+            InitialVelocity::SineMode { v0 } if !v0.is_finite() => {
+                return Err(bad(sub("v0"), format!("must be finite, got {v0}")));
+            }
+            InitialVelocity::Exact {} if self.reference.is_none() => {
+                return Err(conflict(
+                    sub("kind"),
+                    "`exact` needs a [reference] solution",
+                ))
+            }
+            InitialVelocity::RigidRotation { omega, centre } => {
+                if d != 2 {
+                    return Err(conflict(sub("kind"), "a rigid rotation needs a 2D scene"));
+                }
+                if !omega.is_finite() {
+                    return Err(bad(sub("omega"), format!("must be finite, got {omega}")));
+                }
+                vector(sub("centre"), centre)?;
+            }
+            InitialVelocity::Linear {
+                value,
+                origin,
+                gradient,
+            } => {
+                vector(sub("value"), value)?;
+                vector(sub("origin"), origin)?;
+                if gradient.len() != d {
+                    return Err(bad(
+                        sub("gradient"),
+                        format!("needs {d} rows of {d} entries, got {} rows", gradient.len()),
+                    ));
+                }
+                for row in gradient {
+                    vector(sub("gradient"), row)?;
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// About how many particles the bodies get together, computed from the scene
+    /// without building anything (validation bounds it by [`MAX_PARTICLES`]; a Gmsh
+    /// body counts as known only once its file is read).
+    pub fn estimated_particle_count(&self) -> f64 {
+        self.bodies
+            .iter()
+            .map(|b| self.estimated_particles(b))
+            .sum()
+    }
+
+    /// About how many particles `body` gets: exact for boxes, the cells of the
+    /// bounding box (an upper bound) for polygons and disks, 0 for a Gmsh body (its
+    /// count is checked once the file is read).
+    pub(super) fn estimated_particles(&self, body: &Body) -> f64 {
+        let Some((lo, hi)) = body.bounds() else {
+            return 0.0;
+        };
+        (0..self.dim)
+            .map(|k| {
+                let cells = self
+                    .lattice_spacing(body, k)
+                    .map_or(1.0, |h| (hi[k] - lo[k]) / h);
+                if body.shape == BodyShape::Box {
+                    cells
+                } else {
+                    cells.ceil().max(1.0)
+                }
+            })
+            .product()
+    }
+}
+
+/// A material's constants in range; the error names `field.young` and so on.
+pub(super) fn validate_material(field: &str, m: &MaterialSpec) -> Result<(), SceneError> {
+    crate::material::Elastic::new(m.young, m.poisson, m.density).map_err(|e| {
+        let name = match &e {
+            crate::material::MaterialError::OutOfRange { name, .. } => name,
+        };
+        SceneError::new(format!("{field}.{name}"), ErrorKind::Value, e.to_string())
+    })?;
+    Ok(())
+}
+
+/// The region of a polygon body as the mesher's domain (its tags unused).
+pub fn region_polygon(body: &Body) -> PolygonDomain {
+    let corners = |c: &[[f64; 2]]| c.iter().map(|p| Vec2::new(p[0], p[1])).collect::<Vec<_>>();
+    PolygonDomain {
+        outer: corners(&body.outline),
+        outer_tags: vec!["body".to_string(); body.outline.len()],
+        holes: body
+            .holes
+            .iter()
+            .enumerate()
+            .map(|(h, hole)| (corners(hole), format!("holes[{h}]")))
+            .collect(),
+    }
+}
