@@ -220,19 +220,39 @@ fn at(bbox: &[f64; 4], dim: usize, f: [f64; 2]) -> Vec<f64> {
 /// or per-block count, jitter and seed.
 type BodyDraw = ((f64, f64), (f64, f64), bool, [usize; 2], f64, i64);
 
-fn body(mesh: &Mesh, dim: usize, draw: BodyDraw) -> String {
+/// Body `index` of `bodies` keeps to its own slice `[index, index + 1] / bodies` of
+/// the mesh along x (bodies must not overlap; they may touch).
+fn body(mesh: &Mesh, dim: usize, draw: BodyDraw, index: usize, bodies: usize) -> String {
     let ((ax, bx), (ay, by), per_block, n, jitter, seed) = draw;
+    let slice = |a: f64| (index as f64 + a) / bodies as f64;
+    let (ax, bx) = (slice(ax), slice(bx));
     let mut min = at(&mesh.bbox, dim, [ax, ay]);
     let mut max = at(&mesh.bbox, dim, [bx, by]);
-    let counts = if let (true, Some(blocks)) = (per_block, mesh.blocks) {
+    // Whole blocks of the body's slice along x (all blocks along y).
+    let slice_blocks = |cells: f64, k: usize| -> (f64, f64) {
+        if k == 0 {
+            (
+                (index as f64 * cells / bodies as f64).floor(),
+                ((index + 1) as f64 * cells / bodies as f64).floor(),
+            )
+        } else {
+            (0.0, cells)
+        }
+    };
+    let whole_blocks = mesh.blocks.filter(|blocks| {
+        (0..dim).all(|k| {
+            let (lo, hi) = slice_blocks(blocks[k] as f64, k);
+            hi > lo
+        })
+    });
+    let counts = if let (true, Some(blocks)) = (per_block, whole_blocks) {
         // Whole blocks, so that the lattice cells are whole.
         for k in 0..dim {
             let (a, b) = if k == 0 { (ax, bx) } else { (ay, by) };
             let cells = blocks[k] as f64;
-            let (i0, i1) = (
-                (a * cells).floor(),
-                (b * cells).ceil().max((a * cells).floor() + 1.0),
-            );
+            let (first, last) = slice_blocks(cells, k);
+            let i0 = (a * cells).floor().clamp(first, last - 1.0);
+            let i1 = (b * cells).ceil().clamp(i0 + 1.0, last);
             let (lo, hi) = (mesh.bbox[2 * k], mesh.bbox[2 * k + 1]);
             min[k] = lo + i0 / cells * (hi - lo);
             max[k] = if i1 >= cells {
@@ -432,8 +452,9 @@ fn scene() -> impl Strategy<Value = String> {
                         "name = \"property\"\ndim = {dim}\nbasis = \"{basis}\"\nsplit = \"{split}\"\nmass = \"{mass}\"\n\n{}\n{material}\n",
                         mesh.toml
                     );
-                    for b in bodies {
-                        s += &body(&mesh, dim, b);
+                    let count = bodies.len();
+                    for (i, b) in bodies.into_iter().enumerate() {
+                        s += &body(&mesh, dim, b, i, count);
                         s.push('\n');
                     }
                     s += &vel;
