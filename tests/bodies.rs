@@ -575,3 +575,43 @@ fn scenes_with_shaped_bodies_and_own_materials_round_trip() {
     assert_eq!(l.body_sizes.len(), 3);
     assert_eq!(l.body_sizes[2], 6);
 }
+
+/// Placing a polygon body's particles (and checking the other bodies against it)
+/// tests particles against corners: a detailed outline over a fine lattice is
+/// refused before any work, naming the outline, the counts and the limit.
+#[test]
+fn a_polygon_body_too_costly_to_fill_is_refused_before_any_work() {
+    let corners = |n: usize| -> String {
+        let points: Vec<String> = (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                format!("[{:.6}, {:.6}]", 2.0 + 1.5 * a.cos(), 2.0 + 1.5 * a.sin())
+            })
+            .collect();
+        format!("[{}]", points.join(", "))
+    };
+    // 20 000 corners × about 2 × 10⁶ cells: 4 × 10¹⁰ tests.
+    let text = scene_text(
+        &format!(
+            "[[body]]\nshape = \"polygon\"\noutline = {}\ncount = [1000, 1000]\n",
+            corners(20_000)
+        ),
+        "",
+    );
+    let started = std::time::Instant::now();
+    let (field, kind, message) = error_of(&text);
+    assert_eq!(field, "body[0].outline");
+    assert_eq!(kind, Some(ErrorKind::Value));
+    assert!(
+        message.contains("20000 corners") && message.contains("above the limit of 1e10"),
+        "{message}"
+    );
+    // Refused by counting, not after trying (a generous bound, not a timing claim).
+    assert!(started.elapsed().as_secs() < 60);
+    // The same outline over a coarse lattice is filled.
+    let fine = lattice(&format!(
+        "[[body]]\nshape = \"polygon\"\noutline = {}\ncount = [40, 40]\n",
+        corners(20_000)
+    ));
+    assert!(!fine.positions.is_empty());
+}

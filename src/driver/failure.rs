@@ -102,7 +102,7 @@ where
             ));
         }
         self.untreated_under_supported().map(|(_, _, why)| {
-            format!("{why}; use the default mass strategy (remove `mass`, or `--mass default`), which expresses such functions through their neighbours")
+            format!("{why}; use the default mass strategy (`extended`: remove `mass`, or `--mass default`), which expresses such functions through their neighbours")
         })
     }
 

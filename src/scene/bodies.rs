@@ -2,7 +2,7 @@
 //! lattice, its material and initial velocity (its own or the scene's), and the
 //! number of particles of all bodies, bounded before any is made.
 
-use super::limits::{MAX_OUTLINE_CORNERS, MAX_PARTICLES};
+use super::limits::{MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS};
 use super::{
     bad, conflict, Body, BodyShape, ErrorKind, InitialVelocity, MaterialSpec, MeshSpec, Scene,
     SceneError,
@@ -45,6 +45,25 @@ impl Scene {
                     "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
                 ),
             ));
+        }
+        // Each particle of the scene may be tested against every corner of a polygon
+        // body (its own lattice cells when it is filled, the other bodies' particles
+        // in its bounding box for the overlap check): bound the work before it starts.
+        for (b, body) in self.bodies.iter().enumerate() {
+            if body.shape != BodyShape::Polygon {
+                continue;
+            }
+            let corners = body.outline.len() + body.holes.iter().map(Vec::len).sum::<usize>();
+            let tests = corners as f64 * (particles + self.estimated_particles(body));
+            if tests > MAX_POLYGON_TESTS {
+                return Err(bad(
+                    format!("body[{b}].outline"),
+                    format!(
+                        "{corners} corners against about {:.3e} lattice cells and particles take {tests:.3e} point-in-polygon tests, above the limit of {MAX_POLYGON_TESTS:e}: use fewer corners (a coarser outline) or a coarser lattice",
+                        particles + self.estimated_particles(body)
+                    ),
+                ));
+            }
         }
         for (b, body) in self.bodies.iter().enumerate() {
             if body.shape == BodyShape::Gmsh {

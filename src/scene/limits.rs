@@ -23,6 +23,11 @@ pub const MAX_ELEMENTS_1D: usize = 1_000_000;
 pub const MAX_TRIANGLES: usize = 4_000_000;
 /// Most corners of a `polygon` mesh's outline and holes together.
 pub const MAX_OUTLINE_CORNERS: usize = 100_000;
+/// Most point-in-polygon edge tests the polygon bodies may cost: placing a polygon
+/// body's particles and checking that no other body's particle lies inside it test
+/// up to every particle of the scene against every corner of the polygon (about 10 s
+/// at the limit).
+pub const MAX_POLYGON_TESTS: f64 = 1e10;
 /// Most particle frames `run --out` writes.
 pub const MAX_FRAMES: usize = 100_000;
 /// Most rows `run --format table` collects (it aligns them at the end); more need
