@@ -21,15 +21,11 @@ where
     M: MassStrategy<T>,
     Mat: ParticleMaterials<T, D>,
 {
-    /// The worst-covered function with particles in its support, when it is covered
-    /// below [`UNDER_SUPPORTED_COVERAGE`] and the mass strategy treated no function at
-    /// the last assembly: `(function, coverage, a message naming both and the fix)`.
-    /// Measured here if the strategy does not measure coverage itself (call after an
-    /// assembly, e.g. after [`Driver::critical_time_step`]).
-    pub fn untreated_under_supported(&self) -> Option<(usize, f64, String)> {
-        if self.last_report.treated() > 0 {
-            return None;
-        }
+    /// The coverage of every function (the fraction of its support's integral that
+    /// particle volume covers; `None` without particles in its support), as the
+    /// strategy measured it or measured here if it did not need it. For messages
+    /// only: it allocates.
+    fn coverage(&self) -> Vec<Option<f64>> {
         let computed;
         let (support, particle_volume) = match &self.inputs.support {
             Some(s) if self.inputs.needs.coverage => (s, &self.inputs.particle_volume),
@@ -40,14 +36,28 @@ where
                 (&computed.0, &computed.1)
             }
         };
-        let (i, c) = (0..particle_volume.len())
-            .filter(|&i| particle_volume[i] > 0.0)
+        (0..particle_volume.len())
             .map(|i| {
-                (
-                    i,
-                    SupportFacts::coverage_of(particle_volume[i], support.volume[i]),
-                )
+                (particle_volume[i] > 0.0)
+                    .then(|| SupportFacts::coverage_of(particle_volume[i], support.volume[i]))
             })
+            .collect()
+    }
+
+    /// The worst-covered function with particles in its support, when it is covered
+    /// below [`UNDER_SUPPORTED_COVERAGE`] and the mass strategy treated no function at
+    /// the last assembly: `(function, coverage, a message naming both and the fix)`.
+    /// Measured here if the strategy does not measure coverage itself (call after an
+    /// assembly, e.g. after [`Driver::critical_time_step`]).
+    pub fn untreated_under_supported(&self) -> Option<(usize, f64, String)> {
+        if self.last_report.treated() > 0 {
+            return None;
+        }
+        let coverage = self.coverage();
+        let (i, c) = coverage
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| c.map(|c| (i, c)))
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
         (c < UNDER_SUPPORTED_COVERAGE).then(|| {
             (
@@ -119,26 +129,12 @@ where
         }
         // The worst-covered function among those the particle sees (the coverage
         // is measured here if the strategy did not need it).
-        let computed;
-        let (support, particle_volume) = match &self.inputs.support {
-            Some(s) if self.inputs.needs.coverage => (s, &self.inputs.particle_volume),
-            _ => {
-                let mut volume = vec![0.0; self.basis.num_functions()];
-                phases::particle_volume(&self.evals, &self.particles.volume, &mut volume);
-                computed = (SupportFacts::new(&self.basis, &self.pattern, false), volume);
-                (&computed.0, &computed.1)
-            }
-        };
+        let coverage = self.coverage();
         let worst = self
             .evals
             .range(particle)
             .map(|s| self.evals.index[s])
-            .map(|i| {
-                (
-                    i,
-                    SupportFacts::coverage_of(particle_volume[i], support.volume[i]),
-                )
-            })
+            .map(|i| (i, coverage[i].unwrap_or(0.0)))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((i, c)) =
             worst.filter(|&(_, c)| c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0)

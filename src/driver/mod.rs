@@ -31,7 +31,7 @@ mod failure;
 pub mod phases;
 
 pub use critical::CRITICAL_ITERATIONS;
-pub use failure::{SetupError, StepError};
+pub use failure::{SetupError, StepError, NEARLY_SINGULAR};
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
