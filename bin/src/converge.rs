@@ -48,6 +48,19 @@ pub struct ConvergeArgs {
     format: Format,
 }
 
+/// The columns of the table and of `converge.csv`.
+const COLUMNS: [&str; 9] = [
+    "basis",
+    "level",
+    "h",
+    "functions",
+    "particles",
+    "error",
+    "order",
+    "seconds",
+    "stable",
+];
+
 /// One level of the study.
 #[derive(Debug, Clone, Serialize)]
 pub struct Level {
@@ -424,17 +437,7 @@ fn print_levels(
             }
         }
         Format::Table => {
-            let mut table = Table::new(&[
-                "basis",
-                "level",
-                "h",
-                "functions",
-                "particles",
-                "error",
-                "order",
-                "seconds",
-                "stable",
-            ]);
+            let mut table = Table::new(&COLUMNS);
             for r in rows {
                 table.push(vec![
                     r.basis.to_string(),
@@ -456,17 +459,7 @@ fn print_levels(
 
 fn csv(rows: &[Level]) -> String {
     let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
-    let mut out = crate::out::csv_record(&[
-        "basis",
-        "level",
-        "h",
-        "functions",
-        "particles",
-        "error",
-        "order",
-        "seconds",
-        "stable",
-    ]);
+    let mut out = crate::out::csv_record(&COLUMNS);
     out.push('\n');
     for r in rows {
         out += &crate::out::csv_record(&[

@@ -469,81 +469,51 @@ impl Recorder {
         .map_err(output_error)
     }
 
-    /// The displacement of the tracked particles against time: for each particle,
-    /// the components that move (x only in 1D), computed and reference.
+    /// The displacement of the tracked particles against time (see [`Self::tracked_panel`]).
     fn tracked_plot(&self, tracked: &[Tracked]) -> LinePlot {
-        let mut plot = LinePlot::new(
+        self.tracked_panel(
+            tracked,
             format!("{}: tracked particles", self.scene),
-            "time (s)",
             "displacement (m)",
-        );
-        let axis = ["x", "y"];
-        for t in tracked {
-            let has_exact =
-                !t.exact_displacement.is_empty() && t.exact_displacement.len() == t.time.len();
-            let amplitude = |c: usize| {
-                t.displacement
-                    .iter()
-                    .chain(&t.exact_displacement)
-                    .map(|u| u[c].abs())
-                    .filter(|a| a.is_finite())
-                    .fold(0.0, f64::max)
-            };
-            let amplitudes = [amplitude(0), amplitude(1)];
-            let largest = amplitudes[0].max(amplitudes[1]);
-            let components: Vec<usize> = (0..self.dim)
-                .filter(|&c| amplitudes[c] > 1e-3 * largest)
-                .collect();
-            let components = if components.is_empty() {
-                vec![self.dim - 1]
-            } else {
-                components
-            };
-            for c in components {
-                let name = format!("particle {} u_{}", t.particle, axis[c]);
-                let computed = t.time.iter().zip(&t.displacement).map(|(&s, u)| (s, u[c]));
-                if has_exact {
-                    plot = plot.with_series(Series::markers(
-                        format!("{name} (MPM)"),
-                        thin(computed.collect(), MAX_MARKERS),
-                    ));
-                    let exact = t
-                        .time
-                        .iter()
-                        .zip(&t.exact_displacement)
-                        .map(|(&s, u)| (s, u[c]));
-                    plot = plot.with_series(Series::line(
-                        format!("{name} (exact)"),
-                        thin(exact.collect(), MAX_PLOT_POINTS),
-                    ));
-                } else {
-                    plot = plot.with_series(Series::line(
-                        format!("{name} (MPM)"),
-                        thin(computed.collect(), MAX_PLOT_POINTS),
-                    ));
-                }
-            }
-        }
-        plot
+            "u",
+            |t| (&t.displacement, &t.exact_displacement),
+        )
     }
 
-    /// The velocity of the tracked particles against time, the components that
-    /// move: with a reference, the computed velocity as markers and the reference's
-    /// as a line (as the displacement), else the computed one as a line.
+    /// The velocity of the tracked particles against time (see [`Self::tracked_panel`]).
     fn tracked_velocity_plot(&self, tracked: &[Tracked]) -> LinePlot {
-        let mut plot = LinePlot::new(
+        self.tracked_panel(
+            tracked,
             format!("{}: tracked particles, velocity", self.scene),
-            "time (s)",
             "velocity (m/s)",
-        );
+            "v",
+            |t| (&t.velocity, &t.exact_velocity),
+        )
+    }
+
+    /// One panel of `tracked.svg`: for each particle the components of the
+    /// quantity `series(t) = (computed, reference)` that move (above 1e-3 of the
+    /// largest; x only in 1D), named `particle P SYMBOL_x`. With a reference, the
+    /// computed values as markers and the reference as a line; without, the computed
+    /// values as a line.
+    fn tracked_panel(
+        &self,
+        tracked: &[Tracked],
+        title: String,
+        label: &str,
+        symbol: &str,
+        series: impl Fn(&Tracked) -> (&Vec<[f64; 2]>, &Vec<[f64; 2]>),
+    ) -> LinePlot {
+        let mut plot = LinePlot::new(title, "time (s)", label);
         let axis = ["x", "y"];
         for t in tracked {
-            let has_exact = !t.exact_velocity.is_empty() && t.exact_velocity.len() == t.time.len();
+            let (computed, exact) = series(t);
+            let has_exact = !exact.is_empty() && exact.len() == t.time.len();
             let amplitude = |c: usize| {
-                t.velocity
+                computed
                     .iter()
-                    .chain(&t.exact_velocity)
-                    .map(|v| v[c].abs())
+                    .chain(exact)
+                    .map(|u| u[c].abs())
                     .filter(|a| a.is_finite())
                     .fold(0.0, f64::max)
             };
@@ -556,31 +526,24 @@ impl Recorder {
                 components.push(self.dim - 1);
             }
             for c in components {
-                let name = format!("particle {} v_{}", t.particle, axis[c]);
-                let points: Vec<(f64, f64)> = t
-                    .time
-                    .iter()
-                    .zip(&t.velocity)
-                    .map(|(&s, v)| (s, v[c]))
-                    .collect();
+                let name = format!("particle {} {symbol}_{}", t.particle, axis[c]);
+                let points = |values: &Vec<[f64; 2]>| -> Vec<(f64, f64)> {
+                    t.time.iter().zip(values).map(|(&s, u)| (s, u[c])).collect()
+                };
                 if has_exact {
-                    plot = plot.with_series(Series::markers(
-                        format!("{name} (MPM)"),
-                        thin(points, MAX_MARKERS),
-                    ));
-                    let exact = t
-                        .time
-                        .iter()
-                        .zip(&t.exact_velocity)
-                        .map(|(&s, v)| (s, v[c]));
-                    plot = plot.with_series(Series::line(
-                        format!("{name} (exact)"),
-                        thin(exact.collect(), MAX_PLOT_POINTS),
-                    ));
+                    plot = plot
+                        .with_series(Series::markers(
+                            format!("{name} (MPM)"),
+                            thin(points(computed), MAX_MARKERS),
+                        ))
+                        .with_series(Series::line(
+                            format!("{name} (exact)"),
+                            thin(points(exact), MAX_PLOT_POINTS),
+                        ));
                 } else {
                     plot = plot.with_series(Series::line(
                         format!("{name} (MPM)"),
-                        thin(points, MAX_PLOT_POINTS),
+                        thin(points(computed), MAX_PLOT_POINTS),
                     ));
                 }
             }

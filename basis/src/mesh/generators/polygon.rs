@@ -561,20 +561,18 @@ impl<'a> SegmentGrid<'a> {
                 start: Vec::new(),
                 items: Vec::new(),
             };
-            let cover: usize = (0..segments.len()).map(|m| grid.cells_of(m).len()).sum();
+            let cover: usize = (0..segments.len())
+                .map(|m| {
+                    let [i0, j0, i1, j1] = grid.box_cells(m);
+                    (i1 - i0 + 1) * (j1 - j0 + 1)
+                })
+                .sum();
             if cover <= Self::MAX_COVER * n || dims == [1, 1] {
                 grid.fill();
                 return grid;
             }
             cell *= 2.0;
         }
-    }
-
-    /// The cells (row-major indices) segment `m`'s grown box covers.
-    fn cells_of(&self, m: usize) -> std::ops::Range<usize> {
-        // (a range per row is enough for the count; `fill` walks the rows)
-        let [i0, j0, i1, j1] = self.box_cells(m);
-        0..(i1 - i0 + 1) * (j1 - j0 + 1)
     }
 
     /// `[i0, j0, i1, j1]`: the cell columns and rows of segment `m`'s grown box.
