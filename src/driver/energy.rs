@@ -40,20 +40,27 @@ where
             return Ok(0.0);
         }
         if !self.velocity_known {
-            phases::zero(&mut self.velocity);
-            phases::scatter_to_functions(
-                &self.evals,
-                &self.bins,
-                &self.gather,
-                &mut self.local,
-                &self.particles.mass,
-                &self.particles.v,
-                &mut self.velocity,
-            );
-            self.solve_projection()?;
-            self.velocity_known = true;
+            self.project_initial_velocity()?;
         }
         Ok(phases::power(&self.work_force, &self.velocity))
+    }
+
+    /// `v̂⁰`: the projection of the initial particle velocities with this step's
+    /// mass matrix.
+    pub(super) fn project_initial_velocity(&mut self) -> Result<(), StepError> {
+        phases::zero(&mut self.velocity);
+        phases::scatter_to_functions(
+            &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
+            &self.particles.mass,
+            &self.particles.v,
+            &mut self.velocity,
+        );
+        self.solve_projection()?;
+        self.velocity_known = true;
+        Ok(())
     }
 
     /// Work of the non-conservative effects over the step with the mean of the

@@ -38,12 +38,12 @@ pub use phases::update_deformation_gradient;
 
 use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{
-    Constraints, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
+    Constraints, Correction, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
 };
 use crate::materials::ParticleMaterials;
 use crate::particles::Particles;
 use crate::sparse::{Scalar, SymmetricPattern};
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 use phases::{Bins, Evaluations, Gather, Local, UpdateFailure};
 use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
@@ -113,6 +113,12 @@ where
     /// Per-particle forces of the effects that act per particle
     /// ([`Effect::particle_force`]); empty without any.
     particle_force: Vec<SVector<T, D>>,
+    /// `C_p` of the affine correction ([`phases::Affine`]); empty unless the
+    /// strategy asks for it.
+    affine_gradient: Vec<SMatrix<T, D, D>>,
+    /// The points of linear precision `ξ_i`; empty unless the strategy asks for
+    /// the affine correction.
+    function_points: Vec<SVector<T, D>>,
     /// Per-particle terms of the step report's energies.
     energy_terms: Vec<[f64; 8]>,
     work: f64,
@@ -206,6 +212,7 @@ where
         };
         let np = particles.len();
         let stride = basis.max_functions_per_element();
+        let corrects = needs.correction != Correction::None;
         Ok(Driver {
             scratch: (0..phases::chunks(np))
                 .map(|_| BasisEval::for_basis(&basis))
@@ -221,6 +228,14 @@ where
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             adjust: scratch(!effects.is_empty()),
             energy_terms: vec![[0.0; 8]; np],
+            affine_gradient: vec![SMatrix::zeros(); if corrects { np } else { 0 }],
+            function_points: if corrects {
+                (0..n)
+                    .map(|i| SVector::from_fn(|k, _| T::of(basis.function_point(i)[k])))
+                    .collect()
+            } else {
+                Vec::new()
+            },
             particle_force: if effects.iter().any(|e| e.acts_per_particle()) {
                 vec![SVector::zeros(); np]
             } else {
@@ -308,17 +323,7 @@ where
         let power_start = self.power_at_start()?;
         self.solve_acceleration()?;
         let t_solve = clock.elapsed().as_secs_f64() - t_assemble;
-        phases::update_velocities_and_momentum(
-            &self.evals,
-            &self.bins,
-            &self.gather,
-            &mut self.local,
-            &self.rhs,
-            self.dt,
-            &self.particles.mass,
-            &mut self.particles.v,
-            &mut self.velocity,
-        );
+        self.update_velocities_and_momentum()?;
         let before_projection = clock.elapsed().as_secs_f64();
         self.solve_projection()?;
         let t_projection = clock.elapsed().as_secs_f64() - before_projection;
@@ -519,6 +524,39 @@ where
     /// Phase 5: `M v̂ = P` (eq. (20)).
     fn solve_projection(&mut self) -> Result<(), StepError> {
         self.solve_projected(Which::Velocity)
+    }
+
+    /// Phases 4–5: particle velocities and momentum, with the affine correction
+    /// when the strategy lumped rows and asked for it (it needs `v̂ⁿ`, projected
+    /// from the initial velocities before the first step).
+    fn update_velocities_and_momentum(&mut self) -> Result<(), StepError> {
+        let correction = self.inputs.needs.correction;
+        let affine = correction != Correction::None && self.mass.lumped_rows().is_some();
+        if affine && !self.velocity_known {
+            self.project_initial_velocity()?;
+        }
+        let affine = match self.mass.lumped_rows() {
+            Some(decoupled) if affine => Some(phases::Affine {
+                decoupled,
+                points: &self.function_points,
+                gradient: &mut self.affine_gradient,
+                rigid: correction == Correction::Rigid,
+            }),
+            _ => None,
+        };
+        phases::update_velocities_and_momentum(
+            &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
+            &self.rhs,
+            self.dt,
+            &self.particles.mass,
+            &mut self.particles.v,
+            &mut self.velocity,
+            affine,
+        );
+        Ok(())
     }
 
     /// Phase 6: deformation, stress, volume and positions (eqs. (22)–(31)).

@@ -184,8 +184,41 @@ pub fn scatter_to_functions<T: Scalar, const D: usize>(
     });
 }
 
+/// The affine correction of the momentum for lumped rows (APIC and RPIC, Jiang et
+/// al. 2015, on the pairs a lumping decouples).
+///
+/// Lumping the pair `(i, j)` moves `M_ij` onto both diagonals,
+/// `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`; then `M' c = P` no longer returns the
+/// coefficients `c_i = v(ξ_i)` of an affine field `v` that the particles carry
+/// (`ξ_i` the points of linear precision, `Σ_i phi_i(x) ξ_i = x`), and a rigid
+/// rotation decays. Adding to `P` the same pair terms applied to each particle's
+/// affine field `v_p + C_p (x − x_p)`,
+///
+/// `P'_i = P_i + Σ_p m_p phi_i(x_p) Σ_{j decoupled from i} phi_j(x_p) C_p (ξ_i − ξ_j)`,
+///
+/// gives `M' c = P'` exactly for affine fields. Each pair term enters `i` and `j`
+/// with opposite signs, so the total momentum is unchanged. With `rigid`, `C_p` is
+/// replaced by its skew part `(C_p − C_pᵀ)/2`: rigid motions project exactly and
+/// the lumped rows still smooth the straining modes (what steadies a free
+/// surface; `docs/stability.md` measures both).
+///
+/// `C_p` must be the gradient of the field the particle velocity follows: from
+/// `v̂ⁿ` alone (without `Δt ∇a`) the column of B5b blows up.
+pub struct Affine<'a, T: Scalar, const D: usize> {
+    /// `decoupled[i]`: the row of function `i` is lumped ([`crate::mass::MassStrategy::lumped_rows`]).
+    pub decoupled: &'a [bool],
+    /// `ξ_i`, the points of linear precision ([`psmpm_basis::Basis::function_point`]).
+    pub points: &'a [SVector<T, D>],
+    /// `C_p`, written here: the gradient of `v̂ⁿ + Δt a` at the particle, the
+    /// field whose values the particle velocity update (eq. (18)) follows.
+    pub gradient: &'a mut [SMatrix<T, D, D>],
+    /// Keep only the skew part of `C_p` (rigid motions; RPIC).
+    pub rigid: bool,
+}
+
 /// Phases 4–5: particle velocities `v_p += Δt Σ_i a_i phi_i(x_p)` (eq. (18)) and
-/// the momentum `P_i = Σ_p m_p phi_i(x_p) v_p` (eq. (21)) into `momentum`.
+/// the momentum `P_i = Σ_p m_p phi_i(x_p) v_p` (eq. (21)) into `momentum`, which
+/// holds `v̂ⁿ` on entry; with `affine`, corrected for the lumped rows ([`Affine`]).
 #[allow(clippy::too_many_arguments)]
 pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
@@ -197,24 +230,77 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     mass: &[T],
     v: &mut [SVector<T, D>],
     momentum: &mut [Vec<T>],
+    affine: Option<Affine<'_, T, D>>,
 ) {
-    v.par_chunks_mut(CHUNK).enumerate().for_each(|(c, v)| {
-        for (q, v) in v.iter_mut().enumerate() {
-            let mut a = SVector::<T, D>::zeros();
-            for s in evals.range(c * CHUNK + q) {
-                let i = evals.index[s];
-                for k in 0..D {
-                    a[k] += acceleration[k][i] * evals.phi[s];
+    let increment = |p: usize| {
+        let mut a = SVector::<T, D>::zeros();
+        for s in evals.range(p) {
+            let i = evals.index[s];
+            for k in 0..D {
+                a[k] += acceleration[k][i] * evals.phi[s];
+            }
+        }
+        a * dt
+    };
+    let Some(Affine {
+        decoupled,
+        points,
+        gradient,
+        rigid,
+    }) = affine
+    else {
+        v.par_chunks_mut(CHUNK).enumerate().for_each(|(c, v)| {
+            for (q, v) in v.iter_mut().enumerate() {
+                *v += increment(c * CHUNK + q);
+            }
+        });
+        zero(momentum);
+        let v = &*v;
+        scatter_by_elements(bins, evals, gather, local, momentum, |p, s| {
+            let w = mass[p] * evals.phi[s];
+            SVector::<T, D>::from_fn(|k, _| w * v[p][k])
+        });
+        return;
+    };
+    let old = &*momentum;
+
+    (v.par_chunks_mut(CHUNK), gradient.par_chunks_mut(CHUNK))
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(c, (v, gradient))| {
+            for (q, (v, g)) in v.iter_mut().zip(gradient.iter_mut()).enumerate() {
+                let p = c * CHUNK + q;
+                *v += increment(p);
+                *g = SMatrix::zeros();
+                for s in evals.range(p) {
+                    let i = evals.index[s];
+                    for k in 0..D {
+                        let c = old[k][i] + dt * acceleration[k][i];
+                        for l in 0..D {
+                            g[(k, l)] += c * evals.grad_phi[s][l];
+                        }
+                    }
+                }
+                if rigid {
+                    *g = (*g - g.transpose()) * T::of(0.5);
                 }
             }
-            *v += a * dt;
-        }
-    });
+        });
     zero(momentum);
-    let v = &*v;
+    let (v, gradient) = (&*v, &*gradient);
     scatter_by_elements(bins, evals, gather, local, momentum, |p, s| {
         let w = mass[p] * evals.phi[s];
-        SVector::<T, D>::from_fn(|k, _| w * v[p][k])
+        let mut out = v[p] * w;
+        let i = evals.index[s];
+        let mut lever = SVector::<T, D>::zeros();
+        for t in evals.range(p) {
+            let j = evals.index[t];
+            if j != i && (decoupled[i] || decoupled[j]) {
+                lever += (points[i] - points[j]) * evals.phi[t];
+            }
+        }
+        out += gradient[p] * lever * w;
+        out
     });
 }
 

@@ -92,6 +92,8 @@ pub enum MassKind {
         extend: f64,
         /// Coverage below which (and at or above `extend`) a row is lumped.
         lump: f64,
+        /// How the momentum of the lumped rows is corrected.
+        correction: Correction,
     },
     /// Truncated series for `M⁻¹` preconditioned by the lumped mass.
     Fmpm {
@@ -119,7 +121,7 @@ impl Default for MassKind {
 }
 
 /// Names [`MassKind::parse`] knows, for messages.
-pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, fmpm:K";
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-apic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
 
 impl MassKind {
     /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
@@ -172,14 +174,17 @@ impl MassKind {
             ("extended", None) => Ok(MassKind::Extended {
                 coverage: DEFAULT_COVERAGE,
             }),
-            ("extended-hybrid", None) => Ok(MassKind::ExtendedHybrid {
-                extend: DEFAULT_HYBRID_EXTEND,
-                lump: DEFAULT_HYBRID_LUMP,
-            }),
+            (hybrid, None) if Correction::of_name(hybrid).is_some() => {
+                Ok(MassKind::ExtendedHybrid {
+                    extend: DEFAULT_HYBRID_EXTEND,
+                    lump: DEFAULT_HYBRID_LUMP,
+                    correction: Correction::of_name(hybrid).unwrap_or_default(),
+                })
+            }
             ("extended", Some(a)) => Ok(MassKind::Extended {
                 coverage: fraction(a)?,
             }),
-            ("extended-hybrid", Some(a)) => {
+            (hybrid, Some(a)) if Correction::of_name(hybrid).is_some() => {
                 // `:` between the two (lists of strategies are comma-separated);
                 // `,` is read too.
                 let (c1, c2) = a.split_once([':', ',']).ok_or_else(|| {
@@ -191,7 +196,11 @@ impl MassKind {
                         "`{name}`: the extension coverage {extend} is above the lumping coverage {lump}"
                     ));
                 }
-                Ok(MassKind::ExtendedHybrid { extend, lump })
+                Ok(MassKind::ExtendedHybrid {
+                    extend,
+                    lump,
+                    correction: Correction::of_name(hybrid).unwrap_or_default(),
+                })
             }
             ("fmpm", Some(a)) => a
                 .parse::<usize>()
@@ -219,10 +228,12 @@ impl MassKind {
             MassKind::Extended { coverage } if coverage != DEFAULT_COVERAGE => {
                 format!("extended:{coverage}")
             }
-            MassKind::ExtendedHybrid { extend, lump }
-                if (extend, lump) != (DEFAULT_HYBRID_EXTEND, DEFAULT_HYBRID_LUMP) =>
-            {
-                format!("extended-hybrid:{extend}:{lump}")
+            MassKind::ExtendedHybrid {
+                extend,
+                lump,
+                correction,
+            } if (extend, lump) != (DEFAULT_HYBRID_EXTEND, DEFAULT_HYBRID_LUMP) => {
+                format!("{}:{extend}:{lump}", correction.hybrid_name())
             }
             MassKind::Fmpm { order } => format!("fmpm:{order}"),
             other => other.name().to_string(),
@@ -237,7 +248,7 @@ impl MassKind {
             MassKind::Partial(_) => "partial",
             MassKind::Deactivate { .. } => "deactivate",
             MassKind::Extended { .. } => "extended",
-            MassKind::ExtendedHybrid { .. } => "extended-hybrid",
+            MassKind::ExtendedHybrid { correction, .. } => correction.hybrid_name(),
             MassKind::Fmpm { .. } => "fmpm",
         }
     }
@@ -250,7 +261,11 @@ impl MassKind {
             MassKind::Partial(rule) => Box::new(Partial::new(rule)),
             MassKind::Deactivate { threshold } => Box::new(Deactivate::new(threshold)),
             MassKind::Extended { coverage } => Box::new(Extended::new(coverage)),
-            MassKind::ExtendedHybrid { extend, lump } => Box::new(Extended::hybrid(extend, lump)),
+            MassKind::ExtendedHybrid {
+                extend,
+                lump,
+                correction,
+            } => Box::new(Extended::hybrid(extend, lump, correction)),
             MassKind::Fmpm { order } => Box::new(Fmpm::new(order)),
         }
     }
@@ -288,6 +303,42 @@ pub struct Needs {
     pub coverage: bool,
     /// The polynomial coefficients of the basis in [`SupportFacts`].
     pub polynomials: bool,
+    /// The correction of the momentum for the rows [`MassStrategy::lumped_rows`]
+    /// returns (the driver then keeps a velocity gradient per particle and the
+    /// basis's points of linear precision).
+    pub correction: Correction,
+}
+
+/// How the driver corrects the momentum `P` of the rows a strategy lumped, so that
+/// some velocity fields still project exactly through them
+/// (`driver::phases::Affine`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Correction {
+    /// No correction: a lumped row smooths every field but a constant.
+    #[default]
+    None,
+    /// Rigid-body motions (translation and rotation) project exactly: the particle
+    /// velocity gradient's skew part (RPIC, Jiang et al. 2015). Lumping still
+    /// smooths the straining modes.
+    Rigid,
+    /// Every affine field projects exactly: the whole velocity gradient (APIC).
+    Affine,
+}
+
+impl Correction {
+    /// The name of the hybrid extension with this correction.
+    pub fn hybrid_name(self) -> &'static str {
+        match self {
+            Correction::Rigid => "extended-hybrid",
+            Correction::Affine => "extended-hybrid-apic",
+            Correction::None => "extended-hybrid-plain",
+        }
+    }
+    fn of_name(name: &str) -> Option<Self> {
+        [Correction::Rigid, Correction::Affine, Correction::None]
+            .into_iter()
+            .find(|c| c.hybrid_name() == name)
+    }
 }
 
 /// Per-step facts a strategy may use (empty slices for facts it did not ask for).
@@ -334,6 +385,15 @@ pub trait MassStrategy<T: Scalar>: Send {
     /// (the largest over components). Costs about `2 ×` [`CONDITION_ITERATIONS`]
     /// solves; call on request.
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64;
+    /// The functions whose rows were lumped in the system last factorised
+    /// (`M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ` over the pairs with a lumped
+    /// row), when the strategy asked ([`Needs::correction`]) for the momentum to be
+    /// corrected so that rigid or affine velocity fields project exactly
+    /// (`phases::update_velocities_and_momentum`). `None`: no row lumped this step,
+    /// or no correction wanted.
+    fn lumped_rows(&self) -> Option<&[bool]> {
+        None
+    }
 }
 
 impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
@@ -359,6 +419,9 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         (**self).condition_estimate(pattern)
+    }
+    fn lumped_rows(&self) -> Option<&[bool]> {
+        (**self).lumped_rows()
     }
 }
 

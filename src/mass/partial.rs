@@ -50,6 +50,7 @@ impl<T: Scalar> MassStrategy<T> for Partial<T> {
             empty_elements: self.rule == LumpRule::EmptyElement,
             coverage: matches!(self.rule, LumpRule::Coverage(_)),
             polynomials: false,
+            correction: super::Correction::None,
         }
     }
     fn prepare(&mut self, setup: &MassSetup) {

@@ -279,7 +279,16 @@ fn mass_kinds_parse() {
         MassKind::parse("extended-hybrid:0.02:0.75").unwrap(),
         MassKind::ExtendedHybrid {
             extend: 0.02,
-            lump: 0.75
+            lump: 0.75,
+            correction: super::Correction::Rigid,
+        }
+    );
+    assert_eq!(
+        MassKind::parse("extended-hybrid-plain").unwrap(),
+        MassKind::ExtendedHybrid {
+            extend: 0.02,
+            lump: 0.75,
+            correction: super::Correction::None,
         }
     );
     assert_eq!(
@@ -293,6 +302,9 @@ fn mass_kinds_parse() {
         "fmpm:2",
         "extended",
         "extended-hybrid:0.25:0.5",
+        "extended-hybrid-plain:0.25:0.5",
+        "extended-hybrid-plain",
+        "extended-hybrid-apic:0.1:0.2",
         "lumped",
     ] {
         assert_eq!(MassKind::parse(kind).unwrap().spec(), kind);

@@ -27,8 +27,8 @@
 use super::condition::lanczos_estimate;
 use super::masked::MaskedCholesky;
 use super::{
-    distinct_fixed_sets, MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext,
-    SupportFacts,
+    distinct_fixed_sets, Correction, MassError, MassReport, MassSetup, MassStrategy, Needs,
+    StepContext, SupportFacts,
 };
 use crate::sparse::{Scalar, SymmetricPattern};
 use solve::{conjugate_gradients, Reduced, Scratch};
@@ -68,6 +68,10 @@ pub struct Extended<T: Scalar> {
     /// to `coverage` when nothing is lumped).
     lump: f64,
     lumped: Vec<bool>,
+    /// How the driver corrects the momentum of the lumped rows.
+    correction: Correction,
+    /// Some row is lumped in this step.
+    any_lumped: bool,
     /// Buffer of the row lumping.
     diagonal_add: Vec<T>,
     support: SupportFacts,
@@ -105,17 +109,22 @@ pub struct Extended<T: Scalar> {
 impl<T: Scalar> Extended<T> {
     /// Extension below `coverage` (a fraction in `(0, 1)`).
     pub fn new(coverage: f64) -> Self {
-        Self::hybrid(coverage, coverage)
+        Self::hybrid(coverage, coverage, Correction::None)
     }
 
     /// Extension below `extend`, and the rows of the functions covered in
     /// `[extend, lump)` lumped (`M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ` over their
     /// off-diagonal entries, as partial lumping does): mass and momentum are kept.
-    pub fn hybrid(extend: f64, lump: f64) -> Self {
+    /// The driver corrects the momentum of the lumped rows as `correction` says
+    /// (with [`Correction::Rigid`] a lumped row keeps rigid rotations, which it
+    /// would otherwise damp).
+    pub fn hybrid(extend: f64, lump: f64, correction: Correction) -> Self {
         Extended {
             coverage: extend,
             lump: lump.max(extend),
             lumped: Vec::new(),
+            correction,
+            any_lumped: false,
             diagonal_add: Vec::new(),
             support: SupportFacts::default(),
             fixed: Vec::new(),
@@ -163,11 +172,12 @@ impl<T: Scalar> Extended<T> {
 
 impl<T: Scalar> MassStrategy<T> for Extended<T> {
     fn spec(&self) -> String {
+        let hybrid = self.correction.hybrid_name();
         if (self.coverage, self.lump) == (super::DEFAULT_HYBRID_EXTEND, super::DEFAULT_HYBRID_LUMP)
         {
-            "extended-hybrid".into()
+            hybrid.into()
         } else if self.lump > self.coverage {
-            format!("extended-hybrid:{}:{}", self.coverage, self.lump)
+            format!("{hybrid}:{}:{}", self.coverage, self.lump)
         } else if self.coverage == DEFAULT_COVERAGE {
             "extended".into()
         } else {
@@ -179,7 +189,15 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             empty_elements: false,
             coverage: true,
             polynomials: true,
+            correction: if self.lump > self.coverage {
+                self.correction
+            } else {
+                Correction::None
+            },
         }
+    }
+    fn lumped_rows(&self) -> Option<&[bool]> {
+        (self.correction != Correction::None && self.any_lumped).then_some(&self.lumped[..])
     }
     fn prepare(&mut self, setup: &MassSetup) {
         let pattern = setup.pattern;
@@ -273,6 +291,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             );
         }
         report.lumped_rows = self.lumped.iter().filter(|&&l| l).count();
+        self.any_lumped = report.lumped_rows > 0;
         self.active.clear();
         self.extended.clear();
         for i in 0..n {
