@@ -72,7 +72,7 @@ fn column_large_on_1x8_lumped_and_partial_stay_stable_consistent_fails_cleanly()
     assert!(!summary.stable);
     let failure = summary.failure.unwrap();
     assert!(
-        failure.starts_with("step ") && failure.contains("`extended`"),
+        failure.starts_with("step ") && failure.contains("`extended-hybrid`"),
         "{failure}"
     );
     assert!(summary.t_end < 0.2, "fails early: {}", summary.t_end);

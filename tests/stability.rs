@@ -1,4 +1,4 @@
-//! Hard cases stay stable with the default mass strategy (extension), written as a
+//! Hard cases stay stable with the default mass strategy (the hybrid extension), written as a
 //! user writes scenes: a body in a mostly empty unstructured mesh, the seeds'
 //! column refined. The same cases break the consistent mass, with a message that
 //! names the under-supported function and the fix.
@@ -59,20 +59,21 @@ condition = true
 fn a_block_dropped_into_a_mostly_empty_box_lands_stably_with_the_default_mass() {
     let scene = Scene::from_toml(DROP, "drop.toml").unwrap();
     assert_eq!(scene.mass, MassKind::default());
-    let (mut extended_max, mut treated_max) = (0, 0);
+    let (mut extended_max, mut lumped_max) = (0, 0);
     let mut landed = false;
     let summary = run(&scene, &mut |r| {
         extended_max = extended_max.max(r.mass_report.extended);
-        treated_max = treated_max.max(r.mass_report.treated());
+        lumped_max = lumped_max.max(r.mass_report.lumped_rows);
         // The block falls 0.6 in about 0.35 s and lands on the floor.
         landed |= r.time > 0.4;
     })
     .unwrap();
     assert!(summary.stable, "{summary:?}");
     assert!(landed);
+    // The functions with almost no particles are extended, the rows of the
+    // moderately covered ones lumped.
     assert!(extended_max > 0, "nothing was extended");
-    // The extension alone: nothing lumped or deactivated.
-    assert_eq!(treated_max, extended_max);
+    assert!(lumped_max > 0, "nothing was lumped");
     let condition = summary.max_condition.unwrap();
     assert!(condition < 1e3, "condition {condition}");
     // The consistent mass fails at once, and says why and what to do.
@@ -103,11 +104,12 @@ fn the_refined_column_is_stable_with_the_default_mass() {
     partial.mass = MassKind::parse("partial").unwrap();
     let p = run(&partial, &mut |_| {}).unwrap();
     assert!(p.stable);
-    // Not less accurate than the seeds' partial lumping (E_u; the sudden load
-    // dominates the error, both are about 1e-4).
+    // As accurate as the seeds' partial lumping (E_u; the sudden load dominates
+    // the error). At this t = 1 the default is 8 % above (2.32e-5 against
+    // 2.15e-5); at the stability matrix's t = 2.5 it is below (docs/stability.md).
     let (e, ep) = (summary.error.unwrap(), p.error.unwrap());
     println!("E_u: default {e:.4e}, partial {ep:.4e}");
-    assert!(e < 1.5 * ep, "default {e:.3e}, partial {ep:.3e}");
+    assert!(e < 1.15 * ep, "default {e:.3e}, partial {ep:.3e}");
 }
 
 /// Where every function is well covered (B2 at a thesis resolution), the default

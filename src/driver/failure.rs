@@ -112,7 +112,7 @@ where
             ));
         }
         self.untreated_under_supported().map(|(_, _, why)| {
-            format!("{why}; use the default mass strategy (`extended`: remove `mass`, or `--mass default`), which expresses such functions through their neighbours")
+            format!("{why}; use the default mass strategy (`extended-hybrid`: remove `mass`, or `--mass default`), which expresses such functions through their neighbours")
         })
     }
 
@@ -140,7 +140,7 @@ where
             worst.filter(|&(_, c)| c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0)
         {
             return format!(
-                "the particle sits in the support of function {i} at {}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                "the particle sits in the support of function {i} at {}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
                 point(&to_f64_point(&self.basis.function_point(i))),
                 c,
                 self.mass.spec()
@@ -149,7 +149,7 @@ where
         if let Some((i, c)) = self.last_report.worst_coverage {
             if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 {
                 return format!(
-                    "function {i} at {} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended`)",
+                    "function {i} at {} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended-hybrid`)",
                     point(&to_f64_point(&self.basis.function_point(i))),
                     self.mass.spec()
                 );
@@ -183,18 +183,23 @@ where
                 ),
                 None => String::new(),
             };
+            let spec = self.mass.spec();
+            let alternative = if spec.starts_with("extended-hybrid") {
+                "`lumped`, which gives up the accuracy of the consistent rows"
+            } else {
+                "`extended-hybrid` (the default), which also lumps the rows of functions covered below 0.75"
+            };
             format!(
-                "`{}` treated {treated} functions and the rest is still singular{worst}: use more particles per element (`per_block` or `count`; `--particles`), or `extended-hybrid`, which also lumps the rows of functions covered below 0.75",
-                self.mass.spec()
+                "`{spec}` treated {treated} functions and the rest is still singular{worst}: use more particles per element (`per_block` or `count`; `--particles`), or {alternative}"
             )
         } else {
             match self.last_report.worst_coverage {
                 Some((i, c)) => format!(
-                    "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended`), which expresses such functions through their neighbours",
+                    "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
                     point(&to_f64_point(&self.basis.function_point(i)))
                 ),
                 None => format!(
-                    "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended`), or `partial` / `lumped`",
+                    "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended-hybrid`), or `partial` / `lumped`",
                     self.mass.spec()
                 ),
             }

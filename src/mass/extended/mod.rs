@@ -1,4 +1,5 @@
-//! Extension (aggregation) of under-supported functions: the default strategy.
+//! Extension (aggregation) of under-supported functions, alone (`extended`) or
+//! with lumped rows (`extended-hybrid`, the default strategy).
 //!
 //! A function whose support is covered by particle volume below a fraction `C`
 //! of its integral (`Σ_p V_p phi_j(x_p) < C ∫ phi_j`) is not solved for. It is
@@ -16,6 +17,15 @@
 //! total mass `1ᵀ Eᵀ M E 1 = 1ᵀ M 1` and the momentum are conserved, and the
 //! polynomial precision (hence the order) of the basis is kept. Where every
 //! function is well covered `E = I` and the strategy is the consistent mass.
+//!
+//! The hybrid ([`Extended::hybrid`], `extended-hybrid:C1:C2`, the default strategy
+//! at `0.02:0.75`) extends only the functions with almost no particles (below
+//! `C1`) and lumps the rows of the solved functions covered in `[C1, C2)`,
+//! `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`: lumping raises the critical step
+//! where extension of moderately covered functions lowers it, and keeps their
+//! degrees of freedom. The driver corrects the momentum of the lumped rows so that
+//! rigid motions still project exactly ([`Correction::Rigid`]); a lumped row
+//! would otherwise damp the rotation of a free body.
 //!
 //! The reduced system changes pattern whenever the set of extended functions
 //! does, so it is solved matrix-free by conjugate gradients with a Jacobi
