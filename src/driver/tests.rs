@@ -120,7 +120,7 @@ fn projection_error(
 }
 
 /// The corrections of `phases::Affine`: through lumped rows, a rigid motion
-/// projects exactly with the rigid (default) and the affine correction, a
+/// projects exactly with the affine (default) and the rigid correction, a
 /// general affine field with the affine one only; without a correction both are
 /// missed by percents.
 #[test]
@@ -132,10 +132,10 @@ fn the_corrections_project_rigid_and_affine_fields_exactly_through_lumped_rows()
         rigid(x) + nalgebra::Vector2::new(0.5 * x.x, -0.3 * x.y + 0.2 * x.x)
     }
     for (mass, field, exact) in [
-        ("extended-hybrid", rigid as fn(_) -> _, true),
-        ("extended-hybrid-apic", rigid, true),
-        ("extended-hybrid-apic", affine, true),
-        ("extended-hybrid", affine, false),
+        ("extended-hybrid-rpic", rigid as fn(_) -> _, true),
+        ("extended-hybrid", rigid, true),
+        ("extended-hybrid", affine, true),
+        ("extended-hybrid-rpic", affine, false),
         ("extended-hybrid-plain", rigid, false),
         ("extended-hybrid-plain", affine, false),
     ] {

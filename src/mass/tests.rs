@@ -280,7 +280,7 @@ fn mass_kinds_parse() {
         MassKind::ExtendedHybrid {
             extend: 0.02,
             lump: 0.75,
-            correction: super::Correction::Rigid,
+            correction: super::Correction::Affine,
         }
     );
     assert_eq!(
@@ -304,7 +304,7 @@ fn mass_kinds_parse() {
         "extended-hybrid:0.25:0.5",
         "extended-hybrid-plain:0.25:0.5",
         "extended-hybrid-plain",
-        "extended-hybrid-apic:0.1:0.2",
+        "extended-hybrid-rpic:0.1:0.2",
         "lumped",
     ] {
         assert_eq!(MassKind::parse(kind).unwrap().spec(), kind);

@@ -24,7 +24,8 @@
 //! `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`: lumping raises the critical step
 //! where extension of moderately covered functions lowers it, and keeps their
 //! degrees of freedom. The driver corrects the momentum of the lumped rows so that
-//! rigid motions still project exactly ([`Correction::Rigid`]); a lumped row
+//! affine fields, hence rigid motions, still project exactly
+//! ([`Correction::Affine`]); a lumped row
 //! would otherwise damp the rotation of a free body.
 //!
 //! The reduced system changes pattern whenever the set of extended functions
@@ -126,7 +127,7 @@ impl<T: Scalar> Extended<T> {
     /// `[extend, lump)` lumped (`M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ` over their
     /// off-diagonal entries, as partial lumping does): mass and momentum are kept.
     /// The driver corrects the momentum of the lumped rows as `correction` says
-    /// (with [`Correction::Rigid`] a lumped row keeps rigid rotations, which it
+    /// (with [`Correction::Affine`] a lumped row keeps rigid rotations, which it
     /// would otherwise damp).
     pub fn hybrid(extend: f64, lump: f64, correction: Correction) -> Self {
         Extended {
