@@ -530,20 +530,18 @@ where
     /// when the strategy lumped rows and asked for it (it needs `v̂ⁿ`, projected
     /// from the initial velocities before the first step).
     fn update_velocities_and_momentum(&mut self) -> Result<(), StepError> {
-        let correction = self.inputs.needs.correction;
-        let affine = correction != Correction::None && self.mass.lumped_rows().is_some();
-        if affine && !self.velocity_known {
+        // `Some` only for a strategy that asked for a correction (`Needs::correction`)
+        // and lumped rows in this step.
+        if self.mass.lumped_rows().is_some() && !self.velocity_known {
             self.project_initial_velocity()?;
         }
-        let affine = match self.mass.lumped_rows() {
-            Some(decoupled) if affine => Some(phases::Affine {
-                decoupled,
-                points: &self.function_points,
-                gradient: &mut self.affine_gradient,
-                rigid: correction == Correction::Rigid,
-            }),
-            _ => None,
-        };
+        let rigid = self.inputs.needs.correction == Correction::Rigid;
+        let affine = self.mass.lumped_rows().map(|decoupled| phases::Affine {
+            decoupled,
+            points: &self.function_points,
+            gradient: &mut self.affine_gradient,
+            rigid,
+        });
         phases::update_velocities_and_momentum(
             &self.evals,
             &self.bins,

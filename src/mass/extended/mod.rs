@@ -382,9 +382,6 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             let op = self.reduced(s);
             op.restrict(rhs, &mut b);
             let result = conjugate_gradients(&op, &self.precond[s], &b, &mut scratch);
-            if std::env::var("PSMPM_DEBUG_CG").is_ok() {
-                eprintln!("cg {:?} extended {}", result, self.ext_ptr[self.role.len()]);
-            }
             op.expand_all(&scratch.x, rhs);
             result
         };
