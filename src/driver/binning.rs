@@ -164,6 +164,25 @@ impl Gather {
             });
     }
 
+    /// `values_j += Σ` of the local matrix blocks' entries `j`, in element order.
+    pub(super) fn add_matrix<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        values: &mut [T],
+    ) {
+        values
+            .par_iter_mut()
+            .with_min_len(ENTRY_CHUNK)
+            .enumerate()
+            .for_each(|(j, v)| {
+                let mut sum = T::zero();
+                for &s in &self.matrix_source[self.matrix_start[j]..self.matrix_start[j + 1]] {
+                    sum += local.matrix[s];
+                }
+                *v += sum;
+            });
+    }
+
     /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in
     /// element order.
     pub(super) fn functions<T: Scalar, const D: usize>(

@@ -213,6 +213,7 @@ where
         let np = particles.len();
         let stride = basis.max_functions_per_element();
         let corrects = needs.correction != Correction::None;
+        let momentum_corrects = matches!(needs.correction, Correction::Rigid | Correction::Affine);
         Ok(Driver {
             scratch: (0..phases::chunks(np))
                 .map(|_| BasisEval::for_basis(&basis))
@@ -228,7 +229,7 @@ where
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             adjust: scratch(!effects.is_empty()),
             energy_terms: vec![[0.0; 8]; np],
-            affine_gradient: vec![SMatrix::zeros(); if corrects { np } else { 0 }],
+            affine_gradient: vec![SMatrix::zeros(); if momentum_corrects { np } else { 0 }],
             function_points: if corrects {
                 (0..n)
                     .map(|i| SVector::from_fn(|k, _| T::of(basis.function_point(i)[k])))
@@ -391,6 +392,24 @@ where
                 &self.particles.volume,
                 &mut self.inputs.particle_volume,
             );
+        }
+        if self.inputs.needs.correction == Correction::InMass {
+            let context = StepContext {
+                touches_empty: &self.inputs.touches_empty,
+                particle_volume: &self.inputs.particle_volume,
+            };
+            if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
+                phases::add_affine_lumping(
+                    &self.evals,
+                    &self.bins,
+                    &self.gather,
+                    &mut self.local,
+                    &self.particles.mass,
+                    &self.function_points,
+                    lumped,
+                    &mut self.values,
+                );
+            }
         }
     }
 

@@ -167,6 +167,84 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     gather.functions(local, true, force);
 }
 
+/// The affine-preserving lumping of the hybrid extension ([`crate::mass::Correction::InMass`]),
+/// added to the assembled `values` of `M`.
+///
+/// Lumping the pair `(i, j)` adds `M_ij (e_i − e_j)(e_i − e_j)ᵀ` to `M`, with
+/// `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)`: the quadratic form grows by
+/// `Σ_p m_p phi_i phi_j (c_i − c_j)²`, which does not vanish on an affine field
+/// `c_i = A ξ_i + b` (`ξ_i` the points of linear precision), so that a lumped row
+/// damps a rigid rotation. Here each particle's pair term measures `c_i − c_j`
+/// against the difference the field's own gradient at the particle predicts,
+///
+/// `M_A = M + Σ_p m_p Σ_{(i,j) lumped} phi_i phi_j g g ᵀ`, `g = e_i − e_j − G_p (ξ_i − ξ_j)`,
+///
+/// with `(G_p d)_k = grad phi_k(x_p) · d` over the particle's functions `k`
+/// (`Σ_k c_k grad phi_k(x_p)` is the field's gradient there). For an affine
+/// field `gᵀc = c_i − c_j − A (ξ_i − ξ_j) = 0`: affine fields project exactly,
+/// `M_A c = M c`. Since `Σ_k grad phi_k = 0`, `gᵀ 1 = 0`: row sums, total mass and
+/// momentum are those of `M`. `M_A − M` is a sum of positive semi-definite
+/// terms with weights linear in a poorly covered function's values, as in
+/// lumping, so `M_A ⪰ M` keeps such a function away from a zero pivot. `M_A` is
+/// symmetric and serves both solves of the step (eqs. (17) and (20)), so the
+/// energy balance `Pᵀ M_A⁻¹ F = v̂ᵀ F` of the step holds as with the consistent
+/// mass. Every `g` lives on one particle's functions, so `M_A` keeps the
+/// pattern of `M`; summed element by element (see the module's notes on threads).
+#[allow(clippy::too_many_arguments)]
+pub fn add_affine_lumping<T: Scalar, const D: usize>(
+    evals: &Evaluations<T, D>,
+    bins: &Bins,
+    gather: &Gather,
+    local: &mut Local<T, D>,
+    mass: &[T],
+    points: &[SVector<T, D>],
+    lumped: &[bool],
+    values: &mut [T],
+) {
+    let stride = local.stride;
+    (
+        local.matrix.par_chunks_mut(stride * stride),
+        local.vector.par_chunks_mut(stride * D),
+    )
+        .into_par_iter()
+        .with_min_len(ELEMENT_CHUNK)
+        .enumerate()
+        .for_each(|(e, (lm, g))| {
+            lm.iter_mut().for_each(|v| *v = T::zero());
+            for &p in bins.particles(e) {
+                let base = p * evals.stride;
+                let m = evals.len[p];
+                let index = &evals.index[base..base + m];
+                if !index.iter().any(|&i| lumped[i]) {
+                    continue;
+                }
+                let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
+                for a in 0..m {
+                    for b in a + 1..m {
+                        let (i, j) = (index[a], index[b]);
+                        let w = mass[p] * phi[a] * phi[b];
+                        if !(lumped[i] || lumped[j]) || w == T::zero() {
+                            continue;
+                        }
+                        let d = points[i] - points[j];
+                        for c in 0..m {
+                            g[c] = -grad_phi[c].dot(&d);
+                        }
+                        g[a] += T::one();
+                        g[b] -= T::one();
+                        for c in 0..m {
+                            let wc = w * g[c];
+                            for k in c..m {
+                                lm[c * stride + k] += wc * g[k];
+                            }
+                        }
+                    }
+                }
+            }
+        });
+    gather.add_matrix(local, values);
+}
+
 /// The particle → function scatter `out_{k,i} += Σ_p w_p phi_i(x_p) q_{p,k}`
 /// shared by the momentum (eq. (21), `w = m`, `q = v`) and any projection of a
 /// particle field onto the basis.

@@ -124,7 +124,7 @@ impl Default for MassKind {
 }
 
 /// Names [`MassKind::parse`] knows, for messages.
-pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-sym[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
 
 impl MassKind {
     /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
@@ -326,21 +326,35 @@ pub enum Correction {
     /// dropped block (`docs/stability.md`), kept for the comparison.
     Rigid,
     /// Every affine field projects exactly: the whole velocity gradient (APIC,
-    /// Jiang et al. 2015). The default hybrid's.
+    /// Jiang et al. 2015), added to the momentum only. Measured to dissipate the
+    /// straining modes of a body after an impact (`docs/stability.md`).
     Affine,
+    /// Every affine field projects exactly, through the mass matrix itself: the
+    /// lumped pairs move onto the diagonal only the part of `M_ij` that an affine
+    /// field does not see (`driver::phases::add_affine_lumping`). The matrix
+    /// stays symmetric positive definite and serves both solves of the step, so
+    /// the step's energy balance holds as with the consistent mass. No momentum
+    /// correction.
+    InMass,
 }
 
 impl Correction {
     /// The name of the hybrid extension with this correction.
     pub fn hybrid_name(self) -> &'static str {
         match self {
+            Correction::InMass => "extended-hybrid-sym",
             Correction::Affine => "extended-hybrid",
             Correction::Rigid => "extended-hybrid-rpic",
             Correction::None => "extended-hybrid-plain",
         }
     }
     fn of_name(name: &str) -> Option<Self> {
-        [Correction::Affine, Correction::Rigid, Correction::None]
+        [
+            Correction::InMass,
+            Correction::Affine,
+            Correction::Rigid,
+            Correction::None,
+        ]
             .into_iter()
             .find(|c| c.hybrid_name() == name)
     }
@@ -399,6 +413,21 @@ pub trait MassStrategy<T: Scalar>: Send {
     fn lumped_rows(&self) -> Option<&[bool]> {
         None
     }
+    /// For a strategy whose [`Needs::correction`] is [`Correction::InMass`]: the
+    /// functions of the step classified from `context` and the assembled `values`
+    /// of `M`, before [`factorize`](Self::factorize); returns the functions whose
+    /// rows are lumped, for the driver to add the affine-preserving lumping term
+    /// to `values` (`driver::phases::add_affine_lumping`). `factorize` is then
+    /// called with the modified values and keeps this classification. `None`: no
+    /// row lumped this step.
+    fn classify(
+        &mut self,
+        _pattern: &SymmetricPattern,
+        _values: &[T],
+        _context: StepContext,
+    ) -> Option<&[bool]> {
+        None
+    }
 }
 
 impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
@@ -427,6 +456,14 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn lumped_rows(&self) -> Option<&[bool]> {
         (**self).lumped_rows()
+    }
+    fn classify(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        context: StepContext,
+    ) -> Option<&[bool]> {
+        (**self).classify(pattern, values, context)
     }
 }
 

@@ -83,6 +83,9 @@ pub struct Extended<T: Scalar> {
     correction: Correction,
     /// Some row is lumped in this step.
     any_lumped: bool,
+    /// The step's classification, made by [`MassStrategy::classify`] before the
+    /// driver added the affine-preserving lumping term ([`Correction::InMass`]).
+    classified: Option<MassReport>,
     /// Buffer of the row lumping.
     diagonal_add: Vec<T>,
     support: SupportFacts,
@@ -136,6 +139,7 @@ impl<T: Scalar> Extended<T> {
             lumped: Vec::new(),
             correction,
             any_lumped: false,
+            classified: None,
             diagonal_add: Vec::new(),
             support: SupportFacts::default(),
             fixed: Vec::new(),
@@ -181,6 +185,55 @@ impl<T: Scalar> Extended<T> {
     }
 }
 
+impl<T: Scalar> Extended<T> {
+    /// The roles of the step's functions from their coverage (inactive, solved,
+    /// extended with their rows of `E`) and the lumped rows of the hybrid.
+    fn classify_functions(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        context: StepContext,
+    ) -> MassReport {
+        let n = pattern.dim();
+        let mut report = MassReport::default();
+        for i in 0..n {
+            let d = values[pattern.diagonal_position(i)];
+            if d <= T::zero() {
+                self.role[i] = Role::Inactive;
+                continue;
+            }
+            report.active += 1;
+            let coverage =
+                SupportFacts::coverage_of(context.particle_volume[i], self.support.volume[i]);
+            if report.worst_coverage.is_none_or(|(_, w)| coverage < w) {
+                report.worst_coverage = Some((i, coverage));
+            }
+            self.role[i] = if coverage < self.coverage && !self.support.coefficients.is_empty() {
+                Role::Extended
+            } else {
+                Role::Solved
+            };
+            self.lumped[i] = self.role[i] == Role::Solved && coverage < self.lump;
+        }
+        self.ext_idx.clear();
+        self.ext_w.clear();
+        for j in 0..n {
+            self.ext_ptr[j] = self.ext_idx.len();
+            if self.role[j] == Role::Extended {
+                if self.extend(j) {
+                    report.extended += 1;
+                } else {
+                    // Nothing to carry it: keep it as an unknown, lumped in the hybrid.
+                    self.role[j] = Role::Solved;
+                    self.lumped[j] = self.lump > self.coverage;
+                }
+            }
+        }
+        self.ext_ptr[n] = self.ext_idx.len();
+        report
+    }
+}
+
 impl<T: Scalar> MassStrategy<T> for Extended<T> {
     fn spec(&self) -> String {
         let hybrid = self.correction.hybrid_name();
@@ -208,7 +261,8 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         }
     }
     fn lumped_rows(&self) -> Option<&[bool]> {
-        (self.correction != Correction::None && self.any_lumped).then_some(&self.lumped[..])
+        let corrects = matches!(self.correction, Correction::Rigid | Correction::Affine);
+        (corrects && self.any_lumped).then_some(&self.lumped[..])
     }
     fn prepare(&mut self, setup: &MassSetup) {
         let pattern = setup.pattern;
@@ -245,6 +299,18 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.local = Vec::with_capacity(6 * MAX_EXTENSION_TERMS);
         self.weights = Vec::with_capacity(MAX_EXTENSION_TERMS);
     }
+    fn classify(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        context: StepContext,
+    ) -> Option<&[bool]> {
+        if self.correction != Correction::InMass {
+            return None;
+        }
+        self.classified = Some(self.classify_functions(pattern, values, context));
+        self.lumped.iter().any(|&l| l).then_some(&self.lumped[..])
+    }
     fn factorize(
         &mut self,
         pattern: &SymmetricPattern,
@@ -253,54 +319,27 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
     ) -> Result<MassReport, MassError> {
         let n = pattern.dim();
         self.values.copy_from_slice(values);
-        let mut report = MassReport::default();
-        for i in 0..n {
-            let d = values[pattern.diagonal_position(i)];
-            if d <= T::zero() {
-                self.role[i] = Role::Inactive;
-                continue;
-            }
-            report.active += 1;
-            let coverage =
-                SupportFacts::coverage_of(context.particle_volume[i], self.support.volume[i]);
-            if report.worst_coverage.is_none_or(|(_, w)| coverage < w) {
-                report.worst_coverage = Some((i, coverage));
-            }
-            self.role[i] = if coverage < self.coverage && !self.support.coefficients.is_empty() {
-                Role::Extended
-            } else {
-                Role::Solved
-            };
-            self.lumped[i] = self.role[i] == Role::Solved && coverage < self.lump;
-        }
-        self.ext_idx.clear();
-        self.ext_w.clear();
-        for j in 0..n {
-            self.ext_ptr[j] = self.ext_idx.len();
-            if self.role[j] == Role::Extended {
-                if self.extend(j) {
-                    report.extended += 1;
-                } else {
-                    // Nothing to carry it: keep it as an unknown, lumped in the hybrid.
-                    self.role[j] = Role::Solved;
-                    self.lumped[j] = self.lump > self.coverage;
+        let mut report = match self.classified.take() {
+            // The driver added the affine-preserving lumping term to `values`.
+            Some(report) => report,
+            None => {
+                let report = self.classify_functions(pattern, values, context);
+                // Lumped rows: every off-diagonal entry of a lumped row moves onto
+                // both diagonals (row sums kept, `M' ⪰ M`).
+                if self.lumped.iter().any(|&l| l) {
+                    super::masked::modify_rows(
+                        pattern,
+                        values,
+                        &self.lumped,
+                        |_| false,
+                        T::zero(),
+                        &mut self.diagonal_add,
+                        &mut self.values,
+                    );
                 }
+                report
             }
-        }
-        self.ext_ptr[n] = self.ext_idx.len();
-        // Lumped rows: every off-diagonal entry of a lumped row moves onto both
-        // diagonals (row sums kept, `M' ⪰ M`).
-        if self.lumped.iter().any(|&l| l) {
-            super::masked::modify_rows(
-                pattern,
-                values,
-                &self.lumped,
-                |_| false,
-                T::zero(),
-                &mut self.diagonal_add,
-                &mut self.values,
-            );
-        }
+        };
         report.lumped_rows = self.lumped.iter().filter(|&&l| l).count();
         self.any_lumped = report.lumped_rows > 0;
         self.active.clear();
