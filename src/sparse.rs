@@ -198,9 +198,18 @@ impl<T: Scalar> SparseCholesky<T> {
     /// Symbolic factorisation (AMD ordering) of `pattern`, with scratch memory for
     /// solves with up to `rhs_columns` right-hand sides at once.
     pub fn new(pattern: &SymmetricPattern, rhs_columns: usize) -> Self {
-        let n = pattern.dim();
-        let col_ptr = pattern.col_ptr().to_vec();
-        let row_idx = pattern.row_idx().to_vec();
+        Self::from_upper(
+            pattern.col_ptr().to_vec(),
+            pattern.row_idx().to_vec(),
+            rhs_columns,
+        )
+    }
+
+    /// Symbolic factorisation (AMD ordering) of the symmetric matrix whose upper
+    /// triangle has the compressed sparse columns `col_ptr`, `row_idx` (rows
+    /// sorted within each column, every diagonal entry present).
+    pub fn from_upper(col_ptr: Vec<usize>, row_idx: Vec<usize>, rhs_columns: usize) -> Self {
+        let n = col_ptr.len() - 1;
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_cholesky(
             sym,
@@ -224,6 +233,11 @@ impl<T: Scalar> SparseCholesky<T> {
             scratch: MemBuffer::new(req),
             rhs_columns: rhs_columns.max(1),
         }
+    }
+
+    /// Whether this factorisation was made for the upper pattern `col_ptr`, `row_idx`.
+    pub fn has_pattern(&self, col_ptr: &[usize], row_idx: &[usize]) -> bool {
+        self.col_ptr == col_ptr && self.row_idx == row_idx
     }
 
     /// Numeric factorisation of the matrix whose upper triangle has `values`

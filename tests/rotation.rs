@@ -161,7 +161,7 @@ fn lumped_rows_lose_the_rotation_that_the_affine_correction_keeps() {
         "default",
         "extended",
         "extended-hybrid",
-        "extended-hybrid-sym",
+        "extended-hybrid-apic",
         "extended-hybrid-rpic",
     ] {
         let s = spin(law, MassKind::parse(keeping).unwrap());

@@ -151,10 +151,12 @@ pub struct RunArgs {
     /// Basis: ps or pl (2D scenes), bspline or pl1d (1D scenes).
     #[arg(long)]
     basis: Option<String>,
-    /// Mass strategy: default (= extended: under-supported functions expressed
-    /// through well-covered neighbours), extended:C (coverage threshold C), consistent,
-    /// lumped, partial (lump rows touching empty elements), partial:TAU (lump rows with
-    /// M_ii < TAU·max M_jj), partial-coverage:C, deactivate, deactivate:THRESHOLD or fmpm:K.
+    /// Mass strategy: default (= extended-hybrid: functions with almost no particles
+    /// expressed through well-covered neighbours, poorly covered rows lumped except
+    /// for what an affine field sees), extended-hybrid:C1:C2, extended[:C] (coverage
+    /// threshold C), consistent, lumped, partial (lump rows touching empty elements),
+    /// partial:TAU (lump rows with M_ii < TAU·max M_jj), partial-coverage:C,
+    /// deactivate, deactivate:THRESHOLD, extended-hybrid-apic|-rpic|-plain or fmpm:K.
     #[arg(long)]
     mass: Option<String>,
     #[command(flatten)]

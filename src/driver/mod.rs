@@ -119,6 +119,9 @@ where
     /// The points of linear precision `ξ_i`; empty unless the strategy asks for
     /// the affine correction.
     function_points: Vec<SVector<T, D>>,
+    /// The size of each element for the affine-preserving lumping
+    /// ([`phases::element_scales`]); empty unless the strategy uses it.
+    element_scale: Vec<T>,
     /// Per-particle terms of the step report's energies.
     energy_terms: Vec<[f64; 8]>,
     work: f64,
@@ -213,6 +216,18 @@ where
         let np = particles.len();
         let stride = basis.max_functions_per_element();
         let corrects = needs.correction != Correction::None;
+        let function_points: Vec<SVector<T, D>> = if corrects {
+            (0..n)
+                .map(|i| SVector::from_fn(|k, _| T::of(basis.function_point(i)[k])))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let element_scale = if needs.correction == Correction::InMass {
+            phases::element_scales(&basis, &function_points)
+        } else {
+            Vec::new()
+        };
         let momentum_corrects = matches!(needs.correction, Correction::Rigid | Correction::Affine);
         Ok(Driver {
             scratch: (0..phases::chunks(np))
@@ -230,13 +245,8 @@ where
             adjust: scratch(!effects.is_empty()),
             energy_terms: vec![[0.0; 8]; np],
             affine_gradient: vec![SMatrix::zeros(); if momentum_corrects { np } else { 0 }],
-            function_points: if corrects {
-                (0..n)
-                    .map(|i| SVector::from_fn(|k, _| T::of(basis.function_point(i)[k])))
-                    .collect()
-            } else {
-                Vec::new()
-            },
+            function_points,
+            element_scale,
             particle_force: if effects.iter().any(|e| e.acts_per_particle()) {
                 vec![SVector::zeros(); np]
             } else {
@@ -405,7 +415,9 @@ where
                     &self.gather,
                     &mut self.local,
                     &self.particles.mass,
+                    &self.particles.x,
                     &self.function_points,
+                    &self.element_scale,
                     lumped,
                     &mut self.values,
                 );

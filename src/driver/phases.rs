@@ -190,6 +190,15 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
 /// energy balance `Pᵀ M_A⁻¹ F = v̂ᵀ F` of the step holds as with the consistent
 /// mass. Every `g` lives on one particle's functions, so `M_A` keeps the
 /// pattern of `M`; summed element by element (see the module's notes on threads).
+///
+/// `M_A` leaves to `M` alone the affine fields that vanish at the particles: an
+/// element whose particles do not determine an affine field (fewer than
+/// `D + 1`, or nearly on a line) would leave such a field free, and the system
+/// singular. The particles of such an element lump their pairs plainly
+/// (`g = e_i − e_j`). An element passes when the mass-weighted covariance `S` of
+/// its particle positions has `det S ≥ (α s_e)^D`, with `s_e` the mean variance
+/// per axis of its functions' points `ξ` (`element_scale`, [`element_scales`])
+/// and `α =` [`AFFINE_SPREAD`].
 #[allow(clippy::too_many_arguments)]
 pub fn add_affine_lumping<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
@@ -197,7 +206,9 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     gather: &Gather,
     local: &mut Local<T, D>,
     mass: &[T],
+    x: &[SVector<T, D>],
     points: &[SVector<T, D>],
+    element_scale: &[T],
     lumped: &[bool],
     values: &mut [T],
 ) {
@@ -211,7 +222,9 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
         .enumerate()
         .for_each(|(e, (lm, g))| {
             lm.iter_mut().for_each(|v| *v = T::zero());
-            for &p in bins.particles(e) {
+            let inside = bins.particles(e);
+            let affine = determines_affine(inside, mass, x, element_scale[e]);
+            for &p in inside {
                 let base = p * evals.stride;
                 let m = evals.len[p];
                 let index = &evals.index[base..base + m];
@@ -232,17 +245,81 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                         }
                         g[a] += T::one();
                         g[b] -= T::one();
+                        // Affine-preserving part, and where the element's particles
+                        // do not pin an affine field a share `θ` of the plain pair.
+                        let theta = if affine { T::zero() } else { T::of(PLAIN_SHARE) };
+                        let wg = w * (T::one() - theta);
                         for c in 0..m {
-                            let wc = w * g[c];
+                            let wc = wg * g[c];
                             for k in c..m {
                                 lm[c * stride + k] += wc * g[k];
                             }
+                        }
+                        if theta > T::zero() {
+                            let wt = w * theta;
+                            lm[a * stride + a] += wt;
+                            lm[b * stride + b] += wt;
+                            lm[a * stride + b] -= wt;
                         }
                     }
                 }
             }
         });
     gather.add_matrix(local, values);
+}
+
+/// The spread `α` of [`add_affine_lumping`]: an element's particles determine an
+/// affine field when their covariance has `det S ≥ (α s_e)^D` (a uniform fill of
+/// a triangle gives about `0.5 s_e` per axis).
+pub const AFFINE_SPREAD: f64 = 0.01;
+
+/// The share `θ` of the plain pair term `(e_i − e_j)(e_i − e_j)ᵀ` in the elements
+/// whose particles do not determine an affine field ([`add_affine_lumping`]).
+pub const PLAIN_SHARE: f64 = 0.1;
+
+/// Whether the particles `inside` one element determine an affine field
+/// ([`add_affine_lumping`]).
+fn determines_affine<T: Scalar, const D: usize>(
+    inside: &[usize],
+    mass: &[T],
+    x: &[SVector<T, D>],
+    scale: T,
+) -> bool {
+    if inside.len() < D + 1 {
+        return false;
+    }
+    let (mut total, mut mean) = (T::zero(), SVector::<T, D>::zeros());
+    for &p in inside {
+        total += mass[p];
+        mean += x[p] * mass[p];
+    }
+    mean /= total;
+    let mut s = SMatrix::<T, D, D>::zeros();
+    for &p in inside {
+        let d = x[p] - mean;
+        s += d * d.transpose() * (mass[p] / total);
+    }
+    let bound = T::of(AFFINE_SPREAD) * scale;
+    det(&s) >= (0..D).fold(T::one(), |acc, _| acc * bound)
+}
+
+/// `s_e`: the mean variance per axis of the points of linear precision `ξ` of each
+/// element's functions, the element's size in [`add_affine_lumping`].
+pub fn element_scales<T: Scalar, const D: usize, B: Basis<T, D>>(
+    basis: &B,
+    points: &[SVector<T, D>],
+) -> Vec<T> {
+    (0..basis.num_elements())
+        .map(|e| {
+            let f = basis.element_functions(e);
+            let count = T::of(f.len() as f64);
+            let mean = f.iter().fold(SVector::<T, D>::zeros(), |m, &i| m + points[i]) / count;
+            let spread = f
+                .iter()
+                .fold(T::zero(), |s, &i| s + (points[i] - mean).norm_squared());
+            spread / (count * T::of(D as f64))
+        })
+        .collect()
 }
 
 /// The particle → function scatter `out_{k,i} += Σ_p w_p phi_i(x_p) q_{p,k}`

@@ -119,10 +119,11 @@ fn projection_error(
     (worst, driver.report().mass_report.lumped_rows > 0)
 }
 
-/// The corrections of `phases::Affine`: through lumped rows, a rigid motion
-/// projects exactly with the affine (default) and the rigid correction, a
-/// general affine field with the affine one only; without a correction both are
-/// missed by percents.
+/// The corrections of lumped rows: a rigid motion projects exactly with the
+/// affine-preserving lumping in the mass (the default), the affine momentum
+/// correction (`phases::Affine`, APIC) and the rigid one (RPIC), a general affine
+/// field with the first two only; without a correction both are missed by
+/// percents.
 #[test]
 fn the_corrections_project_rigid_and_affine_fields_exactly_through_lumped_rows() {
     fn rigid(x: nalgebra::Vector2<f64>) -> nalgebra::Vector2<f64> {
@@ -133,6 +134,8 @@ fn the_corrections_project_rigid_and_affine_fields_exactly_through_lumped_rows()
     }
     for (mass, field, exact) in [
         ("extended-hybrid-rpic", rigid as fn(_) -> _, true),
+        ("extended-hybrid-apic", rigid, true),
+        ("extended-hybrid-apic", affine, true),
         ("extended-hybrid", rigid, true),
         ("extended-hybrid", affine, true),
         ("extended-hybrid-rpic", affine, false),
@@ -149,18 +152,19 @@ fn the_corrections_project_rigid_and_affine_fields_exactly_through_lumped_rows()
     }
 }
 
-/// The correction enters each decoupled pair with opposite signs: the total
-/// momentum `Σ_p m_p v̂(x_p) = Σ_p m_p v_p` is kept for any field (to the
+/// The momentum correction enters each decoupled pair with opposite signs, and
+/// the affine-preserving lumping keeps the row sums of `M`: the total momentum `Σ_p m_p v̂(x_p) = Σ_p m_p v_p` is kept for any field (to the
 /// conjugate-gradient tolerance where functions are extended).
 #[test]
 fn the_affine_correction_keeps_the_total_momentum() {
     let field = |x: nalgebra::Vector2<f64>| {
         nalgebra::Vector2::new((3.0 * x.x).sin() + x.y * x.y, (2.0 * x.y).cos() - x.x)
     };
-    let mut driver = hybrid_block("extended-hybrid", field);
+    for mass in ["extended-hybrid-apic", "extended-hybrid"] {
+    let mut driver = hybrid_block(mass, field);
     for _ in 0..3 {
         driver.step().unwrap();
-        assert!(driver.mass.lumped_rows().is_some());
+        assert!(driver.report().mass_report.lumped_rows > 0, "{mass}");
         let at = projected_at_particles(&driver);
         let (mut grid, mut particles) = (nalgebra::Vector2::zeros(), nalgebra::Vector2::zeros());
         for p in 0..at.len() {
@@ -169,7 +173,8 @@ fn the_affine_correction_keeps_the_total_momentum() {
         }
         assert!(
             (grid - particles).norm() < 1e-10 * particles.norm(),
-            "{grid} against {particles}"
+            "{mass}: {grid} against {particles}"
         );
+    }
     }
 }

@@ -13,8 +13,8 @@
 //! | `partial`, `partial:TAU`, `partial-coverage:C` | [`Partial`] | `M` with some rows lumped (thesis §5.3; by `M_ii`; by particle coverage) |
 //! | `deactivate[:THRESHOLD]` | [`Deactivate`] | `M` without the functions with `M_ii < threshold` (thesis §5.2) |
 //! | `extended[:C]` | [`Extended`] | `Eᵀ M E`: functions covered below `C` expressed through well-covered neighbours |
-//! | `extended-hybrid[:C1:C2]` (the default, `0.02:0.75`) | [`Extended`] | `Eᵀ M' E`: functions covered below `C1` extended, the rows of those covered in `[C1, C2)` lumped in `M'`, their momentum corrected for affine fields ([`Correction::Affine`]) |
-//! | `extended-hybrid-rpic`, `extended-hybrid-plain` | [`Extended`] | the same with the rigid correction, or none |
+//! | `extended-hybrid[:C1:C2]` (the default, `0.02:0.75`) | [`Extended`] | `Eᵀ M_A E`: functions covered below `C1` extended, the rows of those covered in `[C1, C2)` lumped in `M_A` except for the part an affine field sees ([`Correction::InMass`]) |
+//! | `extended-hybrid-apic`, `extended-hybrid-rpic`, `extended-hybrid-plain` | [`Extended`] | `Eᵀ M' E` with the rows plainly lumped and the momentum corrected for affine fields ([`Correction::Affine`]), rigid ones, or not at all |
 //! | `fmpm:K` | [`Fmpm`] | no solve: the series `Σ_{j≤K} (I − M_L⁻¹ M)^j M_L⁻¹` |
 //!
 //! Homogeneous Dirichlet conditions come as a set of fixed coefficients per
@@ -112,19 +112,19 @@ pub const DEFAULT_HYBRID_LUMP: f64 = 0.75;
 
 impl Default for MassKind {
     /// The default strategy of every basis: the hybrid extension (functions covered
-    /// below 0.02 extended, rows covered below 0.75 lumped with the affine
-    /// correction; `docs/stability.md`).
+    /// below 0.02 extended, rows covered below 0.75 lumped in the affine-preserving
+    /// way, [`Correction::InMass`]; `docs/stability.md`).
     fn default() -> Self {
         MassKind::ExtendedHybrid {
             extend: DEFAULT_HYBRID_EXTEND,
             lump: DEFAULT_HYBRID_LUMP,
-            correction: Correction::Affine,
+            correction: Correction::InMass,
         }
     }
 }
 
 /// Names [`MassKind::parse`] knows, for messages.
-pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-sym[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-apic[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
 
 impl MassKind {
     /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
@@ -342,8 +342,8 @@ impl Correction {
     /// The name of the hybrid extension with this correction.
     pub fn hybrid_name(self) -> &'static str {
         match self {
-            Correction::InMass => "extended-hybrid-sym",
-            Correction::Affine => "extended-hybrid",
+            Correction::InMass => "extended-hybrid",
+            Correction::Affine => "extended-hybrid-apic",
             Correction::Rigid => "extended-hybrid-rpic",
             Correction::None => "extended-hybrid-plain",
         }

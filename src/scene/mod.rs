@@ -18,7 +18,7 @@
 //! name = "column-small"
 //! dim = 2
 //! basis = "ps"               # ps, pl (2D); bspline, pl1d (1D)
-//! mass = "consistent"        # optional: default (extended), consistent, lumped, partial[:TAU], partial-coverage:C, deactivate[:M], extended[:C], extended-hybrid:C1:C2, fmpm:K
+//! mass = "consistent"        # optional: default (extended-hybrid), consistent, lumped, partial[:TAU], partial-coverage:C, deactivate[:M], extended[:C], extended-hybrid[:C1:C2], fmpm:K
 //!
 //! [mesh]
 //! kind = "blocks"            # blocks, polygon, gmsh (2D); interval (1D)

@@ -20,13 +20,17 @@
 //!
 //! The hybrid ([`Extended::hybrid`], `extended-hybrid:C1:C2`, the default strategy
 //! at `0.02:0.75`) extends only the functions with almost no particles (below
-//! `C1`) and lumps the rows of the solved functions covered in `[C1, C2)`,
-//! `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`: lumping raises the critical step
-//! where extension of moderately covered functions lowers it, and keeps their
-//! degrees of freedom. The driver corrects the momentum of the lumped rows so that
-//! affine fields, hence rigid motions, still project exactly
-//! ([`Correction::Affine`]); a lumped row
-//! would otherwise damp the rotation of a free body.
+//! `C1`) and lumps the rows of the solved functions covered in `[C1, C2)`:
+//! lumping raises the critical step where extension of moderately covered
+//! functions lowers it, and keeps their degrees of freedom. A plain lumped row,
+//! `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`, damps the rotation of a free body;
+//! the default lumps only the part of each pair that an affine field does not
+//! see (`M_A`, [`Correction::InMass`], assembled by the driver in
+//! `driver::phases::add_affine_lumping`), so affine fields project exactly and,
+//! the matrix being one symmetric matrix for both solves, the step's energy
+//! balance holds. The variants `-apic`, `-rpic` and `-plain` lump plainly and
+//! correct the momentum instead ([`Correction::Affine`], [`Correction::Rigid`])
+//! or not at all.
 //!
 //! The reduced system changes pattern whenever the set of extended functions
 //! does, so it is solved matrix-free by conjugate gradients with a Jacobi
@@ -42,8 +46,10 @@ use super::{
     StepContext, SupportFacts,
 };
 use crate::sparse::{Scalar, SymmetricPattern};
+use direct::{Direct, FullPattern};
 use solve::{conjugate_gradients, Reduced, Scratch};
 
+mod direct;
 mod solve;
 mod weights;
 
@@ -100,8 +106,13 @@ pub struct Extended<T: Scalar> {
     ext_ptr: Vec<usize>,
     ext_idx: Vec<usize>,
     ext_w: Vec<T>,
-    /// Jacobi preconditioner per fixed set.
+    /// Jacobi preconditioner per fixed set (for the conjugate gradients, used
+    /// where the direct factorisation of a step fails).
     precond: Vec<Vec<T>>,
+    /// `Eᵀ M E` assembled and factorised, per fixed set.
+    reduced_factor: Vec<Direct<T>>,
+    /// Both triangles of the pattern of `M`.
+    full_pattern: FullPattern,
     /// The consistent solve, for the steps in which nothing is extended.
     cholesky: MaskedCholesky<T>,
     /// This step is solved by `cholesky` (nothing extended, factor exists).
@@ -154,6 +165,8 @@ impl<T: Scalar> Extended<T> {
             ext_idx: Vec::new(),
             ext_w: Vec::new(),
             precond: Vec::new(),
+            reduced_factor: Vec::new(),
+            full_pattern: FullPattern::default(),
             cholesky: MaskedCholesky::default(),
             direct: false,
             scratch: Scratch::default(),
@@ -269,6 +282,8 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         let n = pattern.dim();
         let (distinct, solver_of) = distinct_fixed_sets(setup.fixed);
         self.precond = distinct.iter().map(|_| vec![T::zero(); n]).collect();
+        self.reduced_factor = distinct.iter().map(|_| Direct::new(n)).collect();
+        self.full_pattern = FullPattern::new(pattern.col_ptr(), pattern.row_idx());
         self.cholesky.prepare(setup);
         self.fixed = distinct;
         self.solver_of = solver_of;
@@ -379,10 +394,17 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             // `self.values` holds the lumped rows of the hybrid (else `values`).
             self.direct = self.cholesky.factorize(pattern, &self.values).is_ok();
         }
-        // Jacobi preconditioner of the CG, M_ii + Σ_j e_ji² M_jj (not needed when
-        // the step is solved directly).
+        // `Eᵀ M E` factorised per fixed set; where that fails (a pivot lost to
+        // rounding), the conjugate gradients with the Jacobi preconditioner
+        // `M_ii + Σ_j e_ji² M_jj`.
         if !self.direct {
             for s in 0..self.fixed.len() {
+                let mut factor = std::mem::take(&mut self.reduced_factor[s]);
+                let factorised = factor.factorize(&self.reduced(s), &self.full_pattern).is_ok();
+                self.reduced_factor[s] = factor;
+                if factorised {
+                    continue;
+                }
                 let mut precond = std::mem::take(&mut self.precond[s]);
                 {
                     let op = self.reduced(s);
@@ -417,6 +439,14 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         let s = self.solver_of[k];
         let mut b = std::mem::take(&mut self.rhs);
         let mut scratch = std::mem::take(&mut self.scratch);
+        if self.reduced_factor[s].ready {
+            let mut factor = std::mem::take(&mut self.reduced_factor[s]);
+            factor.solve(&self.reduced(s), rhs, &mut b, &mut scratch.x);
+            self.reduced_factor[s] = factor;
+            self.rhs = b;
+            self.scratch = scratch;
+            return Ok(());
+        }
         let result = {
             let op = self.reduced(s);
             op.restrict(rhs, &mut b);
