@@ -247,7 +247,11 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                         g[b] -= T::one();
                         // Affine-preserving part, and where the element's particles
                         // do not pin an affine field a share `θ` of the plain pair.
-                        let theta = if affine { T::zero() } else { T::of(PLAIN_SHARE) };
+                        let theta = if affine {
+                            T::zero()
+                        } else {
+                            T::of(PLAIN_SHARE)
+                        };
                         let wg = w * (T::one() - theta);
                         for c in 0..m {
                             let wc = wg * g[c];
@@ -313,7 +317,10 @@ pub fn element_scales<T: Scalar, const D: usize, B: Basis<T, D>>(
         .map(|e| {
             let f = basis.element_functions(e);
             let count = T::of(f.len() as f64);
-            let mean = f.iter().fold(SVector::<T, D>::zeros(), |m, &i| m + points[i]) / count;
+            let mean = f
+                .iter()
+                .fold(SVector::<T, D>::zeros(), |m, &i| m + points[i])
+                / count;
             let spread = f
                 .iter()
                 .fold(T::zero(), |s, &i| s + (points[i] - mean).norm_squared());

@@ -355,8 +355,8 @@ impl Correction {
             Correction::Rigid,
             Correction::None,
         ]
-            .into_iter()
-            .find(|c| c.hybrid_name() == name)
+        .into_iter()
+        .find(|c| c.hybrid_name() == name)
     }
 }
 

@@ -280,6 +280,14 @@ fn mass_kinds_parse() {
         MassKind::ExtendedHybrid {
             extend: 0.02,
             lump: 0.75,
+            correction: super::Correction::InMass,
+        }
+    );
+    assert_eq!(
+        MassKind::parse("extended-hybrid-apic").unwrap(),
+        MassKind::ExtendedHybrid {
+            extend: 0.02,
+            lump: 0.75,
             correction: super::Correction::Affine,
         }
     );

@@ -144,8 +144,7 @@ impl<T: Scalar> Direct<T> {
             self.by_column_ptr[i + 1] += self.by_column_ptr[i];
         }
         self.by_column.clear();
-        self.by_column
-            .resize(self.by_column_ptr[n], (0, T::zero()));
+        self.by_column.resize(self.by_column_ptr[n], (0, T::zero()));
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.by_column_ptr[..n]);
         for &r in op.extended {
@@ -256,7 +255,13 @@ impl<T: Scalar> Direct<T> {
 
     /// Solves `Eᵀ M E x = Eᵀ rhs` and writes `E x` into `rhs` (zero off the
     /// active functions). `full_b` and `x` are scratch of the function count.
-    pub(super) fn solve(&mut self, op: &Reduced<'_, T>, rhs: &mut [T], full_b: &mut [T], x: &mut [T]) {
+    pub(super) fn solve(
+        &mut self,
+        op: &Reduced<'_, T>,
+        rhs: &mut [T],
+        full_b: &mut [T],
+        x: &mut [T],
+    ) {
         op.restrict(rhs, full_b);
         let m = self.free.len();
         for q in 0..m {

@@ -400,7 +400,9 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         if !self.direct {
             for s in 0..self.fixed.len() {
                 let mut factor = std::mem::take(&mut self.reduced_factor[s]);
-                let factorised = factor.factorize(&self.reduced(s), &self.full_pattern).is_ok();
+                let factorised = factor
+                    .factorize(&self.reduced(s), &self.full_pattern)
+                    .is_ok();
                 self.reduced_factor[s] = factor;
                 if factorised {
                     continue;
