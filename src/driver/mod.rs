@@ -524,7 +524,9 @@ where
             .estimate_condition
             .then(|| self.mass.condition_estimate(&self.pattern));
         self.constraints
-            .prepare(&mut self.mass)
+            .prepare(&mut self.mass, |i| {
+                self.values[self.pattern.diagonal_position(i)] > T::zero()
+            })
             .map_err(|source| self.mass_failure(source))
     }
 

@@ -51,7 +51,15 @@ impl<T: Scalar, const D: usize> Constraints<T, D> {
     }
 
     /// Forms `W` and the Cholesky factor of `S` with the strategy's factorisation.
-    pub fn prepare<M: MassStrategy<T> + ?Sized>(&mut self, mass: &mut M) -> Result<(), MassError> {
+    /// `has_particles(i)`: function `i` has particles in its support (`M_ii > 0`);
+    /// a constraint on functions without any needs no solve (its `W` is zero, as
+    /// every strategy holds such functions at zero), which keeps the cost of slip
+    /// walls to the walls a body touches.
+    pub fn prepare<M: MassStrategy<T> + ?Sized>(
+        &mut self,
+        mass: &mut M,
+        has_particles: impl Fn(usize) -> bool,
+    ) -> Result<(), MassError> {
         let m = self.rows.len();
         if m == 0 {
             return Ok(());
@@ -61,14 +69,18 @@ impl<T: Scalar, const D: usize> Constraints<T, D> {
                 let w = &mut self.w[c][k];
                 w.iter_mut().for_each(|v| *v = T::zero());
                 let mut any = false;
+                let mut touched = false;
                 for &(kk, i, weight) in row {
                     if kk == k {
                         w[i] += weight;
                         any = true;
+                        touched |= has_particles(i);
                     }
                 }
-                if any {
+                if any && touched {
                     mass.solve(k, w)?;
+                } else if any {
+                    w.iter_mut().for_each(|v| *v = T::zero());
                 }
             }
         }
