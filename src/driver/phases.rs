@@ -362,7 +362,7 @@ pub fn scatter_to_functions<T: Scalar, const D: usize>(
 /// with opposite signs, so the total momentum is unchanged. With `rigid`, `C_p` is
 /// replaced by its skew part `(C_p − C_pᵀ)/2` (RPIC): rigid motions project exactly
 /// and the lumped rows still smooth the straining modes; measured unstable on a
-/// jittered column (`docs/stability.md`), so the default is the whole `C_p`.
+/// jittered column (`docs/stability.md`), so `extended-hybrid-apic` takes the whole `C_p`.
 ///
 /// `C_p` must be the gradient of the field the particle velocity follows: from
 /// `v̂ⁿ` alone (without `Δt ∇a`) the column of B5b blows up.
