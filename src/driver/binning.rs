@@ -80,6 +80,26 @@ pub struct Local<T: Scalar, const D: usize> {
 }
 
 impl<T: Scalar, const D: usize> Local<T, D> {
+    /// Each element's local matrix block and vector, zeroed, in parallel tasks of
+    /// at least [`ELEMENT_CHUNK`] elements: `(e, (matrix, vector))`.
+    pub(super) fn par_elements(
+        &mut self,
+    ) -> impl IndexedParallelIterator<Item = (usize, (&mut [T], &mut [T]))> + '_ {
+        let stride = self.stride;
+        (
+            self.matrix.par_chunks_mut(stride * stride),
+            self.vector.par_chunks_mut(stride * D),
+        )
+            .into_par_iter()
+            .with_min_len(ELEMENT_CHUNK)
+            .enumerate()
+            .map(|(e, (lm, lv))| {
+                lm.iter_mut().for_each(|v| *v = T::zero());
+                lv.iter_mut().for_each(|v| *v = T::zero());
+                (e, (lm, lv))
+            })
+    }
+
     /// Buffers for `elements` elements of up to `stride` functions.
     pub fn new(elements: usize, stride: usize) -> Self {
         Local {
@@ -149,25 +169,12 @@ impl Gather {
         }
     }
 
-    /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order.
-    pub(super) fn matrix<T: Scalar, const D: usize>(&self, local: &Local<T, D>, values: &mut [T]) {
-        values
-            .par_iter_mut()
-            .with_min_len(ENTRY_CHUNK)
-            .enumerate()
-            .for_each(|(j, v)| {
-                let mut sum = T::zero();
-                for &s in &self.matrix_source[self.matrix_start[j]..self.matrix_start[j + 1]] {
-                    sum += local.matrix[s];
-                }
-                *v = sum;
-            });
-    }
-
-    /// `values_j += Σ` of the local matrix blocks' entries `j`, in element order.
-    pub(super) fn add_matrix<T: Scalar, const D: usize>(
+    /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order
+    /// (`values_j +=` with `add`).
+    pub(super) fn matrix<T: Scalar, const D: usize>(
         &self,
         local: &Local<T, D>,
+        add: bool,
         values: &mut [T],
     ) {
         values
@@ -179,7 +186,11 @@ impl Gather {
                 for &s in &self.matrix_source[self.matrix_start[j]..self.matrix_start[j + 1]] {
                     sum += local.matrix[s];
                 }
-                *v += sum;
+                if add {
+                    *v += sum;
+                } else {
+                    *v = sum;
+                }
             });
     }
 

@@ -135,34 +135,24 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     force: &mut [Vec<T>],
 ) {
     let stride = local.stride;
-    (
-        local.matrix.par_chunks_mut(stride * stride),
-        local.vector.par_chunks_mut(stride * D),
-    )
-        .into_par_iter()
-        .with_min_len(ELEMENT_CHUNK)
-        .enumerate()
-        .for_each(|(e, (lm, lv))| {
-            lm.iter_mut().for_each(|v| *v = T::zero());
-            lv.iter_mut().for_each(|v| *v = T::zero());
-            for &p in bins.particles(e) {
-                let base = p * evals.stride;
-                let m = evals.len[p];
-                let (mass, vol, sigma) =
-                    (particles.mass[p], particles.volume[p], &particles.sigma[p]);
-                for a in 0..m {
-                    let w = mass * evals.phi[base + a];
-                    for b in a..m {
-                        lm[a * stride + b] += w * evals.phi[base + b];
-                    }
-                    let f_int = sigma * evals.grad_phi[base + a] * vol;
-                    for k in 0..D {
-                        lv[a * D + k] += f_int[k];
-                    }
+    local.par_elements().for_each(|(e, (lm, lv))| {
+        for &p in bins.particles(e) {
+            let base = p * evals.stride;
+            let m = evals.len[p];
+            let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+            for a in 0..m {
+                let w = mass * evals.phi[base + a];
+                for b in a..m {
+                    lm[a * stride + b] += w * evals.phi[base + b];
+                }
+                let f_int = sigma * evals.grad_phi[base + a] * vol;
+                for k in 0..D {
+                    lv[a * D + k] += f_int[k];
                 }
             }
-        });
-    gather.matrix(local, values);
+        }
+    });
+    gather.matrix(local, false, values);
     zero(force);
     gather.functions(local, true, force);
 }
@@ -213,63 +203,59 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     values: &mut [T],
 ) {
     let stride = local.stride;
-    (
-        local.matrix.par_chunks_mut(stride * stride),
-        local.vector.par_chunks_mut(stride * D),
-    )
-        .into_par_iter()
-        .with_min_len(ELEMENT_CHUNK)
-        .enumerate()
-        .for_each(|(e, (lm, g))| {
-            lm.iter_mut().for_each(|v| *v = T::zero());
-            let inside = bins.particles(e);
-            let affine = determines_affine(inside, mass, x, element_scale[e]);
-            for &p in inside {
-                let base = p * evals.stride;
-                let m = evals.len[p];
-                let index = &evals.index[base..base + m];
-                if !index.iter().any(|&i| lumped[i]) {
-                    continue;
-                }
-                let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
-                for a in 0..m {
-                    for b in a + 1..m {
-                        let (i, j) = (index[a], index[b]);
-                        let w = mass[p] * phi[a] * phi[b];
-                        if !(lumped[i] || lumped[j]) || w == T::zero() {
-                            continue;
+    let touches_lumped = |p: usize| evals.index[evals.range(p)].iter().any(|&i| lumped[i]);
+    local.par_elements().for_each(|(e, (lm, g))| {
+        let inside = bins.particles(e);
+        if !inside.iter().any(|&p| touches_lumped(p)) {
+            return;
+        }
+        let affine = determines_affine(inside, mass, x, element_scale[e]);
+        for &p in inside {
+            if !touches_lumped(p) {
+                continue;
+            }
+            let base = p * evals.stride;
+            let m = evals.len[p];
+            let index = &evals.index[base..base + m];
+            let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
+            for a in 0..m {
+                for b in a + 1..m {
+                    let (i, j) = (index[a], index[b]);
+                    let w = mass[p] * phi[a] * phi[b];
+                    if !(lumped[i] || lumped[j]) || w == T::zero() {
+                        continue;
+                    }
+                    let d = points[i] - points[j];
+                    for c in 0..m {
+                        g[c] = -grad_phi[c].dot(&d);
+                    }
+                    g[a] += T::one();
+                    g[b] -= T::one();
+                    // Affine-preserving part, and where the element's particles
+                    // do not pin an affine field a share `θ` of the plain pair.
+                    let theta = if affine {
+                        T::zero()
+                    } else {
+                        T::of(PLAIN_SHARE)
+                    };
+                    let wg = w * (T::one() - theta);
+                    for c in 0..m {
+                        let wc = wg * g[c];
+                        for k in c..m {
+                            lm[c * stride + k] += wc * g[k];
                         }
-                        let d = points[i] - points[j];
-                        for c in 0..m {
-                            g[c] = -grad_phi[c].dot(&d);
-                        }
-                        g[a] += T::one();
-                        g[b] -= T::one();
-                        // Affine-preserving part, and where the element's particles
-                        // do not pin an affine field a share `θ` of the plain pair.
-                        let theta = if affine {
-                            T::zero()
-                        } else {
-                            T::of(PLAIN_SHARE)
-                        };
-                        let wg = w * (T::one() - theta);
-                        for c in 0..m {
-                            let wc = wg * g[c];
-                            for k in c..m {
-                                lm[c * stride + k] += wc * g[k];
-                            }
-                        }
-                        if theta > T::zero() {
-                            let wt = w * theta;
-                            lm[a * stride + a] += wt;
-                            lm[b * stride + b] += wt;
-                            lm[a * stride + b] -= wt;
-                        }
+                    }
+                    if theta > T::zero() {
+                        let wt = w * theta;
+                        lm[a * stride + a] += wt;
+                        lm[b * stride + b] += wt;
+                        lm[a * stride + b] -= wt;
                     }
                 }
             }
-        });
-    gather.add_matrix(local, values);
+        }
+    });
+    gather.matrix(local, true, values);
 }
 
 /// The spread `α` of [`add_affine_lumping`]: an element's particles determine an
