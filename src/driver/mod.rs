@@ -62,10 +62,13 @@ pub struct Fix {
 }
 
 /// The per-step facts a mass strategy asked for.
-struct StrategyInputs {
+struct StrategyInputs<T: Scalar> {
     needs: Needs,
     touches_empty: Vec<bool>,
     particle_volume: Vec<f64>,
+    particle_count: Vec<f64>,
+    /// Ones, one per particle: the weights of `particle_count`.
+    ones: Vec<T>,
     support: Option<SupportFacts>,
 }
 
@@ -125,7 +128,7 @@ where
     /// Per-particle terms of the step report's energies.
     energy_terms: Vec<[f64; 8]>,
     work: f64,
-    inputs: StrategyInputs,
+    inputs: StrategyInputs<T>,
     last_report: MassReport,
     last_condition: Option<f64>,
     phases: PhaseTimes,
@@ -211,6 +214,8 @@ where
             needs,
             touches_empty: vec![false; if needs.empty_elements { n } else { 0 }],
             particle_volume: vec![0.0; if needs.coverage { n } else { 0 }],
+            particle_count: vec![0.0; if needs.coverage { n } else { 0 }],
+            ones: vec![T::one(); if needs.coverage { particles.len() } else { 0 }],
             support,
         };
         let np = particles.len();
@@ -402,11 +407,20 @@ where
                 &self.particles.volume,
                 &mut self.inputs.particle_volume,
             );
+            phases::particle_volume_by_elements(
+                &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
+                &self.inputs.ones,
+                &mut self.inputs.particle_count,
+            );
         }
         if self.inputs.needs.correction == Correction::InMass {
             let context = StepContext {
                 touches_empty: &self.inputs.touches_empty,
                 particle_volume: &self.inputs.particle_volume,
+                particle_count: &self.inputs.particle_count,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
                 phases::add_affine_lumping(
@@ -515,6 +529,7 @@ where
         let context = StepContext {
             touches_empty: &self.inputs.touches_empty,
             particle_volume: &self.inputs.particle_volume,
+            particle_count: &self.inputs.particle_count,
         };
         match self.mass.factorize(&self.pattern, &self.values, context) {
             Ok(report) => self.last_report = report,

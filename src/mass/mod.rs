@@ -13,7 +13,7 @@
 //! | `partial`, `partial:TAU`, `partial-coverage:C` | [`Partial`] | `M` with some rows lumped (thesis §5.3; by `M_ii`; by particle coverage) |
 //! | `deactivate[:THRESHOLD]` | [`Deactivate`] | `M` without the functions with `M_ii < threshold` (thesis §5.2) |
 //! | `extended[:C]` | [`Extended`] | `Eᵀ M E`: functions covered below `C` expressed through well-covered neighbours |
-//! | `extended-hybrid[:C1:C2]` (the default, `0.02:0.75`) | [`Extended`] | `Eᵀ M_A E`: functions covered below `C1` extended, the rows of those covered in `[C1, C2)` lumped in `M_A` except for the part an affine field sees ([`Correction::InMass`]) |
+//! | `extended-hybrid[:C1:C2]` (the default, `0.02:0.75`) | [`Extended`] | `Eᵀ M_A E`: functions covered below `C1` extended, the rows of those covered in `[C1, C2)` or sampled by less than one particle lumped in `M_A` except for the part an affine field sees ([`Correction::InMass`]) |
 //! | `extended-hybrid-apic`, `extended-hybrid-rpic`, `extended-hybrid-plain` | [`Extended`] | `Eᵀ M' E` with the rows plainly lumped and the momentum corrected for affine fields ([`Correction::Affine`]), rigid ones, or not at all |
 //! | `fmpm:K` | [`Fmpm`] | no solve: the series `Σ_{j≤K} (I − M_L⁻¹ M)^j M_L⁻¹` |
 //!
@@ -367,6 +367,9 @@ pub struct StepContext<'a> {
     pub touches_empty: &'a [bool],
     /// `Σ_p V_p phi_i(x_p)`: the particle volume seen by function `i`.
     pub particle_volume: &'a [f64],
+    /// `Σ_p phi_i(x_p)`: how many particles sample function `i` (each weighted by
+    /// its value there); measured with the coverage.
+    pub particle_count: &'a [f64],
 }
 
 /// What a strategy is prepared with once per mesh.

@@ -14,6 +14,7 @@ struct Column {
     values: Vec<f64>,
     touches_empty: Vec<bool>,
     particle_volume: Vec<f64>,
+    particle_count: Vec<f64>,
 }
 
 fn column_mass() -> Column {
@@ -30,6 +31,7 @@ fn filled_to(height: f64) -> Column {
     let pattern = SymmetricPattern::new(&ps);
     let mut values = vec![0.0; pattern.nnz()];
     let mut particle_volume = vec![0.0; ps.num_functions()];
+    let mut particle_count = vec![0.0; ps.num_functions()];
     let mut eval = BasisEval::for_basis(&ps);
     let mut rng = SplitMix64(3);
     let mut occupied = vec![false; ps.num_elements()];
@@ -41,6 +43,7 @@ fn filled_to(height: f64) -> Column {
         let scatter = pattern.element_scatter(e);
         for a in 0..9 {
             particle_volume[eval.index[a]] += 0.003 * eval.phi[a];
+            particle_count[eval.index[a]] += eval.phi[a];
             for b in a..9 {
                 values[scatter[a * 9 + b]] += 0.01 * eval.phi[a] * eval.phi[b];
             }
@@ -58,6 +61,7 @@ fn filled_to(height: f64) -> Column {
         values,
         touches_empty,
         particle_volume,
+        particle_count,
     }
 }
 
@@ -80,6 +84,7 @@ fn context(c: &Column) -> StepContext<'_> {
     StepContext {
         touches_empty: &c.touches_empty,
         particle_volume: &c.particle_volume,
+        particle_count: &c.particle_count,
     }
 }
 

@@ -63,6 +63,14 @@ pub const MAX_EXTENSION_TERMS: usize = 48;
 /// Largest acceptable extension weight; a larger one means the neighbourhood is too
 /// small to extrapolate well, and the next ring is added.
 pub const MAX_EXTENSION_WEIGHT: f64 = 2.0;
+/// The hybrid also lumps the row of a function sampled by less than this,
+/// `Σ_p phi_i(x_p) < N` (each particle weighted by the function's value there),
+/// whatever its coverage: a function whose support lies in a few small elements
+/// can be covered by the body yet seen by too few particles for its consistent
+/// row (`docs/examples/slide-strike.toml` stops at t ≈ 0.32 with `N = 0.5` and
+/// runs with `N = 1`; `N = 3` also lumps well-sampled boundary functions of B2
+/// and B5a and costs accuracy there, `docs/stability.md`).
+pub const MIN_PARTICLE_COUNT: f64 = 1.0;
 /// Relative residual at which the conjugate-gradient solve stops.
 pub const CG_TOLERANCE: f64 = 1e-11;
 /// Iteration limit of the conjugate-gradient solve.
@@ -226,7 +234,10 @@ impl<T: Scalar> Extended<T> {
             } else {
                 Role::Solved
             };
-            self.lumped[i] = self.role[i] == Role::Solved && coverage < self.lump;
+            let sparse = context.particle_count[i] < MIN_PARTICLE_COUNT;
+            self.lumped[i] = self.role[i] == Role::Solved
+                && self.lump > self.coverage
+                && (coverage < self.lump || sparse);
         }
         self.ext_idx.clear();
         self.ext_w.clear();
