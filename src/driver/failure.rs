@@ -156,6 +156,16 @@ where
             }
         }
         let speed = self.particles.v[particle].norm().to_f64();
+        let element = self.particles.element[particle];
+        let (inside, functions) = (
+            self.bins.particles(element).len(),
+            self.basis.element_functions(element).len(),
+        );
+        if inside < functions {
+            return format!(
+                "the element around it inverted (speed {speed:.3e}); it holds {inside} particles for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
+            );
+        }
         if let Some(critical) = self.dt_critical {
             let dt = self.dt.to_f64();
             return format!(
