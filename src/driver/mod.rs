@@ -392,6 +392,11 @@ where
             &self.bins,
             &self.gather,
             &mut self.local,
+            if self.inputs.needs.row_sums_only {
+                phases::MassMatrix::RowSums
+            } else {
+                phases::MassMatrix::Full
+            },
             &mut self.values,
             &mut self.rhs,
         );

@@ -124,6 +124,11 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
 /// upper triangle in the pattern's order, and the internal force
 /// `F_{k,i} = −Σ_p V_p σ_{kl} ∂phi_i/∂x_l` (eq. (15)) into `force` (overwritten);
 /// summed element by element (see the module's notes on threads).
+///
+/// With `matrix` = [`MassMatrix::RowSums`] only the diagonal is written, with the
+/// row sums `Σ_j M_ij = Σ_p m_p phi_i(x_p)` (the basis is a partition of unity,
+/// `Σ_j phi_j = 1`), and every other entry is zero: what the lumped mass reads,
+/// at one product per function and particle instead of one per pair.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     particles: &Particles<T, D>,
@@ -131,10 +136,12 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     bins: &Bins,
     gather: &Gather,
     local: &mut Local<T, D>,
+    matrix: MassMatrix,
     values: &mut [T],
     force: &mut [Vec<T>],
 ) {
     let stride = local.stride;
+    let full = matrix == MassMatrix::Full;
     local.par_elements().for_each(|(e, (lm, lv))| {
         for &p in bins.particles(e) {
             let base = p * evals.stride;
@@ -142,8 +149,12 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
             let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
             for a in 0..m {
                 let w = mass * evals.phi[base + a];
-                for b in a..m {
-                    lm[a * stride + b] += w * evals.phi[base + b];
+                if full {
+                    for b in a..m {
+                        lm[a * stride + b] += w * evals.phi[base + b];
+                    }
+                } else {
+                    lm[a * stride + a] += w;
                 }
                 let f_int = sigma * evals.grad_phi[base + a] * vol;
                 for k in 0..D {
@@ -155,6 +166,15 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     gather.matrix(local, false, values);
     zero(force);
     gather.functions(local, true, force);
+}
+
+/// Which part of `M` phase 2a assembles ([`assemble_mass_and_internal_force`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MassMatrix {
+    /// Every entry `M_ij`.
+    Full,
+    /// The row sums on the diagonal, zero elsewhere.
+    RowSums,
 }
 
 /// The affine-preserving lumping of the hybrid extension ([`crate::mass::Correction::InMass`]),

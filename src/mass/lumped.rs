@@ -1,6 +1,6 @@
 //! The lumped (row-sum) mass `M_ii^L = Σ_j M_ij = Σ_p m_p phi_i(x_p)`.
 
-use super::{MassError, MassReport, MassSetup, MassStrategy, StepContext};
+use super::{MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext};
 use crate::sparse::{Scalar, SymmetricPattern};
 
 /// Row-sum lumping: a diagonal solve.
@@ -20,6 +20,12 @@ impl<T: Scalar> Lumped<T> {
 impl<T: Scalar> MassStrategy<T> for Lumped<T> {
     fn spec(&self) -> String {
         "lumped".into()
+    }
+    fn needs(&self) -> Needs {
+        Needs {
+            row_sums_only: true,
+            ..Needs::default()
+        }
     }
     fn prepare(&mut self, setup: &MassSetup) {
         self.fixed = setup.fixed.to_vec();

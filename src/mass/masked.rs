@@ -8,6 +8,7 @@
 use super::condition::{estimate, Operator};
 use super::{distinct_fixed_sets, MassError, MassSetup};
 use crate::sparse::{Scalar, SparseCholesky, SymmetricPattern};
+use rayon::prelude::*;
 
 /// `out = M'`: `values` (`M` in `pattern`) with the rows and columns where
 /// `masked(i)` replaced by the diagonal entry `masked_diagonal`, and every
@@ -63,7 +64,8 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     pub inactive: Vec<bool>,
     /// Rows replaced by their lumped value.
     pub lumped: Vec<bool>,
-    diagonal_add: Vec<T>,
+    /// `modify_rows`' buffer, one per distinct fixed set.
+    diagonal_add: Vec<Vec<T>>,
     work: [Vec<T>; 2],
 }
 
@@ -84,7 +86,7 @@ impl<T: Scalar> MaskedCholesky<T> {
         self.solver_of = solver_of;
         self.inactive = vec![false; n];
         self.lumped = vec![false; n];
-        self.diagonal_add = vec![T::zero(); n];
+        self.diagonal_add = vec![vec![T::zero(); n]; self.fixed.len()];
         self.work = [vec![T::zero(); n], vec![T::zero(); n]];
     }
 
@@ -105,19 +107,31 @@ impl<T: Scalar> MaskedCholesky<T> {
         } else {
             T::one()
         };
-        for (s, fixed) in self.fixed.iter().enumerate() {
-            let inactive = &self.inactive;
-            modify_rows(
-                pattern,
-                values,
-                &self.lumped,
-                |i| fixed[i] || inactive[i],
-                scale,
-                &mut self.diagonal_add,
-                &mut self.modified[s],
-            );
-            self.solvers[s].factorize(&self.modified[s])?;
-        }
+        // The distinct fixed sets are independent systems: factorised side by side
+        // on the pool (each result is the same for any thread count), the first
+        // failure in set order reported.
+        let (inactive, lumped) = (&self.inactive, &self.lumped);
+        let results: Vec<Result<(), MassError>> = (
+            self.fixed.par_iter(),
+            self.diagonal_add.par_iter_mut(),
+            self.modified.par_iter_mut(),
+            self.solvers.par_iter_mut(),
+        )
+            .into_par_iter()
+            .map(|(fixed, diagonal_add, modified, solver)| {
+                modify_rows(
+                    pattern,
+                    values,
+                    lumped,
+                    |i| fixed[i] || inactive[i],
+                    scale,
+                    diagonal_add,
+                    modified,
+                );
+                solver.factorize(modified).map_err(MassError::from)
+            })
+            .collect();
+        results.into_iter().collect::<Result<(), MassError>>()?;
         Ok(())
     }
 

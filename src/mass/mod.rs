@@ -310,6 +310,10 @@ pub struct Needs {
     /// returns (the driver then keeps a velocity gradient per particle and the
     /// basis's points of linear precision).
     pub correction: Correction,
+    /// The strategy reads only the row sums `Σ_j M_ij` of `M` (the lumped mass):
+    /// the driver then assembles them on the diagonal and nothing else
+    /// (`driver::phases::MassMatrix::RowSums`).
+    pub row_sums_only: bool,
 }
 
 /// How the driver corrects the momentum `P` of the rows a strategy lumped, so that

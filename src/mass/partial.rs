@@ -51,6 +51,7 @@ impl<T: Scalar> MassStrategy<T> for Partial<T> {
             coverage: matches!(self.rule, LumpRule::Coverage(_)),
             polynomials: false,
             correction: super::Correction::None,
+            row_sums_only: false,
         }
     }
     fn prepare(&mut self, setup: &MassSetup) {

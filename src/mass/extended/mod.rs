@@ -282,6 +282,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             } else {
                 Correction::None
             },
+            row_sums_only: false,
         }
     }
     fn lumped_rows(&self) -> Option<&[bool]> {

@@ -15,9 +15,10 @@
 //!    [`bezier`].
 //!
 //! Evaluation ([`Basis::eval`]) locates the sub-triangle by three sign tests
-//! ([`Refinement::sub_triangle_of`]), evaluates its six Bernstein polynomials and
-//! their (constant-coefficient) gradients, and combines them with the stored
-//! ordinates of the nine functions of the triangle: no allocation, no search.
+//! ([`Refinement::sub_triangle_of`]) and evaluates the nine functions' quadratics
+//! on it, each converted once from its Bézier ordinates to monomials in
+//! `x − P_0` (`P_0` a corner of the sub-triangle, [`monomials`]): nine flops for a
+//! value and gradient, no allocation, no search.
 //!
 //! Function `3 i + q` belongs to vertex `i` and control point `Q_i^{q+1}`. The basis
 //! is a partition of unity, non-negative (every ordinate is a barycentric coordinate
@@ -40,7 +41,9 @@ use crate::mesh::{TriMesh, Vec2};
 use crate::refinement::Refinement;
 pub use crate::refinement::SplitPoint;
 use crate::scalar::Real;
-use bezier::{bernstein, hermite_ordinates, MainTriangle};
+#[cfg(doc)]
+use bezier::bernstein;
+use bezier::{hermite_ordinates, MainTriangle};
 use control_triangle::{control_triangle, HalfPlane, VertexKind};
 use nalgebra::Vector2;
 
@@ -96,16 +99,23 @@ struct LocalCoordinates<T: Real> {
 
 impl<T: Real> LocalCoordinates<T> {
     fn new(p: [Vec2; 3]) -> Self {
-        let d = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
-        // τ_1 = ((x − P_0) × (P_2 − P_0)) / d, τ_2 = ((P_1 − P_0) × (x − P_0)) / d.
-        let g1 = Vec2::new(p[2].y - p[0].y, p[0].x - p[2].x) / d;
-        let g2 = Vec2::new(p[0].y - p[1].y, p[1].x - p[0].x) / d;
+        let [g1, g2] = Self::gradients_f64(p);
         let t = |v: Vec2| Vector2::new(T::of(v.x), T::of(v.y));
         LocalCoordinates {
             origin: t(p[0]),
             g1: t(g1),
             g2: t(g2),
         }
+    }
+
+    /// `g_1, g_2` in `f64`.
+    fn gradients_f64(p: [Vec2; 3]) -> [Vec2; 2] {
+        let d = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
+        // τ_1 = ((x − P_0) × (P_2 − P_0)) / d, τ_2 = ((P_1 − P_0) × (x − P_0)) / d.
+        [
+            Vec2::new(p[2].y - p[0].y, p[0].x - p[2].x) / d,
+            Vec2::new(p[0].y - p[1].y, p[1].x - p[0].x) / d,
+        ]
     }
 
     #[inline(always)]
@@ -115,8 +125,8 @@ impl<T: Real> LocalCoordinates<T> {
         [T::one() - t1 - t2, t1, t2]
     }
 
-    /// Gradients of `τ_0, τ_1, τ_2`.
-    #[inline(always)]
+    /// Gradients of `τ_0, τ_1, τ_2` (the tests' conditioning measure).
+    #[cfg(test)]
     fn gradients(&self) -> [Vector2<T>; 3] {
         [-(self.g1 + self.g2), self.g1, self.g2]
     }
@@ -131,8 +141,29 @@ struct ElementData<T: Real> {
     r_lambda: [T; 3],
     /// Sub-triangle barycentric coordinates.
     tau: [LocalCoordinates<T>; 6],
-    /// `ordinates[s][f]`: the six Bézier ordinates of local function `f` on sub-triangle `s`.
-    ordinates: [[[T; 6]; 9]; 6],
+    /// `poly[s][f]`: local function `f` on sub-triangle `s` as the monomial
+    /// coefficients in the sub-triangle's `τ_1, τ_2` ([`monomials`] of its Bézier
+    /// ordinates).
+    poly: [[[T; 6]; 9]; 6],
+}
+
+/// The quadratic `Σ_{|ijk|=2} b_ijk B_ijk(τ)` of a triangle in its barycentric
+/// coordinates `τ_1, τ_2` (`τ_0 = 1 − τ_1 − τ_2`), as the monomial coefficients
+/// `[a_0, …, a_5]` of `a_0 + a_1 τ_1 + a_2 τ_2 + a_3 τ_1² + a_4 τ_1 τ_2 + a_5 τ_2²`. The
+/// ordinates `b` are in the order of [`bernstein`] (`τ_0², τ_1², τ_2², 2τ_0τ_1,
+/// 2τ_1τ_2, 2τ_0τ_2`); expanding `τ_0` gives `a_0 = b_0`, `a_1 = 2 (b_3 − b_0)`,
+/// `a_2 = 2 (b_5 − b_0)`, `a_3 = b_0 + b_1 − 2 b_3`, `a_4 = 2 (b_0 − b_3 + b_4 − b_5)`,
+/// `a_5 = b_0 + b_2 − 2 b_5`. In `τ` rather than in `x`, the round-off stays that of
+/// the Bernstein form on slender sub-triangles (where `|∇τ|` is large).
+pub fn monomials(b: [f64; 6]) -> [f64; 6] {
+    [
+        b[0],
+        2.0 * (b[3] - b[0]),
+        2.0 * (b[5] - b[0]),
+        b[0] + b[1] - 2.0 * b[3],
+        2.0 * (b[0] - b[3] + b[4] - b[5]),
+        b[0] + b[2] - 2.0 * b[5],
+    ]
 }
 
 /// A control point lies on a boundary edge's line when its distance to it is at most
@@ -195,7 +226,8 @@ impl<T: Real> PowellSabin<T> {
                 r: std::array::from_fn(|m| refinement.local_edge_point(&mesh, t, m)),
                 r_lambda: std::array::from_fn(|m| refinement.local_edge_lambdas(&mesh, t, m).0),
             };
-            let mut ordinates = [[[T::zero(); 6]; 9]; 6];
+            let subs = refinement.sub_triangles(&mesh, t);
+            let mut poly = [[[T::zero(); 6]; 9]; 6];
             for k in 0..3 {
                 let tr = &triplets[tri[k]];
                 for q in 0..3 {
@@ -205,17 +237,16 @@ impl<T: Real> PowellSabin<T> {
                     g[k] = Vec2::new(tr.beta[q], tr.gamma[q]);
                     let b = hermite_ordinates(&geometry, f, g);
                     for s in 0..6 {
-                        ordinates[s][3 * k + q] = b[s].map(T::of);
+                        poly[s][3 * k + q] = monomials(b[s]).map(T::of);
                     }
                 }
             }
-            let subs = refinement.sub_triangles(&mesh, t);
             elements.push(ElementData {
                 lambda: LocalCoordinates::new(geometry.v),
                 z_bary: geometry.z_bary.map(T::of),
                 r_lambda: geometry.r_lambda.map(T::of),
                 tau: std::array::from_fn(|s| LocalCoordinates::new(subs[s])),
-                ordinates,
+                poly,
             });
         }
         let mut support_offsets = vec![0];
@@ -324,11 +355,13 @@ impl<T: Real> PowellSabin<T> {
 
     /// Evaluates the nine functions of `element` at `x` with the quadratic polynomial
     /// of sub-triangle `piece` (numbered as in [`crate::refinement`]), also where `x`
-    /// lies outside that sub-triangle (the polynomial is extended). With `τ` the
-    /// barycentric coordinates of `x` in the sub-triangle and `b_f` the stored
-    /// ordinates of function `f`:
+    /// lies outside that sub-triangle (the polynomial is extended). With `τ_1, τ_2`
+    /// the barycentric coordinates of `x` in the sub-triangle and `a_f` the stored
+    /// [`monomials`] of function `f` (its Bézier ordinates `b_f,ijk` converted once,
+    /// so that `φ_f(x) = Σ_{|ijk|=2} b_f,ijk B_ijk(τ)`):
     ///
-    /// `φ_f(x) = Σ_{|ijk|=2} b_f,ijk B_ijk(τ)`, `∇φ_f(x) = Σ_ijk b_f,ijk Σ_m ∂B_ijk/∂τ_m ∇τ_m`.
+    /// `φ_f = a_0 + τ_1 (a_1 + a_3 τ_1 + a_4 τ_2) + τ_2 (a_2 + a_5 τ_2)`,
+    /// `∇φ_f = (a_1 + 2 a_3 τ_1 + a_4 τ_2) ∇τ_1 + (a_2 + a_4 τ_1 + 2 a_5 τ_2) ∇τ_2`.
     ///
     /// Used by [`Basis::eval`] after locating the sub-triangle, and by the C¹ tests to
     /// compare the two pieces meeting at an edge at the same point.
@@ -341,25 +374,18 @@ impl<T: Real> PowellSabin<T> {
         out: &mut BasisEval<T, 2>,
     ) {
         let e = &self.elements[element];
-        let tau = e.tau[piece].at(x);
-        let grad_tau = e.tau[piece].gradients();
-        let (b, db) = bernstein(tau);
-        let grad_b: [Vector2<T>; 6] = std::array::from_fn(|k| {
-            grad_tau[0] * db[k][0] + grad_tau[1] * db[k][1] + grad_tau[2] * db[k][2]
-        });
-        let ordinates = &e.ordinates[piece];
+        let tau = &e.tau[piece];
+        let [_, t1, t2] = tau.at(x);
+        let poly = &e.poly[piece];
         let functions = &self.element_functions[element];
         for f in 0..9 {
-            let c = &ordinates[f];
-            let mut phi = T::zero();
-            let mut grad = Vector2::zeros();
-            for k in 0..6 {
-                phi += c[k] * b[k];
-                grad += grad_b[k] * c[k];
-            }
+            let a = &poly[f];
+            let h1 = a[1] + a[3] * t1 + a[4] * t2;
+            let h2 = a[2] + a[5] * t2;
             out.index[f] = functions[f];
-            out.phi[f] = phi;
-            out.grad_phi[f] = grad;
+            out.phi[f] = a[0] + t1 * h1 + t2 * h2;
+            let (d1, d2) = (h1 + a[3] * t1, h2 + a[4] * t1 + a[5] * t2);
+            out.grad_phi[f] = tau.g1 * d1 + tau.g2 * d2;
         }
         out.set_len(9);
     }

@@ -1,0 +1,289 @@
+//! The kernels of a step, one by one, at about 1e5 particles (B5a's column refined
+//! to 14 × 112 blocks, 8 × 8 particles per block: 100 352 particles, as
+//! `mpm-cli throughput --sizes 1e5`), one thread:
+//!
+//! - `locate`: point location of every particle, from the element it was in
+//!   before the particles moved by a tenth of a particle spacing (the step's
+//!   case), and with no hint (set-up);
+//! - `eval`: basis values and gradients at every particle (PL, PS; the 1D
+//!   quadratic B-spline and PL on 1e5 points of a 3 263-element line);
+//! - `assemble`: the mass matrix (every entry, or the row sums the lumped mass
+//!   reads) and the internal force, element by element as the driver does;
+//! - `cholesky`: the numeric factorisation of the PS mass matrix (9 789
+//!   functions) and one solve with two right-hand sides.
+//!
+//! Run: `cargo bench --bench kernels`. The whole step of each variant is in
+//! `benches/step.rs` and `mpm-cli throughput`; `docs/performance.md` has the
+//! figures.
+
+use nalgebra::{Matrix2, Vector1, Vector2};
+use psmpm::basis::basis::bspline1d::QuadraticBSpline;
+use psmpm::basis::basis::linear::Linear;
+use psmpm::basis::basis::linear1d::Linear1d;
+use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+use psmpm::basis::mesh::generators::block_grid;
+use psmpm::basis::mesh::mesh1d::Mesh1d;
+use psmpm::basis::{Basis, BasisEval, TriMesh};
+use psmpm::driver::phases::{
+    assemble_mass_and_internal_force, locate_and_evaluate, Bins, Evaluations, Gather, Local,
+    MassMatrix,
+};
+use psmpm::particles::Particles;
+use psmpm::sparse::{SparseCholesky, SymmetricPattern};
+
+const BLOCKS: (usize, usize) = (14, 112);
+const PER_BLOCK: usize = 8;
+const WIDTH: f64 = 2.0;
+const HEIGHT: f64 = 25.0;
+
+fn mesh() -> TriMesh {
+    block_grid(0.0, WIDTH, 0.0, HEIGHT, BLOCKS.0, BLOCKS.1).unwrap()
+}
+
+/// Particle positions on the lattice of `PER_BLOCK × PER_BLOCK` per block, shifted
+/// by `shift` particle spacings along both axes.
+fn positions(shift: f64) -> Vec<Vector2<f64>> {
+    let (nx, ny) = (BLOCKS.0 * PER_BLOCK, BLOCKS.1 * PER_BLOCK);
+    let (dx, dy) = (WIDTH / nx as f64, HEIGHT / ny as f64);
+    let mut x = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            x.push(Vector2::new(
+                (i as f64 + 0.5 + shift) * dx,
+                (j as f64 + 0.5 + shift) * dy,
+            ));
+        }
+    }
+    x
+}
+
+fn particles() -> Particles<f64, 2> {
+    let x = positions(0.0);
+    let n = x.len();
+    let mut p = Particles::new(x, vec![WIDTH * HEIGHT / n as f64; n], 1e3);
+    p.sigma
+        .iter_mut()
+        .for_each(|s| *s = Matrix2::new(-1e3, 10.0, 10.0, -2e3));
+    p
+}
+
+fn ps() -> PowellSabin<f64> {
+    PowellSabin::new(mesh(), SplitPoint::Incentre).unwrap()
+}
+
+/// The elements of the particles at their lattice positions.
+fn elements<B: Basis<f64, 2>>(basis: &B, x: &[Vector2<f64>]) -> Vec<usize> {
+    x.iter().map(|x| basis.locate(x, None).unwrap()).collect()
+}
+
+mod locate {
+    use super::*;
+
+    #[divan::bench(sample_count = 20)]
+    fn from_previous_element(bencher: divan::Bencher) {
+        let basis = Linear::<f64>::new(mesh());
+        let before = elements(&basis, &positions(0.0));
+        let moved = positions(0.1);
+        bencher.bench_local(|| {
+            let mut found = 0;
+            for (x, &e) in moved.iter().zip(&before) {
+                found += basis.locate(x, Some(e)).unwrap();
+            }
+            found
+        });
+    }
+
+    #[divan::bench(sample_count = 10)]
+    fn without_hint(bencher: divan::Bencher) {
+        let basis = Linear::<f64>::new(mesh());
+        let moved = positions(0.1);
+        bencher.bench_local(|| {
+            let mut found = 0;
+            for x in &moved {
+                found += basis.locate(x, None).unwrap();
+            }
+            found
+        });
+    }
+}
+
+mod eval {
+    use super::*;
+
+    fn bench_2d<B: Basis<f64, 2>>(bencher: divan::Bencher, basis: B) {
+        let x = positions(0.1);
+        let e = elements(&basis, &x);
+        let mut out = BasisEval::for_basis(&basis);
+        bencher.bench_local(|| {
+            let mut sum = 0.0;
+            for (x, &e) in x.iter().zip(&e) {
+                basis.eval(e, x, &mut out);
+                sum += out.phi[0];
+            }
+            sum
+        });
+    }
+
+    fn bench_1d<B: Basis<f64, 1>>(bencher: divan::Bencher, basis: B) {
+        let n = BLOCKS.0 * BLOCKS.1 * PER_BLOCK * PER_BLOCK;
+        let x: Vec<Vector1<f64>> = (0..n)
+            .map(|p| Vector1::new((p as f64 + 0.5) / n as f64))
+            .collect();
+        let e: Vec<usize> = x.iter().map(|x| basis.locate(x, None).unwrap()).collect();
+        let mut out = BasisEval::for_basis(&basis);
+        bencher.bench_local(|| {
+            let mut sum = 0.0;
+            for (x, &e) in x.iter().zip(&e) {
+                basis.eval(e, x, &mut out);
+                sum += out.phi[0];
+            }
+            sum
+        });
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn pl(bencher: divan::Bencher) {
+        bench_2d(bencher, Linear::<f64>::new(mesh()));
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn ps(bencher: divan::Bencher) {
+        bench_2d(bencher, super::ps());
+    }
+
+    /// Points of one line with as many elements as the 2D mesh has vertices.
+    fn line() -> Mesh1d {
+        Mesh1d::uniform(0.0, 1.0, 3263).unwrap()
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn bspline_1d(bencher: divan::Bencher) {
+        bench_1d(bencher, QuadraticBSpline::<f64>::new(line()));
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn pl_1d(bencher: divan::Bencher) {
+        bench_1d(bencher, Linear1d::<f64>::new(line()));
+    }
+
+    /// Locate and evaluate as the step's phase 1 does (stored per particle).
+    #[divan::bench(sample_count = 20)]
+    fn ps_phase(bencher: divan::Bencher) {
+        let basis = super::ps();
+        let x = positions(0.1);
+        let mut element = elements(&basis, &positions(0.0));
+        let mut evals = Evaluations::new(x.len(), basis.max_functions_per_element());
+        let mut scratch: Vec<BasisEval<f64, 2>> = (0..psmpm::driver::phases::chunks(x.len()))
+            .map(|_| BasisEval::for_basis(&basis))
+            .collect();
+        bencher.bench_local(|| {
+            locate_and_evaluate(&basis, &x, &mut element, &mut scratch, &mut evals).is_ok()
+        });
+    }
+}
+
+mod assemble {
+    use super::*;
+
+    fn bench<B: Basis<f64, 2>>(bencher: divan::Bencher, basis: B, matrix: MassMatrix) {
+        let parts = particles();
+        let pattern = SymmetricPattern::new(&basis);
+        let stride = basis.max_functions_per_element();
+        let mut element = elements(&basis, &parts.x);
+        let mut evals = Evaluations::new(parts.len(), stride);
+        let mut scratch: Vec<BasisEval<f64, 2>> = (0..psmpm::driver::phases::chunks(parts.len()))
+            .map(|_| BasisEval::for_basis(&basis))
+            .collect();
+        locate_and_evaluate(&basis, &parts.x, &mut element, &mut scratch, &mut evals)
+            .ok()
+            .unwrap();
+        let mut bins = Bins::new(basis.num_elements(), parts.len());
+        bins.fill(&element);
+        let gather = Gather::new(&basis, &pattern, stride);
+        let mut local = Local::<f64, 2>::new(basis.num_elements(), stride);
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut force = vec![vec![0.0; basis.num_functions()]; 2];
+        bencher.bench_local(|| {
+            assemble_mass_and_internal_force(
+                &parts,
+                &evals,
+                &bins,
+                &gather,
+                &mut local,
+                matrix,
+                &mut values,
+                &mut force,
+            );
+            values[0]
+        });
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn pl_row_sums(bencher: divan::Bencher) {
+        bench(bencher, Linear::<f64>::new(mesh()), MassMatrix::RowSums);
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn pl_full(bencher: divan::Bencher) {
+        bench(bencher, Linear::<f64>::new(mesh()), MassMatrix::Full);
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn ps_row_sums(bencher: divan::Bencher) {
+        bench(bencher, super::ps(), MassMatrix::RowSums);
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn ps_full(bencher: divan::Bencher) {
+        bench(bencher, super::ps(), MassMatrix::Full);
+    }
+}
+
+mod cholesky {
+    use super::*;
+
+    /// The PS mass matrix of the particles (upper triangle) and its pattern.
+    fn mass_matrix() -> (SymmetricPattern, Vec<f64>) {
+        let basis = super::ps();
+        let parts = particles();
+        let pattern = SymmetricPattern::new(&basis);
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut out = BasisEval::for_basis(&basis);
+        for (p, x) in parts.x.iter().enumerate() {
+            let e = basis.locate(x, None).unwrap();
+            basis.eval(e, x, &mut out);
+            let scatter = pattern.element_scatter(e);
+            let m = out.len();
+            for a in 0..m {
+                for b in a..m {
+                    values[scatter[a * m + b]] += parts.mass[p] * out.phi[a] * out.phi[b];
+                }
+            }
+        }
+        (pattern, values)
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn factorize(bencher: divan::Bencher) {
+        let (pattern, values) = mass_matrix();
+        let mut solver = SparseCholesky::new(&pattern, 2);
+        bencher.bench_local(|| solver.factorize(&values).is_ok());
+    }
+
+    #[divan::bench(sample_count = 20)]
+    fn solve_two_columns(bencher: divan::Bencher) {
+        let (pattern, values) = mass_matrix();
+        let mut solver = SparseCholesky::new(&pattern, 2);
+        solver.factorize(&values).unwrap();
+        let n = pattern.dim();
+        let mut rhs = vec![1.0; 2 * n];
+        bencher.bench_local(|| {
+            solver.solve_in_place(&mut rhs, 2);
+            rhs[0]
+        });
+    }
+}
+
+fn main() {
+    divan::main();
+}
