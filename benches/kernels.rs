@@ -1,12 +1,14 @@
 //! The kernels of a step, one by one, at about 1e5 particles (B5a's column refined
 //! to 14 × 112 blocks, 8 × 8 particles per block: 100 352 particles, as
-//! `mpm-cli throughput --sizes 1e5`), one thread:
+//! `mpm-cli throughput --sizes 1e5`), on a pool of one thread:
 //!
 //! - `locate`: point location of every particle, from the element it was in
 //!   before the particles moved by a tenth of a particle spacing (the step's
 //!   case), and with no hint (set-up);
-//! - `eval`: basis values and gradients at every particle (PL, PS; the 1D
-//!   quadratic B-spline and PL on 1e5 points of a 3 263-element line);
+//! - `eval`: basis values and gradients at every particle in lattice order (PL,
+//!   PS; the 1D quadratic B-spline and PL on 1e5 points of a 3 263-element line),
+//!   and phase 1 of the step for PS (locate, bin by element, evaluate in element
+//!   order);
 //! - `assemble`: the mass matrix (every entry, or the row sums the lumped mass
 //!   reads) and the internal force, element by element as the driver does;
 //! - `cholesky`: the numeric factorisation of the PS mass matrix (9 789
@@ -173,11 +175,20 @@ mod eval {
         let x = positions(0.1);
         let mut element = elements(&basis, &positions(0.0));
         let mut evals = Evaluations::new(x.len(), basis.max_functions_per_element());
+        let mut bins = Bins::new(basis.num_elements(), x.len());
         let mut scratch: Vec<BasisEval<f64, 2>> = (0..psmpm::driver::phases::chunks(x.len()))
             .map(|_| BasisEval::for_basis(&basis))
             .collect();
         bencher.bench_local(|| {
-            locate_and_evaluate(&basis, &x, &mut element, &mut scratch, &mut evals).is_ok()
+            locate_and_evaluate(
+                &basis,
+                &x,
+                &mut element,
+                &mut bins,
+                &mut scratch,
+                &mut evals,
+            )
+            .is_ok()
         });
     }
 }
@@ -194,11 +205,17 @@ mod assemble {
         let mut scratch: Vec<BasisEval<f64, 2>> = (0..psmpm::driver::phases::chunks(parts.len()))
             .map(|_| BasisEval::for_basis(&basis))
             .collect();
-        locate_and_evaluate(&basis, &parts.x, &mut element, &mut scratch, &mut evals)
-            .ok()
-            .unwrap();
         let mut bins = Bins::new(basis.num_elements(), parts.len());
-        bins.fill(&element);
+        locate_and_evaluate(
+            &basis,
+            &parts.x,
+            &mut element,
+            &mut bins,
+            &mut scratch,
+            &mut evals,
+        )
+        .ok()
+        .unwrap();
         let gather = Gather::new(&basis, &pattern, stride);
         let mut local = Local::<f64, 2>::new(basis.num_elements(), stride);
         let mut values = vec![0.0; pattern.nnz()];
@@ -285,5 +302,10 @@ mod cholesky {
 }
 
 fn main() {
-    divan::main();
+    // One thread: the kernels' own cost (phase 1 and the assembly run on the pool).
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(divan::main);
 }

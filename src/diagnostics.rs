@@ -7,7 +7,7 @@ use crate::mass::MassReport;
 use crate::materials::ParticleMaterials;
 use crate::particles::Particles;
 use crate::sparse::Scalar;
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, SVector};
 
 /// Largest growth of the total energy (relative to the energy scale of the run)
 /// for a run to count as stable.
@@ -104,47 +104,87 @@ pub struct Energies {
     pub max_speed: f64,
 }
 
-/// The energies and momentum of `parts` under `material` and `effects`.
+/// The energies and momentum of `parts` under `material` and `effects`: the
+/// [`particle_terms`] summed per chunk of [`crate::driver::phases::CHUNK`]
+/// particles, the chunks then in order, as the driver's step sums them (the same
+/// bits).
 pub fn energies<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     parts: &Particles<T, D>,
     material: &Mat,
     effects: &[Box<dyn Effect<T, D>>],
 ) -> Energies {
-    energies_from_terms(
-        (0..parts.len()).map(|p| particle_terms(parts, material, p)),
-        parts,
-        effects,
-    )
+    let chunk = crate::driver::phases::CHUNK;
+    let partials = (0..parts.len().div_ceil(chunk)).map(|c| {
+        let mut sum = [0.0; 8];
+        for p in c * chunk..((c + 1) * chunk).min(parts.len()) {
+            accumulate_terms(&mut sum, &particle_terms(parts, material, p));
+        }
+        sum
+    });
+    energies_from_terms(partials, parts, effects)
 }
 
 /// What particle `p` adds to [`energies`]: `½ m |v|²`, `|v|`, `V⁰ W(F)`, the
 /// initial stress's work `V⁰ σ⁰ : (sym F − I)`, whether it has an initial stress
-/// (1 or 0), `m`, `m v` (up to two components). Computed apart (in parallel by the
-/// driver) and summed by [`energies_from_terms`] in particle order, the sums are
-/// those of [`energies`], bit for bit.
+/// (1 or 0), `m`, `m v` (up to two components), as [`terms_of`] gives them.
 pub fn particle_terms<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     parts: &Particles<T, D>,
     material: &Mat,
     p: usize,
 ) -> [f64; 8] {
-    let m = parts.mass[p].to_f64();
-    let speed2 = parts.v[p].norm_squared().to_f64();
+    terms_of(
+        parts.mass[p],
+        &parts.v[p],
+        parts.volume0[p],
+        &parts.f[p],
+        &parts.sigma0[p],
+        material.energy_density(p, &parts.f[p]),
+    )
+}
+
+/// The [`particle_terms`] of a particle of mass `m`, velocity `v`, initial volume
+/// `volume0`, deformation gradient `f`, initial stress `sigma0` and strain energy
+/// density `w = W(F)`.
+#[inline]
+pub fn terms_of<T: Scalar, const D: usize>(
+    m: T,
+    v: &SVector<T, D>,
+    volume0: T,
+    f: &SMatrix<T, D, D>,
+    sigma0: &SMatrix<T, D, D>,
+    w: T,
+) -> [f64; 8] {
+    let m = m.to_f64();
+    let speed2 = v.norm_squared().to_f64();
     let mut terms = [0.0; 8];
     terms[0] = 0.5 * m * speed2;
     terms[1] = speed2.sqrt();
-    terms[2] = parts.volume0[p].to_f64() * material.energy_density(p, &parts.f[p]).to_f64();
-    if parts.sigma0[p] != SMatrix::<T, D, D>::zeros() {
+    terms[2] = volume0.to_f64() * w.to_f64();
+    if *sigma0 != SMatrix::<T, D, D>::zeros() {
         // First-order work of the initial stress: V⁰ σ⁰ : (sym F − I).
-        let f = &parts.f[p];
         let e = (f + f.transpose()) * T::of(0.5) - SMatrix::<T, D, D>::identity();
-        terms[3] = parts.volume0[p].to_f64() * parts.sigma0[p].dot(&e).to_f64();
+        terms[3] = volume0.to_f64() * sigma0.dot(&e).to_f64();
         terms[4] = 1.0;
     }
     terms[5] = m;
     for k in 0..D {
-        terms[6 + k] = m * parts.v[p][k].to_f64();
+        terms[6 + k] = m * v[k].to_f64();
     }
     terms
+}
+
+/// `sum += terms` in the order [`energies_from_terms`] reads them: entry 1 (the
+/// speed) as a maximum, the others summed. Partial sums of consecutive particles,
+/// read in their order, give [`energies_from_terms`] a fixed summation order.
+#[inline]
+pub fn accumulate_terms(sum: &mut [f64; 8], terms: &[f64; 8]) {
+    for (k, (s, t)) in sum.iter_mut().zip(terms).enumerate() {
+        if k == 1 {
+            *s = s.max(*t);
+        } else {
+            *s += *t;
+        }
+    }
 }
 
 /// [`energies`] from the [`particle_terms`] of every particle, in particle order.

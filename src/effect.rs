@@ -23,12 +23,15 @@ use crate::studies::exact::AxisAligned;
 use nalgebra::{SMatrix, SVector};
 
 /// Basis values of every particle at the start of a step, as the driver evaluated
-/// them: particle `p` has `len[p]` entries at `p * stride ..`.
+/// them: particle `p` has `len[slot[p]]` entries at `slot[p] * stride ..` (the
+/// driver stores them in element order; see `driver::phases::Evaluations`).
 pub struct ParticleBasis<'a, T: Scalar, const D: usize> {
-    /// Entries per particle slot.
+    /// Entries per slot.
     pub stride: usize,
-    /// Valid entries per particle.
+    /// Valid entries per slot.
     pub len: &'a [usize],
+    /// The slot of each particle.
+    pub slot: &'a [usize],
     /// Function indices.
     pub index: &'a [usize],
     /// Values `phi_i(x_p)`.
@@ -39,8 +42,9 @@ impl<T: Scalar, const D: usize> ParticleBasis<'_, T, D> {
     /// Adds `phi_i(x_p) f` to `forces[k][i]` for the functions of particle `p`.
     #[inline]
     pub fn scatter(&self, p: usize, f: &SVector<T, D>, forces: &mut [Vec<T>]) {
-        let base = p * self.stride;
-        for a in 0..self.len[p] {
+        let s = self.slot[p];
+        let base = s * self.stride;
+        for a in 0..self.len[s] {
             let (i, phi) = (self.index[base + a], self.phi[base + a]);
             for k in 0..D {
                 forces[k][i] += f[k] * phi;

@@ -244,9 +244,8 @@ pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
         .for_each(|(e, lv)| {
             lv.iter_mut().for_each(|v| *v = T::zero());
             for &p in bins.particles(e) {
-                let base = p * evals.stride;
-                for a in 0..evals.len[p] {
-                    let f = q(p, base + a);
+                for (a, s) in evals.range(p).enumerate() {
+                    let f = q(p, s);
                     for k in 0..D {
                         lv[a * D + k] += f[k];
                     }

@@ -1,14 +1,14 @@
 //! The energy balance of a step: the energies and momentum of the state (the
-//! per-particle terms in parallel, summed in particle order), and the work of the
-//! non-conservative effects booked with the mean of the start and end velocities.
+//! particle terms summed per chunk of particles in phase 6, the chunks then in
+//! order), and the work of the non-conservative effects booked with the mean of
+//! the start and end velocities.
 
 use super::{phases, Driver, StepError};
-use crate::diagnostics::{energies, energies_from_terms, particle_terms, Energies, StepReport};
+use crate::diagnostics::{energies, energies_from_terms, Energies, StepReport};
 use crate::mass::MassStrategy;
 use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use psmpm_basis::Basis;
-use rayon::prelude::*;
 
 impl<T, const D: usize, B, M, Mat> Driver<T, D, B, M, Mat>
 where
@@ -17,19 +17,15 @@ where
     M: MassStrategy<T>,
     Mat: ParticleMaterials<T, D>,
 {
-    /// [`energies`] of the current state, the per-particle terms computed in
-    /// parallel and summed in particle order (the same sums, bit for bit).
-    pub(super) fn step_energies(&mut self) -> Energies {
-        let (parts, material) = (&self.particles, &self.material);
-        self.energy_terms
-            .par_chunks_mut(phases::CHUNK)
-            .enumerate()
-            .for_each(|(c, terms)| {
-                for (q, t) in terms.iter_mut().enumerate() {
-                    *t = particle_terms(parts, material, c * phases::CHUNK + q);
-                }
-            });
-        energies_from_terms(self.energy_terms.iter().copied(), parts, &self.effects)
+    /// [`energies`] of the state after phase 6, from the per-chunk sums of the
+    /// particle terms that [`phases::update_particles`] accumulated (a fixed
+    /// order for any number of threads).
+    pub(super) fn step_energies(&self) -> Energies {
+        energies_from_terms(
+            self.energy_terms.iter().copied(),
+            &self.particles,
+            &self.effects,
+        )
     }
 
     /// Power of the non-conservative forces with the velocity at the start of the

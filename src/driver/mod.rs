@@ -125,7 +125,8 @@ where
     /// The size of each element for the affine-preserving lumping
     /// ([`phases::element_scales`]); empty unless the strategy uses it.
     element_scale: Vec<T>,
-    /// Per-particle terms of the step report's energies.
+    /// Per-chunk sums of the particle terms of the step report's energies
+    /// (written by [`phases::update_particles`]).
     energy_terms: Vec<[f64; 8]>,
     work: f64,
     inputs: StrategyInputs<T>,
@@ -248,7 +249,7 @@ where
             velocity_known: false,
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             adjust: scratch(!effects.is_empty()),
-            energy_terms: vec![[0.0; 8]; np],
+            energy_terms: vec![[0.0; 8]; phases::chunks(np)],
             affine_gradient: vec![SMatrix::zeros(); if momentum_corrects { np } else { 0 }],
             function_points,
             element_scale,
@@ -364,6 +365,7 @@ where
             &self.basis,
             &self.particles.x,
             &mut self.particles.element,
+            &mut self.bins,
             &mut self.scratch,
             &mut self.evals,
         )
@@ -385,7 +387,6 @@ where
     /// Phase 2a: `M`, `F = −F^int` into `rhs`, and the facts the mass strategy
     /// asked for.
     fn assemble_mass(&mut self) {
-        self.bins.fill(&self.particles.element);
         phases::assemble_mass_and_internal_force(
             &self.particles,
             &self.evals,
@@ -457,6 +458,7 @@ where
             basis: ParticleBasis {
                 stride: self.evals.stride,
                 len: &self.evals.len,
+                slot: &self.evals.slot,
                 index: &self.evals.index,
                 phi: &self.evals.phi,
             },
@@ -618,6 +620,7 @@ where
             self.dt,
             &self.material,
             &mut self.particles,
+            &mut self.energy_terms,
         )
         .map_err(|failure| {
             let (particle, quantity) = match failure {

@@ -35,11 +35,20 @@ use super::binning::{ELEMENT_CHUNK, ENTRY_CHUNK};
 pub const CHUNK: usize = 1024;
 
 /// Basis values and gradients of every particle, as evaluated in phase 1.
+///
+/// The entries are stored by slot, in element order: phase 1 puts particle `p`
+/// at slot `slot[p]`, its position in the step's [`Bins`], so that the sums
+/// element by element stream through them and the evaluation reads each
+/// element's data for all its particles at once. Slot `s` has `len[s]` entries
+/// (function index, `phi`, `grad_phi`) at `s * stride ..`; [`Self::range`] finds a
+/// particle's.
 pub struct Evaluations<T: Scalar, const D: usize> {
-    /// Entries per particle slot (the basis's largest number of functions per element).
+    /// Entries per slot (the basis's largest number of functions per element).
     pub stride: usize,
-    /// Valid entries per particle.
+    /// Valid entries per slot.
     pub len: Vec<usize>,
+    /// `slot[p]`: the slot of particle `p`.
+    pub slot: Vec<usize>,
     /// Function indices `i`.
     pub index: Vec<usize>,
     /// Values `phi_i(x_p)`.
@@ -49,22 +58,25 @@ pub struct Evaluations<T: Scalar, const D: usize> {
 }
 
 impl<T: Scalar, const D: usize> Evaluations<T, D> {
-    /// Buffers for `particles` particles with up to `stride` functions each.
+    /// Buffers for `particles` particles with up to `stride` functions each
+    /// (particle `p` in slot `p` until phase 1 orders them).
     pub fn new(particles: usize, stride: usize) -> Self {
         Evaluations {
             stride,
             len: vec![0; particles],
+            slot: (0..particles).collect(),
             index: vec![0; particles * stride],
             phi: vec![T::zero(); particles * stride],
             grad_phi: vec![SVector::zeros(); particles * stride],
         }
     }
 
-    /// The slot range of particle `p`.
+    /// The entry range of particle `p`.
     #[inline]
     pub fn range(&self, p: usize) -> std::ops::Range<usize> {
-        let base = p * self.stride;
-        base..base + self.len[p]
+        let s = self.slot[p];
+        let base = s * self.stride;
+        base..base + self.len[s]
     }
 }
 
@@ -74,21 +86,43 @@ pub struct Outside {
     pub particle: usize,
 }
 
-/// Phase 1: locate every particle (walking from its previous element) and
-/// evaluate the basis there, [`CHUNK`] particles per task with one scratch
-/// buffer each (`scratch` holds [`chunks`]`(x.len())` of them). On failure, the
-/// first particle outside.
+/// Phase 1: locate every particle (walking from its previous element), bin the
+/// particles by element ([`Bins`]), and evaluate the basis at each particle in bin
+/// order, into its slot ([`Evaluations`]); [`CHUNK`] particles per task with one
+/// scratch buffer each (`scratch` holds [`chunks`]`(x.len())` of them). On
+/// failure, the first particle outside.
 pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
     basis: &B,
     x: &[SVector<T, D>],
     element: &mut [usize],
+    bins: &mut Bins,
     scratch: &mut [BasisEval<T, D>],
     out: &mut Evaluations<T, D>,
 ) -> Result<(), Outside> {
+    let failure = (x.par_chunks(CHUNK), element.par_chunks_mut(CHUNK))
+        .into_par_iter()
+        .enumerate()
+        .filter_map(|(c, (x, element))| {
+            for q in 0..x.len() {
+                let Some(e) = basis.locate(&x[q], Some(element[q])) else {
+                    return Some(c * CHUNK + q);
+                };
+                element[q] = e;
+            }
+            None
+        })
+        .min();
+    if let Some(particle) = failure {
+        return Err(Outside { particle });
+    }
+    bins.fill(element);
+    for (s, &p) in bins.order.iter().enumerate() {
+        out.slot[p] = s;
+    }
     let stride = out.stride;
-    let failure = (
-        x.par_chunks(CHUNK),
-        element.par_chunks_mut(CHUNK),
+    let (order, element) = (&bins.order, &*element);
+    (
+        order.par_chunks(CHUNK),
         out.len.par_chunks_mut(CHUNK),
         out.index.par_chunks_mut(CHUNK * stride),
         out.phi.par_chunks_mut(CHUNK * stride),
@@ -96,14 +130,9 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
         scratch.par_iter_mut(),
     )
         .into_par_iter()
-        .enumerate()
-        .filter_map(|(c, (x, element, len, index, phi, grad_phi, scratch))| {
-            for q in 0..x.len() {
-                let Some(e) = basis.locate(&x[q], Some(element[q])) else {
-                    return Some(c * CHUNK + q);
-                };
-                element[q] = e;
-                basis.eval(e, &x[q], scratch);
+        .for_each(|(order, len, index, phi, grad_phi, scratch)| {
+            for (q, &p) in order.iter().enumerate() {
+                basis.eval(element[p], &x[p], scratch);
                 let base = q * stride;
                 let m = scratch.len();
                 len[q] = m;
@@ -111,13 +140,8 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
                 phi[base..base + m].copy_from_slice(&scratch.phi[..m]);
                 grad_phi[base..base + m].copy_from_slice(&scratch.grad_phi[..m]);
             }
-            None
-        })
-        .min();
-    match failure {
-        Some(particle) => Err(Outside { particle }),
-        None => Ok(()),
-    }
+        });
+    Ok(())
 }
 
 /// Phase 2a: the mass matrix `M_ij = Σ_p m_p phi_i(x_p) phi_j(x_p)` (eq. (13)),
@@ -144,8 +168,8 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     let full = matrix == MassMatrix::Full;
     local.par_elements().for_each(|(e, (lm, lv))| {
         for &p in bins.particles(e) {
-            let base = p * evals.stride;
-            let m = evals.len[p];
+            let range = evals.range(p);
+            let (base, m) = (range.start, range.len());
             let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
             for a in 0..m {
                 let w = mass * evals.phi[base + a];
@@ -234,8 +258,8 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             if !touches_lumped(p) {
                 continue;
             }
-            let base = p * evals.stride;
-            let m = evals.len[p];
+            let range = evals.range(p);
+            let (base, m) = (range.start, range.len());
             let index = &evals.index[base..base + m];
             let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
             for a in 0..m {
@@ -508,61 +532,79 @@ pub fn update_deformation_gradient<T: Scalar, const D: usize>(
 /// positions and displacements `x_p += Δt Σ_i v̂_i phi_i(x_p)` (eqs. (30)–(31)).
 /// [`CHUNK`] particles per task; on failure, that of the first failing particle
 /// (the particles of other chunks are updated all the same).
+///
+/// `energy[c]` receives the [`crate::diagnostics::particle_terms`] of the updated
+/// particles of chunk `c`, accumulated in particle order
+/// ([`crate::diagnostics::accumulate_terms`]), for the step's energies.
 pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     evals: &Evaluations<T, D>,
     velocity: &[Vec<T>],
     dt: T,
     material: &Mat,
     parts: &mut Particles<T, D>,
+    energy: &mut [[f64; 8]],
 ) -> Result<(), UpdateFailure> {
     let failure = (
-        parts.f.par_chunks_mut(CHUNK),
-        parts.sigma.par_chunks_mut(CHUNK),
-        parts.volume.par_chunks_mut(CHUNK),
-        parts.x.par_chunks_mut(CHUNK),
-        parts.u.par_chunks_mut(CHUNK),
-        parts.sigma0.par_chunks(CHUNK),
-        parts.volume0.par_chunks(CHUNK),
-        parts.v.par_chunks(CHUNK),
+        (
+            parts.f.par_chunks_mut(CHUNK),
+            parts.sigma.par_chunks_mut(CHUNK),
+            parts.volume.par_chunks_mut(CHUNK),
+            parts.x.par_chunks_mut(CHUNK),
+            parts.u.par_chunks_mut(CHUNK),
+            parts.sigma0.par_chunks(CHUNK),
+        ),
+        (
+            parts.volume0.par_chunks(CHUNK),
+            parts.v.par_chunks(CHUNK),
+            parts.mass.par_chunks(CHUNK),
+            energy.par_iter_mut(),
+        ),
     )
         .into_par_iter()
         .enumerate()
-        .filter_map(|(c, (fs, sigma, volume, x, u, sigma0, volume0, v))| {
-            for q in 0..fs.len() {
-                let p = c * CHUNK + q;
-                let mut grad_v = SMatrix::<T, D, D>::zeros();
-                let mut v_hat = SVector::<T, D>::zeros();
-                for s in evals.range(p) {
-                    let i = evals.index[s];
-                    for k in 0..D {
-                        let c = velocity[k][i];
-                        v_hat[k] += c * evals.phi[s];
-                        for l in 0..D {
-                            grad_v[(k, l)] += c * evals.grad_phi[s][l];
+        .filter_map(
+            |(c, ((fs, sigma, volume, x, u, sigma0), (volume0, v, mass, energy)))| {
+                *energy = [0.0; 8];
+                for q in 0..fs.len() {
+                    let p = c * CHUNK + q;
+                    let mut grad_v = SMatrix::<T, D, D>::zeros();
+                    let mut v_hat = SVector::<T, D>::zeros();
+                    for s in evals.range(p) {
+                        let i = evals.index[s];
+                        for k in 0..D {
+                            let c = velocity[k][i];
+                            v_hat[k] += c * evals.phi[s];
+                            for l in 0..D {
+                                grad_v[(k, l)] += c * evals.grad_phi[s][l];
+                            }
                         }
                     }
+                    let f = update_deformation_gradient(&fs[q], &grad_v, dt);
+                    let j = det(&f);
+                    if !(j.to_f64() > 0.0 && j.to_f64().is_finite()) {
+                        return Some(UpdateFailure::Jacobian {
+                            particle: p,
+                            jacobian: j.to_f64(),
+                        });
+                    }
+                    fs[q] = f;
+                    sigma[q] = sigma0[q] + material.stress(p, &f);
+                    volume[q] = volume0[q] * j;
+                    x[q] += v_hat * dt;
+                    u[q] += v_hat * dt;
+                    let w = material.energy_density(p, &f);
+                    let terms =
+                        crate::diagnostics::terms_of(mass[q], &v[q], volume0[q], &f, &sigma0[q], w);
+                    crate::diagnostics::accumulate_terms(energy, &terms);
+                    if !x[q].iter().all(|c| c.to_f64().is_finite())
+                        || !v[q].iter().all(|c| c.to_f64().is_finite())
+                    {
+                        return Some(UpdateFailure::NotFinite { particle: p });
+                    }
                 }
-                let f = update_deformation_gradient(&fs[q], &grad_v, dt);
-                let j = det(&f);
-                if !(j.to_f64() > 0.0 && j.to_f64().is_finite()) {
-                    return Some(UpdateFailure::Jacobian {
-                        particle: p,
-                        jacobian: j.to_f64(),
-                    });
-                }
-                fs[q] = f;
-                sigma[q] = sigma0[q] + material.stress(p, &f);
-                volume[q] = volume0[q] * j;
-                x[q] += v_hat * dt;
-                u[q] += v_hat * dt;
-                if !x[q].iter().all(|c| c.to_f64().is_finite())
-                    || !v[q].iter().all(|c| c.to_f64().is_finite())
-                {
-                    return Some(UpdateFailure::NotFinite { particle: p });
-                }
-            }
-            None
-        })
+                None
+            },
+        )
         .min_by_key(UpdateFailure::particle);
     match failure {
         Some(f) => Err(f),
@@ -617,9 +659,8 @@ pub fn particle_volume_by_elements<T: Scalar, const D: usize>(
         .for_each(|(e, lv)| {
             lv.iter_mut().for_each(|v| *v = T::zero());
             for &p in bins.particles(e) {
-                let base = p * evals.stride;
-                for a in 0..evals.len[p] {
-                    lv[a * D] += volume[p] * evals.phi[base + a];
+                for (a, s) in evals.range(p).enumerate() {
+                    lv[a * D] += volume[p] * evals.phi[s];
                 }
             }
         });

@@ -7,7 +7,7 @@
 
 use super::condition::{estimate, Operator};
 use super::{distinct_fixed_sets, MassError, MassSetup};
-use crate::sparse::{Scalar, SparseCholesky, SymmetricPattern};
+use crate::sparse::{NotPositiveDefinite, Scalar, SparseCholesky, SymmetricPattern};
 use rayon::prelude::*;
 
 /// `out = M'`: `values` (`M` in `pattern`) with the rows and columns where
@@ -66,6 +66,8 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     pub lumped: Vec<bool>,
     /// `modify_rows`' buffer, one per distinct fixed set.
     diagonal_add: Vec<Vec<T>>,
+    /// The failure of each set's last factorisation.
+    failed: Vec<Option<NotPositiveDefinite>>,
     work: [Vec<T>; 2],
 }
 
@@ -87,6 +89,7 @@ impl<T: Scalar> MaskedCholesky<T> {
         self.inactive = vec![false; n];
         self.lumped = vec![false; n];
         self.diagonal_add = vec![vec![T::zero(); n]; self.fixed.len()];
+        self.failed = vec![None; self.fixed.len()];
         self.work = [vec![T::zero(); n], vec![T::zero(); n]];
     }
 
@@ -111,14 +114,15 @@ impl<T: Scalar> MaskedCholesky<T> {
         // on the pool (each result is the same for any thread count), the first
         // failure in set order reported.
         let (inactive, lumped) = (&self.inactive, &self.lumped);
-        let results: Vec<Result<(), MassError>> = (
+        (
             self.fixed.par_iter(),
             self.diagonal_add.par_iter_mut(),
             self.modified.par_iter_mut(),
             self.solvers.par_iter_mut(),
+            self.failed.par_iter_mut(),
         )
             .into_par_iter()
-            .map(|(fixed, diagonal_add, modified, solver)| {
+            .for_each(|(fixed, diagonal_add, modified, solver, failed)| {
                 modify_rows(
                     pattern,
                     values,
@@ -128,10 +132,11 @@ impl<T: Scalar> MaskedCholesky<T> {
                     diagonal_add,
                     modified,
                 );
-                solver.factorize(modified).map_err(MassError::from)
-            })
-            .collect();
-        results.into_iter().collect::<Result<(), MassError>>()?;
+                *failed = solver.factorize(modified).err();
+            });
+        if let Some(failure) = self.failed.iter().flatten().next() {
+            return Err(MassError::from(failure.clone()));
+        }
         Ok(())
     }
 

@@ -283,6 +283,31 @@ fn converge_prints_levels_orders_and_writes_its_plots() {
     assert!(table.starts_with("  basis  level"), "{table}");
 }
 
+/// `docs/results.md` (B4): the ladder's command, cut to two steps, keeps about
+/// 1000 particles per element as h halves (the particles double per axis).
+#[test]
+fn the_b4_ladder_keeps_its_particles_per_element() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/studies/b4-ladder.toml"
+    );
+    let json = stdout(&[
+        "converge", scene, "--levels", "2", "--basis", "ps", "--t-end", "5e-5", "--format", "json",
+    ]);
+    let study: Value = serde_json::from_str(&json).unwrap();
+    let rows = study["levels"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    let get = |r: &Value, k: &str| r[k].as_f64().unwrap();
+    assert_eq!(get(&rows[0], "particles"), 65536.0);
+    assert_eq!(get(&rows[1], "particles"), 262144.0);
+    assert_eq!(get(&rows[0], "functions"), 123.0);
+    assert_eq!(get(&rows[1], "functions"), 426.0);
+    // Particles per function (and so per element) about the same on both levels.
+    let per_function = |r: &Value| get(r, "particles") / get(r, "functions");
+    let ratio = per_function(&rows[1]) / per_function(&rows[0]);
+    assert!((0.8..1.25).contains(&ratio), "{ratio}");
+}
+
 /// README: `converge vibrating-bar-1d --levels 4` used to end with a negative order
 /// and no word of why. The study now measures why at the level where an order falls.
 #[test]
