@@ -43,6 +43,17 @@ pub struct ConvergeArgs {
     /// table marks it).
     #[arg(long)]
     strict: bool,
+    /// An error to reach: prints, per basis, the wall time at which its error
+    /// falls to this value (log-log interpolation between the two levels around
+    /// it) and how many times faster the fastest basis gets there (a
+    /// work-precision comparison; `docs/performance.md`).
+    #[arg(long, value_name = "ERROR")]
+    target_error: Option<f64>,
+    /// Threads of each run's particle phases (default: all cores; 1 for
+    /// work-precision timings on a shared machine). The errors are the same for any
+    /// number.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -82,6 +93,102 @@ pub struct Level {
     pub seconds: f64,
     /// Stable verdict.
     pub stable: bool,
+}
+
+/// When a basis's error reaches a target error ([`ConvergeArgs::target_error`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct Reach {
+    /// Basis.
+    pub basis: &'static str,
+    /// Wall time at which the error reaches the target: interpolated in log-log
+    /// between the last level above it and the first at or below it; `None` when
+    /// no stable level reaches it.
+    pub seconds: Option<f64>,
+    /// How `seconds` was found: `interpolated`, `at most` (the first level is
+    /// already below the target) or `not reached`.
+    pub how: &'static str,
+}
+
+/// Per basis, when its error reaches `target` (levels in order, stable ones only).
+pub fn reaches(rows: &[Level], target: f64) -> Vec<Reach> {
+    let mut bases: Vec<&'static str> = rows.iter().map(|r| r.basis).collect();
+    bases.dedup();
+    bases
+        .into_iter()
+        .map(|basis| {
+            let points: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.basis == basis && r.stable && r.seconds > 0.0)
+                .filter_map(|r| r.error.filter(|e| *e > 0.0).map(|e| (r.seconds, e)))
+                .collect();
+            let first = points.iter().position(|&(_, e)| e <= target);
+            let (seconds, how) = match first {
+                None => (None, "not reached"),
+                Some(0) => (Some(points[0].0), "at most"),
+                Some(i) => {
+                    let ((t0, e0), (t1, e1)) = (points[i - 1], points[i]);
+                    let slope = (t1.ln() - t0.ln()) / (e1.ln() - e0.ln());
+                    (
+                        Some((t0.ln() + (target.ln() - e0.ln()) * slope).exp()),
+                        "interpolated",
+                    )
+                }
+            };
+            Reach {
+                basis,
+                seconds,
+                how,
+            }
+        })
+        .collect()
+}
+
+/// A target error and when each basis reaches it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Target {
+    /// The error to reach.
+    pub error: f64,
+    /// Per basis.
+    pub reaches: Vec<Reach>,
+}
+
+/// Everything a study prints and writes.
+struct Study<'a> {
+    rows: &'a [Level],
+    against: Against,
+    diagnoses: &'a [Diagnosis],
+    notes: &'a [String],
+    target: Option<&'a Target>,
+}
+
+/// The lines saying when each basis reaches `target` and how much faster the
+/// fastest one does.
+fn reach_lines(target: f64, reaches: &[Reach]) -> String {
+    let mut out = String::new();
+    for r in reaches {
+        out += &match (r.seconds, r.how) {
+            (Some(t), "at most") => format!(
+                "{} reaches error {target:.1e} at its first level: in at most {t:.3} s\n",
+                r.basis
+            ),
+            (Some(t), _) => format!("{} reaches error {target:.1e} in {t:.3} s\n", r.basis),
+            _ => format!(
+                "{} does not reach error {target:.1e} on these levels\n",
+                r.basis
+            ),
+        };
+    }
+    let mut timed: Vec<(&str, f64)> = reaches
+        .iter()
+        .filter_map(|r| r.seconds.map(|t| (r.basis, t)))
+        .collect();
+    timed.sort_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some(&(fastest, t)) = timed.first() {
+        for &(other, u) in &timed[1..] {
+            out += &format!("{fastest} reaches it {:.1}× faster than {other}\n", u / t);
+        }
+    }
+    out
 }
 
 /// What the errors of a study are measured against.
@@ -171,6 +278,14 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
             args.levels
         )));
     }
+    crate::run::check_threads(args.threads)?;
+    if let Some(e) = args.target_error {
+        if !(e.is_finite() && e > 0.0) {
+            return Err(CliError::Input(format!(
+                "--target-error must be a positive error, got {e}"
+            )));
+        }
+    }
     let base = read_scene(&args.scene)?;
     let against = if base.reference.is_some() {
         Against::Exact
@@ -209,6 +324,17 @@ pub fn prepare(args: &ConvergeArgs) -> Result<Vec<Scene>, CliError> {
 /// Runs the study and prints it.
 pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     let (base, against, scenes) = levels(&args)?;
+    let pool = crate::run::thread_pool(args.threads)?;
+    pool.install(|| study(&args, base, against, scenes))
+}
+
+/// The runs of [`converge`], on the current pool.
+fn study(
+    args: &ConvergeArgs,
+    base: Scene,
+    against: Against,
+    scenes: Vec<Vec<Scene>>,
+) -> Result<(), CliError> {
     let mut rows: Vec<Level> = Vec::new();
     let mut diagnoses: Vec<Diagnosis> = Vec::new();
     let mut notes: Vec<String> = Vec::new();
@@ -311,9 +437,20 @@ pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
         }
     }
     progress.finish();
-    print_levels(&rows, against, &diagnoses, &notes, args.format);
+    let target = args.target_error.map(|e| Target {
+        error: e,
+        reaches: reaches(&rows, e),
+    });
+    let study = Study {
+        rows: &rows,
+        against,
+        diagnoses: &diagnoses,
+        notes: &notes,
+        target: target.as_ref(),
+    };
+    print_levels(&study, args.format);
     if let Some(dir) = &args.out {
-        write_outputs(dir, &base.name, &rows, against, &diagnoses, &notes)?;
+        write_outputs(dir, &base.name, &study)?;
     }
     let failed = rows.iter().filter(|r| !r.stable).count();
     crate::error::study_verdict(args.strict, failed, rows.len())
@@ -386,17 +523,19 @@ fn verdict(scene: &Scene, half_dt: Option<f64>, double_particles: Option<f64>) -
 
 /// The study as JSON: what the errors are measured against, the levels, the
 /// diagnoses of falling orders and the notes.
-fn json(rows: &[Level], against: Against, diagnoses: &[Diagnosis], notes: &[String]) -> Value {
+fn json(study: &Study) -> Value {
     json!({
-        "against": against,
-        "levels": rows,
-        "diagnoses": diagnoses,
-        "notes": notes,
+        "against": study.against,
+        "levels": study.rows,
+        "diagnoses": study.diagnoses,
+        "notes": study.notes,
+        "target": study.target,
     })
 }
 
 /// The lines printed under the table: what the error is, and why orders fell.
-fn explanation(against: Against, diagnoses: &[Diagnosis], notes: &[String]) -> String {
+fn explanation(study: &Study) -> String {
+    let (against, diagnoses, notes) = (study.against, study.diagnoses, study.notes);
     let mut out = String::new();
     if against == Against::FinestLevel {
         out += "error: E_u against the finest level of the same basis (the scene has no \
@@ -418,21 +557,19 @@ fn explanation(against: Against, diagnoses: &[Diagnosis], notes: &[String]) -> S
             d.verdict
         );
     }
+    if let Some(t) = study.target {
+        out += &reach_lines(t.error, &t.reaches);
+    }
     out
 }
 
-fn print_levels(
-    rows: &[Level],
-    against: Against,
-    diagnoses: &[Diagnosis],
-    notes: &[String],
-    format: Format,
-) {
+fn print_levels(study: &Study, format: Format) {
+    let rows = study.rows;
     match format {
-        Format::Json => println!("{}", json(rows, against, diagnoses, notes)),
+        Format::Json => println!("{}", json(study)),
         Format::Csv => {
             print!("{}", csv(rows));
-            for line in explanation(against, diagnoses, notes).lines() {
+            for line in explanation(study).lines() {
                 eprintln!("# {line}");
             }
         }
@@ -452,7 +589,7 @@ fn print_levels(
                 ]);
             }
             print!("{}", table.render());
-            print!("{}", explanation(against, diagnoses, notes));
+            print!("{}", explanation(study));
         }
     }
 }
@@ -479,14 +616,8 @@ fn csv(rows: &[Level]) -> String {
 }
 
 /// `converge.csv`, `converge.json`, `error-vs-h.svg`, `work-precision.svg`.
-fn write_outputs(
-    dir: &std::path::Path,
-    scene: &str,
-    rows: &[Level],
-    against: Against,
-    diagnoses: &[Diagnosis],
-    notes: &[String],
-) -> Result<(), CliError> {
+fn write_outputs(dir: &std::path::Path, scene: &str, study: &Study) -> Result<(), CliError> {
+    let (rows, against) = (study.rows, study.against);
     let io = |path: &std::path::Path, e: std::io::Error| {
         CliError::Input(format!("{}: cannot write: {e}", path.display()))
     };
@@ -494,8 +625,7 @@ fn write_outputs(
     let path = dir.join("converge.csv");
     std::fs::write(&path, csv(rows)).map_err(|e| io(&path, e))?;
     let path = dir.join("converge.json");
-    let json =
-        serde_json::to_string_pretty(&json(rows, against, diagnoses, notes)).unwrap_or_default();
+    let json = serde_json::to_string_pretty(&json(study)).unwrap_or_default();
     std::fs::write(&path, json).map_err(|e| io(&path, e))?;
     let mut bases: Vec<&str> = rows.iter().map(|r| r.basis).collect();
     bases.dedup();
@@ -551,4 +681,49 @@ fn write_outputs(
         line_plot(&path, &plot).map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn level(basis: &'static str, seconds: f64, error: f64, stable: bool) -> Level {
+        Level {
+            basis,
+            level: 0,
+            h: 1.0,
+            functions: 1,
+            particles: 1,
+            error: Some(error),
+            order: None,
+            seconds,
+            stable,
+        }
+    }
+
+    #[test]
+    fn the_time_to_an_error_is_interpolated_in_log_log() {
+        let rows = [
+            level("ps", 1.0, 1e-4, true),
+            level("ps", 10.0, 1e-6, true),
+            level("pl", 2.0, 1e-6, true),
+            level("bspline", 1.0, 1e-3, true),
+            level("bspline", 5.0, 1e-7, false),
+        ];
+        let r = reaches(&rows, 1e-5);
+        assert_eq!(r.len(), 3);
+        // Halfway in log error is halfway in log time: √10 s.
+        assert_eq!(r[0].how, "interpolated");
+        assert!((r[0].seconds.unwrap() - 10f64.sqrt()).abs() < 1e-12);
+        // Already below at its first level: at most its time.
+        assert_eq!((r[1].seconds, r[1].how), (Some(2.0), "at most"));
+        // An unstable level does not count.
+        assert_eq!((r[2].seconds, r[2].how), (None, "not reached"));
+        let lines = reach_lines(1e-5, &r);
+        assert!(
+            lines.contains("pl reaches it 1.6× faster than ps"),
+            "{lines}"
+        );
+        assert!(lines.contains("bspline does not reach"), "{lines}");
+    }
 }

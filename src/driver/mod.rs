@@ -558,10 +558,8 @@ where
             Which::Acceleration => &mut self.rhs,
             Which::Velocity => &mut self.velocity,
         };
-        for k in 0..D {
-            if let Err(source) = self.mass.solve(k, &mut target[k]) {
-                return Err(self.mass_failure(source));
-            }
+        if let Err(source) = self.mass.solve_all(target) {
+            return Err(self.mass_failure(source));
         }
         let target = match which {
             Which::Acceleration => &mut self.rhs,

@@ -35,6 +35,9 @@ impl<T: Scalar> MassStrategy<T> for Consistent<T> {
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         self.solver.solve(k, rhs)
     }
+    fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
+        self.solver.solve_all(rhs)
+    }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }

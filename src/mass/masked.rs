@@ -151,6 +151,36 @@ impl<T: Scalar> MaskedCholesky<T> {
         Ok(())
     }
 
+    /// [`solve`](Self::solve) for every component; two components with different
+    /// fixed sets (two factorisations) are solved side by side on the pool.
+    pub fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
+        for (k, r) in rhs.iter_mut().enumerate() {
+            let s = self.solver_of[k];
+            for (i, r) in r.iter_mut().enumerate() {
+                if self.fixed[s][i] || self.inactive[i] {
+                    *r = T::zero();
+                }
+            }
+        }
+        match (rhs, self.solver_of.as_slice()) {
+            ([r0, r1], &[a, b]) if a != b => {
+                let (low, high) = self.solvers.split_at_mut(a.max(b));
+                let (s0, s1) = if a < b {
+                    (&mut low[a], &mut high[0])
+                } else {
+                    (&mut high[0], &mut low[b])
+                };
+                rayon::join(|| s0.solve_in_place(r0, 1), || s1.solve_in_place(r1, 1));
+            }
+            (rhs, _) => {
+                for (k, r) in rhs.iter_mut().enumerate() {
+                    self.solvers[self.solver_of[k]].solve_in_place(r, 1);
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// `λ_max` of `M'` by power iteration, `λ_min` by inverse iteration with the
     /// factorisation; the largest ratio over the fixed sets.
     pub fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {

@@ -407,6 +407,15 @@ pub trait MassStrategy<T: Scalar>: Send {
     /// Solves component `k` in place: `rhs` becomes the coefficients, zero at fixed
     /// and inactive functions.
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError>;
+    /// Solves every component, `rhs[k]` with [`solve`](Self::solve)`(k, ·)`;
+    /// strategies with a factorisation per fixed set solve them side by side on
+    /// the pool (the same result for any thread count).
+    fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
+        for (k, r) in rhs.iter_mut().enumerate() {
+            self.solve(k, r)?;
+        }
+        Ok(())
+    }
     /// An estimate of the spectral condition number of the systems last factorised
     /// (the largest over components). Costs about `2 ×` [`CONDITION_ITERATIONS`]
     /// solves; call on request.
@@ -457,6 +466,9 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         (**self).solve(k, rhs)
+    }
+    fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
+        (**self).solve_all(rhs)
     }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         (**self).condition_estimate(pattern)

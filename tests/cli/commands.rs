@@ -292,9 +292,26 @@ fn the_b4_ladder_keeps_its_particles_per_element() {
         "/../scenes/studies/b4-ladder.toml"
     );
     let json = stdout(&[
-        "converge", scene, "--levels", "2", "--basis", "ps", "--t-end", "5e-5", "--format", "json",
+        "converge",
+        scene,
+        "--levels",
+        "2",
+        "--basis",
+        "ps",
+        "--t-end",
+        "5e-5",
+        "--threads",
+        "1",
+        "--target-error",
+        "1",
+        "--format",
+        "json",
     ]);
     let study: Value = serde_json::from_str(&json).unwrap();
+    // Every level is below an error of 1 after two steps: reached at the first.
+    assert_eq!(study["target"]["error"], 1.0);
+    assert_eq!(study["target"]["reaches"][0]["basis"], "ps");
+    assert_eq!(study["target"]["reaches"][0]["how"], "at most");
     let rows = study["levels"].as_array().unwrap();
     assert_eq!(rows.len(), 2);
     let get = |r: &Value, k: &str| r[k].as_f64().unwrap();

@@ -382,6 +382,8 @@ fn command_line_cases() -> Vec<Case> {
         args_case("t-end-before-one-step", None, &["run", "vibrating-bar", "--t-end", "1e-9"], "is shorter than one time step"),
         args_case("compare-dt-over-the-limit", None, &["compare", "vibrating-bar", "--dt", "1e-12"], "--dt 1e-12"),
         args_case("converge-dt-over-the-limit", None, &["converge", "vibrating-bar", "--dt", "1e-12"], "above the limit of 10000000"),
+        args_case("converge-target-error-not-positive", None, &["converge", "vibrating-bar", "--target-error", "0"], "--target-error must be a positive error, got 0"),
+        args_case("converge-threads-zero", None, &["converge", "vibrating-bar", "--threads", "0"], "--threads"),
         args_case("frames-over-the-limit", long_bar.clone(), &["run", "@", "--out", "OUT", "--out-every", "1"], "--out-every 1: 200000 steps give 200002 particle frames, above the limit of 100000"),
         args_case("table-rows-over-the-limit", long_bar.clone(), &["run", "@", "--diag-every", "1"], "--diag-every 1: 200000 steps give 200000 table rows, above the limit of 100000"),
         args_case("long-layout", None, &["run", "vibrating-bar", "--layout", &long], &format!("unknown layout `{}…`", "m".repeat(80))),

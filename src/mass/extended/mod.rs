@@ -446,6 +446,15 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         }
         Ok(report)
     }
+    fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
+        if self.direct {
+            return self.cholesky.solve_all(rhs);
+        }
+        for (k, r) in rhs.iter_mut().enumerate() {
+            self.solve(k, r)?;
+        }
+        Ok(())
+    }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         if self.direct {
             return self.cholesky.solve(k, rhs);
