@@ -42,6 +42,12 @@ impl Bins {
 
     /// Sorts the particles by their `element`.
     pub fn fill(&mut self, element: &[usize]) {
+        self.fill_with_slots(element, &mut []);
+    }
+
+    /// [`fill`](Self::fill), and `slot[p]` = the position of particle `p` in the
+    /// order (when `slot` is not empty).
+    pub fn fill_with_slots(&mut self, element: &[usize], slot: &mut [usize]) {
         self.start.iter_mut().for_each(|s| *s = 0);
         for &e in element {
             self.start[e + 1] += 1;
@@ -51,8 +57,13 @@ impl Bins {
             self.start[e + 1] += self.start[e];
         }
         self.cursor.copy_from_slice(&self.start[..ne]);
+        let with_slots = !slot.is_empty();
         for (p, &e) in element.iter().enumerate() {
-            self.order[self.cursor[e]] = p;
+            let s = self.cursor[e];
+            self.order[s] = p;
+            if with_slots {
+                slot[p] = s;
+            }
             self.cursor[e] += 1;
         }
     }

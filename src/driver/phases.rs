@@ -115,10 +115,7 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
     if let Some(particle) = failure {
         return Err(Outside { particle });
     }
-    bins.fill(element);
-    for (s, &p) in bins.order.iter().enumerate() {
-        out.slot[p] = s;
-    }
+    bins.fill_with_slots(element, &mut out.slot);
     let stride = out.stride;
     let (order, element) = (&bins.order, &*element);
     (
