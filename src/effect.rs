@@ -27,25 +27,32 @@ use nalgebra::{SMatrix, SVector};
 /// driver stores them in element order; see `driver::phases::Evaluations`).
 pub struct ParticleBasis<'a, T: Scalar, const D: usize> {
     /// Entries per slot.
-    pub stride: usize,
+    pub(crate) stride: usize,
     /// Valid entries per slot.
-    pub len: &'a [usize],
+    pub(crate) len: &'a [usize],
     /// The slot of each particle.
-    pub slot: &'a [usize],
+    pub(crate) slot: &'a [usize],
     /// Function indices.
-    pub index: &'a [usize],
+    pub(crate) index: &'a [usize],
     /// Values `phi_i(x_p)`.
-    pub phi: &'a [T],
+    pub(crate) phi: &'a [T],
 }
 
 impl<T: Scalar, const D: usize> ParticleBasis<'_, T, D> {
+    /// The functions non-zero at particle `p` and their values `phi_i(x_p)`.
+    #[inline]
+    pub fn functions(&self, p: usize) -> (&[usize], &[T]) {
+        let s = self.slot[p];
+        let base = s * self.stride;
+        let range = base..base + self.len[s];
+        (&self.index[range.clone()], &self.phi[range])
+    }
+
     /// Adds `phi_i(x_p) f` to `forces[k][i]` for the functions of particle `p`.
     #[inline]
     pub fn scatter(&self, p: usize, f: &SVector<T, D>, forces: &mut [Vec<T>]) {
-        let s = self.slot[p];
-        let base = s * self.stride;
-        for a in 0..self.len[s] {
-            let (i, phi) = (self.index[base + a], self.phi[base + a]);
+        let (index, phi) = self.functions(p);
+        for (&i, &phi) in index.iter().zip(phi) {
             for k in 0..D {
                 forces[k][i] += f[k] * phi;
             }
