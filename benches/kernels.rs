@@ -21,7 +21,7 @@
 //! `benches/step.rs` and `mpm-cli throughput`; `docs/performance.md` has the
 //! figures.
 
-use nalgebra::{Matrix2, Vector1, Vector2};
+use nalgebra::{Matrix2, SVector, Vector1, Vector2};
 use psmpm::basis::basis::bspline1d::QuadraticBSpline;
 use psmpm::basis::basis::linear::Linear;
 use psmpm::basis::basis::linear1d::Linear1d;
@@ -115,9 +115,13 @@ mod locate {
 mod eval {
     use super::*;
 
-    fn bench_2d<B: Basis<f64, 2>>(bencher: divan::Bencher, basis: B) {
-        let x = positions(0.1);
-        let e = elements(&basis, &x);
+    /// Evaluates `basis` at every point `x` in its element `e`.
+    fn bench_points<const D: usize, B: Basis<f64, D>>(
+        bencher: divan::Bencher,
+        basis: B,
+        x: Vec<SVector<f64, D>>,
+    ) {
+        let e: Vec<usize> = x.iter().map(|x| basis.locate(x, None).unwrap()).collect();
         let mut out = BasisEval::for_basis(&basis);
         bencher.bench_local(|| {
             let mut sum = 0.0;
@@ -129,21 +133,16 @@ mod eval {
         });
     }
 
+    fn bench_2d<B: Basis<f64, 2>>(bencher: divan::Bencher, basis: B) {
+        bench_points(bencher, basis, positions(0.1));
+    }
+
     fn bench_1d<B: Basis<f64, 1>>(bencher: divan::Bencher, basis: B) {
         let n = BLOCKS.0 * BLOCKS.1 * PER_BLOCK * PER_BLOCK;
-        let x: Vec<Vector1<f64>> = (0..n)
+        let x = (0..n)
             .map(|p| Vector1::new((p as f64 + 0.5) / n as f64))
             .collect();
-        let e: Vec<usize> = x.iter().map(|x| basis.locate(x, None).unwrap()).collect();
-        let mut out = BasisEval::for_basis(&basis);
-        bencher.bench_local(|| {
-            let mut sum = 0.0;
-            for (x, &e) in x.iter().zip(&e) {
-                basis.eval(e, x, &mut out);
-                sum += out.phi[0];
-            }
-            sum
-        });
+        bench_points(bencher, basis, x);
     }
 
     #[divan::bench(sample_count = 20)]
