@@ -33,26 +33,28 @@ pub struct ParticleBasis<'a, T: Scalar, const D: usize> {
     /// The slot of each particle.
     pub(crate) slot: &'a [usize],
     /// Function indices.
-    pub(crate) index: &'a [usize],
+    pub(crate) index: &'a [u32],
     /// Values `phi_i(x_p)`.
     pub(crate) phi: &'a [T],
 }
 
 impl<T: Scalar, const D: usize> ParticleBasis<'_, T, D> {
-    /// The functions non-zero at particle `p` and their values `phi_i(x_p)`.
+    /// The functions `i` non-zero at particle `p` with their values `phi_i(x_p)`.
     #[inline]
-    pub fn functions(&self, p: usize) -> (&[usize], &[T]) {
+    pub fn functions(&self, p: usize) -> impl Iterator<Item = (usize, T)> + '_ {
         let s = self.slot[p];
         let base = s * self.stride;
         let range = base..base + self.len[s];
-        (&self.index[range.clone()], &self.phi[range])
+        self.index[range.clone()]
+            .iter()
+            .zip(&self.phi[range])
+            .map(|(&i, &phi)| (i as usize, phi))
     }
 
     /// Adds `phi_i(x_p) f` to `forces[k][i]` for the functions of particle `p`.
     #[inline]
     pub fn scatter(&self, p: usize, f: &SVector<T, D>, forces: &mut [Vec<T>]) {
-        let (index, phi) = self.functions(p);
-        for (&i, &phi) in index.iter().zip(phi) {
+        for (i, phi) in self.functions(p) {
             for k in 0..D {
                 forces[k][i] += f[k] * phi;
             }

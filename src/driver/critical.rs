@@ -45,7 +45,7 @@ where
         for p in 0..self.particles.len() {
             let m = self.particles.mass[p].to_f64();
             for s in self.evals.range(p) {
-                lumped[self.evals.index[s]] += m * self.evals.phi[s].to_f64();
+                lumped[self.evals.function(s)] += m * self.evals.phi[s].to_f64();
             }
         }
         self.power_iteration(Some(&lumped))
@@ -140,7 +140,7 @@ fn stiffness_product<T: Scalar, const D: usize>(
         let (lambda, mu) = lame(p);
         let mut grad = SMatrix::<T, D, D>::zeros();
         for s in evals.range(p) {
-            let i = evals.index[s];
+            let i = evals.function(s);
             for k in 0..D {
                 for l in 0..D {
                     grad[(k, l)] += v[k][i] * evals.grad_phi[s][l];
@@ -153,7 +153,7 @@ fn stiffness_product<T: Scalar, const D: usize>(
         for s in evals.range(p) {
             let g = sigma * evals.grad_phi[s] * volume[p];
             for k in 0..D {
-                f[k][evals.index[s]] += g[k];
+                f[k][evals.function(s)] += g[k];
             }
         }
     }
@@ -209,7 +209,7 @@ mod tests {
                 for r in e.range(p) {
                     let v = mass * e.phi[s] * e.phi[r];
                     for k in 0..2 {
-                        m[(k * n + e.index[s], k * n + e.index[r])] += v;
+                        m[(k * n + e.function(s), k * n + e.function(r))] += v;
                     }
                 }
             }

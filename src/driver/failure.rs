@@ -133,7 +133,7 @@ where
         let worst = self
             .evals
             .range(particle)
-            .map(|s| self.evals.index[s])
+            .map(|s| self.evals.function(s))
             .map(|i| (i, coverage[i].unwrap_or(0.0)))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((i, c)) =
@@ -267,6 +267,8 @@ pub enum SetupError {
     Boundary { tag: String, message: String },
     #[error("particle {particle} at {} lies outside the mesh", point(position))]
     ParticleOutside { particle: usize, position: Vec<f64> },
+    #[error("the basis has {functions} functions; the driver stores function indices in 32 bits (at most {})", u32::MAX)]
+    TooManyFunctions { functions: usize },
 }
 
 /// A position for a message: `[0.00312378, 0.947718]`, six significant digits per

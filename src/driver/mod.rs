@@ -159,6 +159,9 @@ where
         dt: f64,
     ) -> Result<Self, SetupError> {
         let n = basis.num_functions();
+        if u32::try_from(n).is_err() {
+            return Err(SetupError::TooManyFunctions { functions: n });
+        }
         let mut fixed = vec![vec![false; n]; D];
         let mut general: Vec<Vec<(usize, usize, T)>> = Vec::new();
         for fix in fixes {

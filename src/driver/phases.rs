@@ -49,8 +49,9 @@ pub struct Evaluations<T: Scalar, const D: usize> {
     pub len: Vec<usize>,
     /// `slot[p]`: the slot of particle `p`.
     pub slot: Vec<usize>,
-    /// Function indices `i`.
-    pub index: Vec<usize>,
+    /// Function indices `i` (`u32`: a basis has fewer than 2³² functions, see
+    /// [`Self::new`]; half the bytes of `usize` in the step's busiest arrays).
+    pub index: Vec<u32>,
     /// Values `phi_i(x_p)`.
     pub phi: Vec<T>,
     /// Gradients `grad phi_i(x_p)`.
@@ -59,7 +60,8 @@ pub struct Evaluations<T: Scalar, const D: usize> {
 
 impl<T: Scalar, const D: usize> Evaluations<T, D> {
     /// Buffers for `particles` particles with up to `stride` functions each
-    /// (particle `p` in slot `p` until phase 1 orders them).
+    /// (particle `p` in slot `p` until phase 1 orders them). Function indices are
+    /// stored as `u32`; the driver refuses a basis with 2³² functions or more.
     pub fn new(particles: usize, stride: usize) -> Self {
         Evaluations {
             stride,
@@ -69,6 +71,12 @@ impl<T: Scalar, const D: usize> Evaluations<T, D> {
             phi: vec![T::zero(); particles * stride],
             grad_phi: vec![SVector::zeros(); particles * stride],
         }
+    }
+
+    /// The function index of entry `s`.
+    #[inline]
+    pub fn function(&self, s: usize) -> usize {
+        self.index[s] as usize
     }
 
     /// The entry range of particle `p`.
@@ -133,7 +141,9 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
                 let base = q * stride;
                 let m = scratch.len();
                 len[q] = m;
-                index[base..base + m].copy_from_slice(&scratch.index[..m]);
+                for (to, &from) in index[base..base + m].iter_mut().zip(&scratch.index[..m]) {
+                    *to = from as u32;
+                }
                 phi[base..base + m].copy_from_slice(&scratch.phi[..m]);
                 grad_phi[base..base + m].copy_from_slice(&scratch.grad_phi[..m]);
             }
@@ -244,7 +254,11 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     values: &mut [T],
 ) {
     let stride = local.stride;
-    let touches_lumped = |p: usize| evals.index[evals.range(p)].iter().any(|&i| lumped[i]);
+    let touches_lumped = |p: usize| {
+        evals.index[evals.range(p)]
+            .iter()
+            .any(|&i| lumped[i as usize])
+    };
     local.par_elements().for_each(|(e, (lm, g))| {
         let inside = bins.particles(e);
         if !inside.iter().any(|&p| touches_lumped(p)) {
@@ -261,7 +275,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
             for a in 0..m {
                 for b in a + 1..m {
-                    let (i, j) = (index[a], index[b]);
+                    let (i, j) = (index[a] as usize, index[b] as usize);
                     let w = mass[p] * phi[a] * phi[b];
                     if !(lumped[i] || lumped[j]) || w == T::zero() {
                         continue;
@@ -424,7 +438,7 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     let increment = |p: usize| {
         let mut a = SVector::<T, D>::zeros();
         for s in evals.range(p) {
-            let i = evals.index[s];
+            let i = evals.function(s);
             for k in 0..D {
                 a[k] += acceleration[k][i] * evals.phi[s];
             }
@@ -462,7 +476,7 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
                 *v += increment(p);
                 *g = SMatrix::zeros();
                 for s in evals.range(p) {
-                    let i = evals.index[s];
+                    let i = evals.function(s);
                     for k in 0..D {
                         let c = old[k][i] + dt * acceleration[k][i];
                         for l in 0..D {
@@ -480,10 +494,10 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     scatter_by_elements(bins, evals, gather, local, momentum, |p, s| {
         let w = mass[p] * evals.phi[s];
         let mut out = v[p] * w;
-        let i = evals.index[s];
+        let i = evals.function(s);
         let mut lever = SVector::<T, D>::zeros();
         for t in evals.range(p) {
-            let j = evals.index[t];
+            let j = evals.function(t);
             if j != i && (decoupled[i] || decoupled[j]) {
                 lever += (points[i] - points[j]) * evals.phi[t];
             }
@@ -567,7 +581,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
                     let mut grad_v = SMatrix::<T, D, D>::zeros();
                     let mut v_hat = SVector::<T, D>::zeros();
                     for s in evals.range(p) {
-                        let i = evals.index[s];
+                        let i = evals.function(s);
                         for k in 0..D {
                             let c = velocity[k][i];
                             v_hat[k] += c * evals.phi[s];
@@ -685,7 +699,7 @@ pub fn particle_volume<T: Scalar, const D: usize>(
     out.iter_mut().for_each(|v| *v = 0.0);
     for p in 0..volume.len() {
         for s in evals.range(p) {
-            out[evals.index[s]] += (volume[p] * evals.phi[s]).to_f64();
+            out[evals.function(s)] += (volume[p] * evals.phi[s]).to_f64();
         }
     }
 }

@@ -84,7 +84,7 @@ where
         .map(|p| {
             let mut v = nalgebra::Vector2::zeros();
             for s in driver.evals.range(p) {
-                let i = driver.evals.index[s];
+                let i = driver.evals.function(s);
                 for k in 0..2 {
                     v[k] += driver.velocity[k][i] * driver.evals.phi[s];
                 }

@@ -221,6 +221,9 @@ fn driver<const D: usize, B: Basis<f64, D>>(
             format!("boundary condition on `{tag}`: {message}"),
         ),
         SetupError::Basis(e) => SceneError::new("basis", ErrorKind::Conflict, e.to_string()),
+        e @ SetupError::TooManyFunctions { .. } => {
+            SceneError::new("mesh", ErrorKind::Value, e.to_string())
+        }
     })?;
     driver.estimate_condition = scene.output.condition;
     for (tag, normal) in walls {
