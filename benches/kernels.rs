@@ -198,42 +198,71 @@ mod eval {
 mod assemble {
     use super::*;
 
+    /// What phase 2a needs, after phase 1 on `parts`: pattern, evaluations, bins,
+    /// gather, local buffers, and the value and force buffers.
+    pub(super) struct Assembly {
+        pub pattern: SymmetricPattern,
+        evals: Evaluations<f64, 2>,
+        bins: Bins,
+        gather: Gather,
+        local: Local<f64, 2>,
+        pub values: Vec<f64>,
+        force: Vec<Vec<f64>>,
+    }
+
+    impl Assembly {
+        pub fn new<B: Basis<f64, 2>>(basis: &B, parts: &Particles<f64, 2>) -> Self {
+            let pattern = SymmetricPattern::new(basis);
+            let stride = basis.max_functions_per_element();
+            let mut element = elements(basis, &parts.x);
+            let mut evals = Evaluations::new(parts.len(), stride);
+            let mut scratch: Vec<BasisEval<f64, 2>> =
+                (0..psmpm::driver::phases::chunks(parts.len()))
+                    .map(|_| BasisEval::for_basis(basis))
+                    .collect();
+            let mut bins = Bins::new(basis.num_elements(), parts.len());
+            locate_and_evaluate(
+                basis,
+                &parts.x,
+                &mut element,
+                &mut bins,
+                &mut scratch,
+                &mut evals,
+            )
+            .ok()
+            .unwrap();
+            Assembly {
+                gather: Gather::new(basis, &pattern, stride),
+                local: Local::new(basis.num_elements(), stride),
+                values: vec![0.0; pattern.nnz()],
+                force: vec![vec![0.0; basis.num_functions()]; 2],
+                pattern,
+                evals,
+                bins,
+            }
+        }
+
+        /// Phase 2a into `values` and the force.
+        pub fn run(&mut self, parts: &Particles<f64, 2>, matrix: MassMatrix) {
+            assemble_mass_and_internal_force(
+                parts,
+                &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
+                matrix,
+                &mut self.values,
+                &mut self.force,
+            );
+        }
+    }
+
     fn bench<B: Basis<f64, 2>>(bencher: divan::Bencher, basis: B, matrix: MassMatrix) {
         let parts = particles();
-        let pattern = SymmetricPattern::new(&basis);
-        let stride = basis.max_functions_per_element();
-        let mut element = elements(&basis, &parts.x);
-        let mut evals = Evaluations::new(parts.len(), stride);
-        let mut scratch: Vec<BasisEval<f64, 2>> = (0..psmpm::driver::phases::chunks(parts.len()))
-            .map(|_| BasisEval::for_basis(&basis))
-            .collect();
-        let mut bins = Bins::new(basis.num_elements(), parts.len());
-        locate_and_evaluate(
-            &basis,
-            &parts.x,
-            &mut element,
-            &mut bins,
-            &mut scratch,
-            &mut evals,
-        )
-        .ok()
-        .unwrap();
-        let gather = Gather::new(&basis, &pattern, stride);
-        let mut local = Local::<f64, 2>::new(basis.num_elements(), stride);
-        let mut values = vec![0.0; pattern.nnz()];
-        let mut force = vec![vec![0.0; basis.num_functions()]; 2];
+        let mut assembly = Assembly::new(&basis, &parts);
         bencher.bench_local(|| {
-            assemble_mass_and_internal_force(
-                &parts,
-                &evals,
-                &bins,
-                &gather,
-                &mut local,
-                matrix,
-                &mut values,
-                &mut force,
-            );
-            values[0]
+            assembly.run(&parts, matrix);
+            assembly.values[0]
         });
     }
 
@@ -271,21 +300,9 @@ mod cholesky {
         let basis = super::ps();
         let mut parts = particles();
         parts.x = positions(shift);
-        let pattern = SymmetricPattern::new(&basis);
-        let mut values = vec![0.0; pattern.nnz()];
-        let mut out = BasisEval::for_basis(&basis);
-        for (p, x) in parts.x.iter().enumerate() {
-            let e = basis.locate(x, None).unwrap();
-            basis.eval(e, x, &mut out);
-            let scatter = pattern.element_scatter(e);
-            let m = out.len();
-            for a in 0..m {
-                for b in a..m {
-                    values[scatter[a * m + b]] += parts.mass[p] * out.phi[a] * out.phi[b];
-                }
-            }
-        }
-        (pattern, values)
+        let mut assembly = assemble::Assembly::new(&basis, &parts);
+        assembly.run(&parts, MassMatrix::Full);
+        (assembly.pattern, assembly.values)
     }
 
     #[divan::bench(sample_count = 20)]
@@ -325,9 +342,9 @@ mod conjugate_gradients {
         lumped: &[f64],
         b: &[f64],
         x: &mut [f64],
-        work: &mut [Vec<f64>; 3],
+        work: &mut [Vec<f64>; 4],
     ) -> usize {
-        let [r, z, q] = work;
+        let [r, z, q, p] = work;
         let n = b.len();
         pattern.mul_vec(values, x, q);
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
@@ -336,14 +353,14 @@ mod conjugate_gradients {
             r[i] = b[i] - q[i];
             z[i] = r[i] / lumped[i];
         }
-        let mut p = z.clone();
+        p.copy_from_slice(z);
         let mut rz = dot(r, z);
         for iteration in 0..10_000 {
             if dot(r, r).sqrt() <= 1e-12 * b_norm {
                 return iteration;
             }
-            pattern.mul_vec(values, &p, q);
-            let alpha = rz / dot(&p, q);
+            pattern.mul_vec(values, p, q);
+            let alpha = rz / dot(p, q);
             for i in 0..n {
                 x[i] += alpha * p[i];
                 r[i] -= alpha * q[i];
@@ -371,7 +388,7 @@ mod conjugate_gradients {
         solver.solve_in_place(&mut start, 1);
         let mut lumped = vec![0.0; n];
         pattern.row_sums(&after, &mut lumped);
-        let mut work = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let mut work = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         let mut x = start.clone();
         let iterations = pcg(&pattern, &after, &lumped, &b, &mut x, &mut work);
         eprintln!(

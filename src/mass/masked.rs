@@ -141,26 +141,26 @@ impl<T: Scalar> MaskedCholesky<T> {
     }
 
     pub fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
-        let s = self.solver_of[k];
+        self.mask(k, rhs);
+        self.solvers[self.solver_of[k]].solve_in_place(rhs, 1);
+        Ok(())
+    }
+
+    /// Zeroes the entries of component `k` held at zero (fixed or inactive).
+    fn mask(&self, k: usize, rhs: &mut [T]) {
+        let fixed = &self.fixed[self.solver_of[k]];
         for (i, r) in rhs.iter_mut().enumerate() {
-            if self.fixed[s][i] || self.inactive[i] {
+            if fixed[i] || self.inactive[i] {
                 *r = T::zero();
             }
         }
-        self.solvers[s].solve_in_place(rhs, 1);
-        Ok(())
     }
 
     /// [`solve`](Self::solve) for every component; two components with different
     /// fixed sets (two factorisations) are solved side by side on the pool.
     pub fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         for (k, r) in rhs.iter_mut().enumerate() {
-            let s = self.solver_of[k];
-            for (i, r) in r.iter_mut().enumerate() {
-                if self.fixed[s][i] || self.inactive[i] {
-                    *r = T::zero();
-                }
-            }
+            self.mask(k, r);
         }
         match (rhs, self.solver_of.as_slice()) {
             ([r0, r1], &[a, b]) if a != b => {

@@ -411,10 +411,7 @@ pub trait MassStrategy<T: Scalar>: Send {
     /// strategies with a factorisation per fixed set solve them side by side on
     /// the pool (the same result for any thread count).
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
-        for (k, r) in rhs.iter_mut().enumerate() {
-            self.solve(k, r)?;
-        }
-        Ok(())
+        solve_each(self, rhs)
     }
     /// An estimate of the spectral condition number of the systems last factorised
     /// (the largest over components). Costs about `2 ×` [`CONDITION_ITERATIONS`]
@@ -484,6 +481,18 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     ) -> Option<&[bool]> {
         (**self).classify(pattern, values, context)
     }
+}
+
+/// [`MassStrategy::solve`] of every component in turn (the default of
+/// [`MassStrategy::solve_all`]).
+pub(crate) fn solve_each<T: Scalar, S: MassStrategy<T> + ?Sized>(
+    strategy: &mut S,
+    rhs: &mut [Vec<T>],
+) -> Result<(), MassError> {
+    for (k, r) in rhs.iter_mut().enumerate() {
+        strategy.solve(k, r)?;
+    }
+    Ok(())
 }
 
 /// Groups the components by their set of fixed coefficients: returns the

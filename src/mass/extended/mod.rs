@@ -450,10 +450,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         if self.direct {
             return self.cholesky.solve_all(rhs);
         }
-        for (k, r) in rhs.iter_mut().enumerate() {
-            self.solve(k, r)?;
-        }
-        Ok(())
+        super::solve_each(self, rhs)
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         if self.direct {
