@@ -61,6 +61,7 @@ fn quick_matrix_with_lumped_and_partial() {
             "measure",
             "error",
             "roughness",
+            "roughness_rms",
             "max_condition",
             "lumped_rows",
             "deactivated",
@@ -95,6 +96,8 @@ fn quick_matrix_with_lumped_and_partial() {
         }
     }
     assert_eq!(cell("b2-nx5", "partial")["measure"], "E_u");
+    // Roughness is a column measure.
+    assert!(cell("b2-nx5", "partial")["roughness_rms"].is_null());
     assert_eq!(cell("b4-ppe16-h0.25", "lumped")["measure"], "rms-position");
     // Partial lumping has nothing to lump there and equals the consistent mass
     // (docs/results.md: E_u 3.62e-6 and RMS 5.06e-4).
@@ -110,6 +113,10 @@ fn quick_matrix_with_lumped_and_partial() {
         assert_eq!(c["completed"], true, "{c}");
         assert!((c["t_end"].as_f64().unwrap() - 2.5).abs() < 1e-3, "{c}");
         assert!(c["roughness"].as_f64().unwrap() > 0.0, "{c}");
+        // Over the run, the roughness is lower than at the end (it grows as the
+        // undamped column rings) but not zero.
+        let rms = c["roughness_rms"].as_f64().unwrap();
+        assert!(rms > 0.0 && rms < c["roughness"].as_f64().unwrap(), "{c}");
         assert!(c["lumped_rows"].as_u64().unwrap() > 0, "{c}");
     }
     // The frictionless slide: lumped follows ½ g sin θ t² (relative error).
