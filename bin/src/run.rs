@@ -205,7 +205,7 @@ pub struct RunArgs {
 /// `--vtu`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Vtu {
-    /// Raw binary, zlib-compressed (small, fast to read).
+    /// Binary: zlib-compressed, base64-encoded (small, fast to read).
     Binary,
     /// Text, one value per point and component.
     Ascii,
