@@ -221,6 +221,7 @@ impl<T: Scalar> Extended<T> {
             let d = values[pattern.diagonal_position(i)];
             if d <= T::zero() {
                 self.role[i] = Role::Inactive;
+                self.lumped[i] = false;
                 continue;
             }
             report.active += 1;
