@@ -440,7 +440,11 @@ pub fn prepare(args: &RunArgs) -> Result<Scene, CliError> {
 /// [`run`] on the current thread pool.
 fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     let s = prepare(&args)?;
-    let every = diag_every(&s, &args);
+    let mut every = diag_every(&s, &args);
+    // A Courant-number scene knows its steps at the start of the run: the default
+    // of about 20 rows is set then.
+    let every_from_run =
+        args.diag_every.is_none() && s.output.diagnostics_every == 0 && s.time.dt.is_none();
     let mut recorder = match &args.out {
         Some(dir) => {
             let options = out::OutOptions {
@@ -473,6 +477,9 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             recorder.observe(r, particles);
         }
         if r.step == 0 {
+            if every_from_run && r.dt > 0.0 {
+                every = (out::steps_from_dt(t_end, r.dt) / 20).max(1);
+            }
             // The time step against the critical one, before the first step.
             let line = time_step_line(r);
             match format {

@@ -290,3 +290,33 @@ fn too_few_particles_per_element_is_named_as_the_cause_of_a_tiny_critical_step()
     );
     assert!(!stderr.contains("smaller `time.dt`"), "{stderr}");
 }
+
+/// A scene with a Courant number knows its steps only once the critical step is
+/// estimated; without `--diag-every` it still prints about 20 rows, not one per
+/// step (1212 steps here).
+#[test]
+fn a_courant_scene_prints_about_20_rows() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/stability/b5b-blocks-1x4-p12.toml"
+    );
+    let out = cli()
+        .args(["run", scene, "--t-end", "0.5", "--format", "csv"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let steps: usize = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("# steps="))
+        .unwrap_or_else(|| panic!("no steps in {stderr}"))
+        .parse()
+        .unwrap();
+    let rows = String::from_utf8_lossy(&out.stdout).lines().count() - 1;
+    assert!(steps > 1000, "{steps} steps");
+    assert!((19..=21).contains(&rows), "{rows} rows for {steps} steps");
+}
