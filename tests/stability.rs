@@ -154,3 +154,51 @@ fn a_block_sliding_over_small_boundary_elements_stays_stable_with_the_default_ma
     let failed = run(&extended, &mut |_| {}).unwrap();
     assert!(failed.failure.is_some(), "{failed:?}");
 }
+
+/// A cantilever in a mostly empty box, one element thick (`docs/examples/
+/// cantilever.toml`, written from the docs): over its first period the tip of the
+/// PS beam swings down to twice the Euler–Bernoulli static deflection
+/// `q L⁴ / (8 E' I)`, as a sudden load does; the PL beam, linear triangles one
+/// element thick, locks and swings less than half as far.
+#[test]
+fn a_cantilever_one_element_thick_bends_as_a_beam_with_ps_and_locks_with_pl() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/examples/cantilever.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut scene = Scene::from_toml(&text, path).unwrap();
+    scene.time.t_end = 0.09;
+    let (young, nu, rho, g) = (1e9, 0.3, 1e3, 9.81);
+    let (length, thickness) = (1.2f64, 0.1f64);
+    let inertia = thickness.powi(3) / 12.0;
+    let statics = rho * g * thickness * length.powi(4) / (8.0 * young / (1.0 - nu * nu) * inertia);
+    let mut swing = |basis: &str| {
+        let mut s = scene.clone();
+        s.basis = if basis == "ps" {
+            psmpm::bases::BasisKind::Ps
+        } else {
+            psmpm::bases::BasisKind::Pl
+        };
+        let (mut tip, mut lowest) = (usize::MAX, 0.0f64);
+        let out = psmpm::simulation::observe_2d(&s, &mut |r, p| {
+            let psmpm::simulation::ParticlesRef::Two(p) = p else {
+                return;
+            };
+            if r.step == 0 {
+                let d = |k: usize| (p.x0[k][0] - 1.195).hypot(p.x0[k][1] - 0.5);
+                tip = (0..p.len()).min_by(|&a, &b| d(a).total_cmp(&d(b))).unwrap();
+            }
+            lowest = lowest.min(p.u[tip][1]);
+        })
+        .unwrap();
+        assert!(out.summary.stable, "{basis}: {:?}", out.summary);
+        -lowest / statics
+    };
+    let (ps, pl) = (swing("ps"), swing("pl"));
+    assert!(
+        (ps - 2.0).abs() < 0.1,
+        "PS tip swings to {ps:.3} of the static deflection"
+    );
+    assert!(
+        pl < 1.0,
+        "PL tip swings to {pl:.3} of the static deflection"
+    );
+}
