@@ -21,7 +21,7 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use psmpm_basis::{Basis, Real};
-use sprs::CsMat;
+use std::sync::Arc;
 
 /// The scalar types the solvers accept: a [`Real`] that faer can factorise (`f32`, `f64`).
 pub trait Scalar: Real + faer::traits::RealField {}
@@ -31,63 +31,81 @@ impl<T: Real + faer::traits::RealField> Scalar for T {}
 /// with per-element scatter maps.
 #[derive(Debug, Clone)]
 pub struct SymmetricPattern {
-    /// Upper triangle (`row ≤ col`) with unit values, in CSC storage; its index arrays
-    /// are the pattern, values are kept by the caller.
-    upper: CsMat<f64>,
-    /// Column pointers of `upper`.
-    col_ptr: Vec<usize>,
+    /// Column pointers of the upper triangle (`row ≤ col`) in CSC storage; the
+    /// values are kept by the caller. Shared with the factorisations of the
+    /// pattern ([`SparseCholesky::new`]), not copied.
+    col_ptr: Arc<[usize]>,
+    /// Row indices of the upper triangle, sorted within each column.
+    row_idx: Arc<[usize]>,
     /// For element `e`, `scatter[scatter_offsets[e]..]` holds, for each local pair
     /// `(a, b)` (row-major over the element's functions), the position of entry
-    /// `(min(i,j), max(i,j))` in the value array.
-    scatter: Vec<usize>,
+    /// `(min(i,j), max(i,j))` in the value array (32 bits: the scene limits keep
+    /// the entries below 2³², checked here).
+    scatter: Vec<u32>,
     scatter_offsets: Vec<usize>,
     /// Position of each diagonal entry in the value array.
     diagonal: Vec<usize>,
 }
 
 impl SymmetricPattern {
-    /// The pattern of all products `phi_i phi_j` of `basis`.
+    /// The pattern of all products `phi_i phi_j` of `basis`: column `c` holds the
+    /// functions `r ≤ c` that share an element of `c`'s support with it, and `c`.
+    ///
+    /// # Panics
+    /// If the pattern has `2³²` entries or more (about `10⁸` functions; the scene
+    /// limits stay far below).
     pub fn new<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(basis: &B) -> Self {
         let n = basis.num_functions();
-        let mut tri = sprs::TriMat::new((n, n));
-        for e in 0..basis.num_elements() {
-            let f = basis.element_functions(e);
-            for &i in f {
-                for &j in f {
-                    if i <= j {
-                        tri.add_triplet(i, j, 1.0);
+        // Column by column, the rows marked in `mark` (stamp `c + 1`) as found.
+        let mut mark = vec![0usize; n];
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::new();
+        for c in 0..n {
+            let start = row_idx.len();
+            mark[c] = c + 1;
+            row_idx.push(c);
+            for &e in basis.function_support(c) {
+                for &r in basis.element_functions(e) {
+                    if r < c && mark[r] != c + 1 {
+                        mark[r] = c + 1;
+                        row_idx.push(r);
                     }
                 }
             }
+            row_idx[start..].sort_unstable();
+            col_ptr.push(row_idx.len());
         }
-        for i in 0..n {
-            tri.add_triplet(i, i, 1.0);
-        }
-        // Duplicates are summed by the conversion; only the pattern matters.
-        let upper: CsMat<f64> = tri.to_csc();
+        row_idx.shrink_to_fit();
+        assert!(
+            row_idx.len() < u32::MAX as usize,
+            "a mass matrix pattern of {} entries (the limit is 2^32)",
+            row_idx.len()
+        );
         let position = |i: usize, j: usize| -> usize {
             let (r, c) = if i <= j { (i, j) } else { (j, i) };
-            let start = upper.indptr().outer_inds_sz(c);
-            let rows = &upper.indices()[start.clone()];
-            start.start + rows.binary_search(&r).expect("entry in pattern")
+            let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+            col_ptr[c] + rows.binary_search(&r).expect("entry in pattern")
         };
-        let mut scatter = Vec::new();
+        let total: usize = (0..basis.num_elements())
+            .map(|e| basis.element_functions(e).len().pow(2))
+            .sum();
+        let mut scatter = Vec::with_capacity(total);
         let mut scatter_offsets = Vec::with_capacity(basis.num_elements() + 1);
         scatter_offsets.push(0);
         for e in 0..basis.num_elements() {
             let f = basis.element_functions(e);
             for &i in f {
                 for &j in f {
-                    scatter.push(position(i, j));
+                    scatter.push(position(i, j) as u32);
                 }
             }
             scatter_offsets.push(scatter.len());
         }
         let diagonal = (0..n).map(|i| position(i, i)).collect();
-        let col_ptr = upper.proper_indptr().into_owned();
         SymmetricPattern {
-            upper,
-            col_ptr,
+            col_ptr: col_ptr.into(),
+            row_idx: row_idx.into(),
             scatter,
             scatter_offsets,
             diagonal,
@@ -96,11 +114,11 @@ impl SymmetricPattern {
 
     /// Matrix dimension.
     pub fn dim(&self) -> usize {
-        self.upper.rows()
+        self.col_ptr.len() - 1
     }
     /// Number of stored (upper-triangular) entries.
     pub fn nnz(&self) -> usize {
-        self.upper.nnz()
+        self.row_idx.len()
     }
     /// Column pointers of the upper triangle.
     pub fn col_ptr(&self) -> &[usize] {
@@ -108,11 +126,11 @@ impl SymmetricPattern {
     }
     /// Row indices of the upper triangle (sorted within each column).
     pub fn row_idx(&self) -> &[usize] {
-        self.upper.indices()
+        &self.row_idx
     }
     /// Value positions of the local pairs of element `e`, row-major over its functions.
     #[inline]
-    pub fn element_scatter(&self, e: usize) -> &[usize] {
+    pub fn element_scatter(&self, e: usize) -> &[u32] {
         &self.scatter[self.scatter_offsets[e]..self.scatter_offsets[e + 1]]
     }
     /// Value position of diagonal entry `i`.
@@ -187,8 +205,8 @@ pub const SUPERNODAL_FROM: usize = 4096;
 /// [`SymmetricPattern`]: symbolic analysis once, numeric factorisation per call.
 pub struct SparseCholesky<T: Scalar> {
     symbolic: SymbolicCholesky<usize>,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    col_ptr: Arc<[usize]>,
+    row_idx: Arc<[usize]>,
     l_values: Vec<T>,
     factorised: bool,
     scratch: MemBuffer,
@@ -209,9 +227,9 @@ impl<T: Scalar> SparseCholesky<T> {
     /// Symbolic factorisation (AMD ordering) of `pattern`, with scratch memory for
     /// solves with up to `rhs_columns` right-hand sides at once.
     pub fn new(pattern: &SymmetricPattern, rhs_columns: usize) -> Self {
-        Self::from_upper(
-            pattern.col_ptr().to_vec(),
-            pattern.row_idx().to_vec(),
+        Self::shared(
+            pattern.col_ptr.clone(),
+            pattern.row_idx.clone(),
             rhs_columns,
         )
     }
@@ -220,6 +238,10 @@ impl<T: Scalar> SparseCholesky<T> {
     /// triangle has the compressed sparse columns `col_ptr`, `row_idx` (rows
     /// sorted within each column, every diagonal entry present).
     pub fn from_upper(col_ptr: Vec<usize>, row_idx: Vec<usize>, rhs_columns: usize) -> Self {
+        Self::shared(col_ptr.into(), row_idx.into(), rhs_columns)
+    }
+
+    fn shared(col_ptr: Arc<[usize]>, row_idx: Arc<[usize]>, rhs_columns: usize) -> Self {
         let n = col_ptr.len() - 1;
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_cholesky(
@@ -255,7 +277,7 @@ impl<T: Scalar> SparseCholesky<T> {
 
     /// Whether this factorisation was made for the upper pattern `col_ptr`, `row_idx`.
     pub fn has_pattern(&self, col_ptr: &[usize], row_idx: &[usize]) -> bool {
-        self.col_ptr == col_ptr && self.row_idx == row_idx
+        *self.col_ptr == *col_ptr && *self.row_idx == *row_idx
     }
 
     /// Numeric factorisation of the matrix whose upper triangle has `values`

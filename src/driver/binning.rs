@@ -81,6 +81,22 @@ impl Bins {
     }
 }
 
+/// Entries of an element's local matrix block of `stride` functions: its upper
+/// triangle, row by row (the blocks are symmetric).
+#[inline]
+pub(super) fn packed_len(stride: usize) -> usize {
+    stride * (stride + 1) / 2
+}
+
+/// Position of the local pair `(a, b)`, `a ≤ b`, in an element's block
+/// ([`packed_len`]): row `r` holds `stride − r` entries, so row `a` starts at
+/// `a · stride − a (a − 1) / 2`.
+#[inline]
+pub(super) fn packed(stride: usize, a: usize, b: usize) -> usize {
+    debug_assert!(a <= b && b < stride);
+    a * stride - a * a.saturating_sub(1) / 2 + (b - a)
+}
+
 /// Element-local sums: per element an upper-triangular `stride × stride` block of
 /// the mass matrix and `stride × D` coefficients of a vector field (local
 /// function `a` is the element's `a`-th function, as evaluated in phase 1).
@@ -98,7 +114,7 @@ impl<T: Scalar, const D: usize> Local<T, D> {
     ) -> impl IndexedParallelIterator<Item = (usize, (&mut [T], &mut [T]))> + '_ {
         let stride = self.stride;
         (
-            self.matrix.par_chunks_mut(stride * stride),
+            self.matrix.par_chunks_mut(packed_len(stride)),
             self.vector.par_chunks_mut(stride * D),
         )
             .into_par_iter()
@@ -115,69 +131,95 @@ impl<T: Scalar, const D: usize> Local<T, D> {
     pub fn new(elements: usize, stride: usize) -> Self {
         Local {
             stride,
-            matrix: vec![T::zero(); elements * stride * stride],
+            matrix: vec![T::zero(); elements * packed_len(stride)],
             vector: vec![T::zero(); elements * stride * D],
         }
     }
 }
 
 /// Where each matrix entry and each function coefficient finds its element-local
-/// contributions, in element order (fixed by the mesh, built once).
+/// contributions, in element order (fixed by the mesh, built once). Offsets in
+/// 32 bits (a local buffer of `2³²` entries or more is refused at set-up).
 pub struct Gather {
-    pub(super) matrix_start: Vec<usize>,
+    pub(super) matrix_start: Vec<u32>,
     /// Offsets into [`Local`]'s matrix buffer.
-    pub(super) matrix_source: Vec<usize>,
-    pub(super) function_start: Vec<usize>,
+    pub(super) matrix_source: Vec<u32>,
+    pub(super) function_start: Vec<u32>,
     /// `e * stride + a`: local function `a` of element `e`.
-    pub(super) function_source: Vec<usize>,
+    pub(super) function_source: Vec<u32>,
 }
 
 impl Gather {
     /// The maps of `basis` with `pattern` (its element scatter maps) and local
-    /// blocks of `stride` functions.
+    /// blocks of `stride` functions: counted, then filled in element order (no
+    /// list of pairs in between).
+    ///
+    /// # Panics
+    /// If the local matrix buffer (`elements · stride²` entries) reaches `2³²`;
+    /// the driver refuses such a basis first ([`Gather::fits`]).
     pub fn new<T: Scalar, const D: usize, B: Basis<T, D>>(
         basis: &B,
         pattern: &SymmetricPattern,
         stride: usize,
     ) -> Self {
         let (ne, n) = (basis.num_elements(), basis.num_functions());
-        let mut matrix: Vec<(usize, usize)> = Vec::new();
-        let mut function: Vec<(usize, usize)> = Vec::new();
-        for e in 0..ne {
-            let m = basis.element_functions(e).len();
-            let scatter = pattern.element_scatter(e);
-            for (a, &i) in basis.element_functions(e).iter().enumerate() {
-                function.push((i, e * stride + a));
-                for b in a..m {
-                    matrix.push((scatter[a * m + b], (e * stride + a) * stride + b));
+        assert!(
+            Self::fits(ne, stride),
+            "local buffers of 2^32 entries or more"
+        );
+        // Every (target, source) pair in element order, given to `visit`.
+        let each_matrix = |visit: &mut dyn FnMut(usize, usize)| {
+            for e in 0..ne {
+                let m = basis.element_functions(e).len();
+                let scatter = pattern.element_scatter(e);
+                for a in 0..m {
+                    for b in a..m {
+                        visit(
+                            scatter[a * m + b] as usize,
+                            e * packed_len(stride) + packed(stride, a, b),
+                        );
+                    }
                 }
             }
-        }
-        let group = |pairs: Vec<(usize, usize)>, len: usize| {
-            // Stable: element order kept within each target.
-            let mut start = vec![0; len + 1];
-            for &(t, _) in &pairs {
-                start[t + 1] += 1;
+        };
+        let each_function = |visit: &mut dyn FnMut(usize, usize)| {
+            for e in 0..ne {
+                for (a, &i) in basis.element_functions(e).iter().enumerate() {
+                    visit(i, e * stride + a);
+                }
             }
+        };
+        // Stable: element order kept within each target.
+        let group = |each: &dyn Fn(&mut dyn FnMut(usize, usize)), len: usize| {
+            let mut start = vec![0u32; len + 1];
+            each(&mut |t, _| start[t + 1] += 1);
             for t in 0..len {
                 start[t + 1] += start[t];
             }
             let mut cursor = start[..len].to_vec();
-            let mut source = vec![0; pairs.len()];
-            for (t, s) in pairs {
-                source[cursor[t]] = s;
+            let mut source = vec![0u32; start[len] as usize];
+            each(&mut |t, s| {
+                source[cursor[t] as usize] = s as u32;
                 cursor[t] += 1;
-            }
+            });
             (start, source)
         };
-        let (matrix_start, matrix_source) = group(matrix, pattern.nnz());
-        let (function_start, function_source) = group(function, n);
+        let (matrix_start, matrix_source) = group(&each_matrix, pattern.nnz());
+        let (function_start, function_source) = group(&each_function, n);
         Gather {
             matrix_start,
             matrix_source,
             function_start,
             function_source,
         }
+    }
+
+    /// Whether the local buffers of `elements` elements of `stride` functions
+    /// have fewer than `2³²` entries (32-bit offsets).
+    pub fn fits(elements: usize, stride: usize) -> bool {
+        elements
+            .checked_mul(packed_len(stride))
+            .is_some_and(|e| e < u32::MAX as usize)
     }
 
     /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order
@@ -194,8 +236,9 @@ impl Gather {
             .enumerate()
             .for_each(|(j, v)| {
                 let mut sum = T::zero();
-                for &s in &self.matrix_source[self.matrix_start[j]..self.matrix_start[j + 1]] {
-                    sum += local.matrix[s];
+                let sources = self.matrix_start[j] as usize..self.matrix_start[j + 1] as usize;
+                for &s in &self.matrix_source[sources] {
+                    sum += local.matrix[s as usize];
                 }
                 if add {
                     *v += sum;
@@ -219,10 +262,10 @@ impl Gather {
                 .enumerate()
                 .for_each(|(i, o)| {
                     let mut sum = T::zero();
-                    for &s in
-                        &self.function_source[self.function_start[i]..self.function_start[i + 1]]
-                    {
-                        sum += local.vector[s * D + k];
+                    let sources =
+                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
+                    for &s in &self.function_source[sources] {
+                        sum += local.vector[s as usize * D + k];
                     }
                     if negate {
                         *o -= sum;

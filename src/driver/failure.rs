@@ -267,8 +267,8 @@ pub enum SetupError {
     Boundary { tag: String, message: String },
     #[error("particle {particle} at {} lies outside the mesh", point(position))]
     ParticleOutside { particle: usize, position: Vec<f64> },
-    #[error("the basis has {functions} functions; the driver stores function indices in 32 bits (at most {})", u32::MAX)]
-    TooManyFunctions { functions: usize },
+    #[error("the basis has {functions} functions on {elements} elements; the driver stores function indices and matrix positions in 32 bits (below 2^31 functions and 2^31 element-local entries)")]
+    TooManyFunctions { functions: usize, elements: usize },
 }
 
 /// A position for a message: `[0.00312378, 0.947718]`, six significant digits per

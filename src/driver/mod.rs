@@ -159,8 +159,17 @@ where
         dt: f64,
     ) -> Result<Self, SetupError> {
         let n = basis.num_functions();
-        if u32::try_from(n).is_err() {
-            return Err(SetupError::TooManyFunctions { functions: n });
+        // Function indices, pattern positions and local offsets are stored in 32
+        // bits: below 2³¹ functions and local entries, the pattern's entries
+        // (at most the local ones plus the diagonal) stay below 2³².
+        let local_entries = basis
+            .num_elements()
+            .checked_mul(basis.max_functions_per_element().pow(2));
+        if n >= 1 << 31 || !local_entries.is_some_and(|l| l < 1 << 31) {
+            return Err(SetupError::TooManyFunctions {
+                functions: n,
+                elements: basis.num_elements(),
+            });
         }
         let mut fixed = vec![vec![false; n]; D];
         let mut general: Vec<Vec<(usize, usize, T)>> = Vec::new();

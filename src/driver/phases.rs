@@ -28,7 +28,7 @@ use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 
 pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local};
-use super::binning::{ELEMENT_CHUNK, ENTRY_CHUNK};
+use super::binning::{packed, ELEMENT_CHUNK, ENTRY_CHUNK};
 
 /// Particles per parallel task of the per-particle phases: fixed, so that the
 /// split (and with it every result) does not depend on the number of threads.
@@ -182,10 +182,10 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
                 let w = mass * evals.phi[base + a];
                 if full {
                     for b in a..m {
-                        lm[a * stride + b] += w * evals.phi[base + b];
+                        lm[packed(stride, a, b)] += w * evals.phi[base + b];
                     }
                 } else {
-                    lm[a * stride + a] += w;
+                    lm[packed(stride, a, a)] += w;
                 }
                 let f_int = sigma * evals.grad_phi[base + a] * vol;
                 for k in 0..D {
@@ -294,9 +294,9 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                     if !(lumped[i] || lumped[j]) || w == T::zero() {
                         continue;
                     }
-                    lm[a * stride + a] += w;
-                    lm[b * stride + b] += w;
-                    lm[a * stride + b] -= w;
+                    lm[packed(stride, a, a)] += w;
+                    lm[packed(stride, b, b)] += w;
+                    lm[packed(stride, a, b)] -= w;
                     let d = points[i] - points[j];
                     for r in 0..D {
                         a_rows[a * D + r] += d[r] * w;
@@ -317,7 +317,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                 let bgc = b_form * gc;
                 for k in c..m {
                     let (gk, ak) = (grad_phi[k], row(a_rows, k));
-                    lm[c * stride + k] += keep * (bgc.dot(&gk) - gc.dot(&ak) - ac.dot(&gk));
+                    lm[packed(stride, c, k)] += keep * (bgc.dot(&gk) - gc.dot(&ak) - ac.dot(&gk));
                 }
             }
         }
@@ -692,10 +692,9 @@ pub fn particle_volume_by_elements<T: Scalar, const D: usize>(
         .enumerate()
         .for_each(|(i, o)| {
             let mut sum = 0.0;
-            for &s in
-                &gather.function_source[gather.function_start[i]..gather.function_start[i + 1]]
-            {
-                sum += local.vector[s * D].to_f64();
+            let sources = gather.function_start[i] as usize..gather.function_start[i + 1] as usize;
+            for &s in &gather.function_source[sources] {
+                sum += local.vector[s as usize * D].to_f64();
             }
             *o = sum;
         });

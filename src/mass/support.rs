@@ -112,7 +112,7 @@ impl SupportFacts {
                     continue;
                 }
                 for b in a..m {
-                    gram[scatter[a * m + b]] += T::of(w * phi * eval.phi[b].to_f64());
+                    gram[scatter[a * m + b] as usize] += T::of(w * phi * eval.phi[b].to_f64());
                 }
                 for (beta, ex) in exponents.iter().enumerate() {
                     rhs[beta * n + i] += T::of(w * phi * monomial(ex, &xi));

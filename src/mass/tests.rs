@@ -45,7 +45,7 @@ fn filled_to(height: f64) -> Column {
             particle_volume[eval.index[a]] += 0.003 * eval.phi[a];
             particle_count[eval.index[a]] += eval.phi[a];
             for b in a..9 {
-                values[scatter[a * 9 + b]] += 0.01 * eval.phi[a] * eval.phi[b];
+                values[scatter[a * 9 + b] as usize] += 0.01 * eval.phi[a] * eval.phi[b];
             }
         }
     }

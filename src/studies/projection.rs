@@ -127,7 +127,7 @@ pub fn project<T: Scalar, B: Basis<T, 2> + ?Sized>(
             rhs[eval.index[a]] += wa * fx;
             // Upper triangle: each unordered pair of local functions once.
             for b in a..m {
-                values[scatter[a * m + b]] += wa * eval.phi[b];
+                values[scatter[a * m + b] as usize] += wa * eval.phi[b];
             }
         }
     });
