@@ -137,6 +137,9 @@ impl<T: Scalar, const D: usize> Local<T, D> {
     }
 }
 
+/// Calls its argument with every `(target, source)` pair of a gather map.
+type PairVisitor<'a> = dyn Fn(&mut dyn FnMut(usize, usize)) + 'a;
+
 /// Where each matrix entry and each function coefficient finds its element-local
 /// contributions, in element order (fixed by the mesh, built once). Offsets in
 /// 32 bits (a local buffer of `2³²` entries or more is refused at set-up).
@@ -190,7 +193,7 @@ impl Gather {
             }
         };
         // Stable: element order kept within each target.
-        let group = |each: &dyn Fn(&mut dyn FnMut(usize, usize)), len: usize| {
+        let group = |each: &PairVisitor<'_>, len: usize| {
             let mut start = vec![0u32; len + 1];
             each(&mut |t, _| start[t + 1] += 1);
             for t in 0..len {

@@ -165,7 +165,7 @@ where
         let local_entries = basis
             .num_elements()
             .checked_mul(basis.max_functions_per_element().pow(2));
-        if n >= 1 << 31 || !local_entries.is_some_and(|l| l < 1 << 31) {
+        if n >= 1 << 31 || local_entries.is_none_or(|l| l >= 1 << 31) {
             return Err(SetupError::TooManyFunctions {
                 functions: n,
                 elements: basis.num_elements(),
