@@ -170,7 +170,7 @@ fn a_cantilever_one_element_thick_bends_as_a_beam_with_ps_and_locks_with_pl() {
     let (length, thickness) = (1.2f64, 0.1f64);
     let inertia = thickness.powi(3) / 12.0;
     let statics = rho * g * thickness * length.powi(4) / (8.0 * young / (1.0 - nu * nu) * inertia);
-    let mut swing = |basis: &str| {
+    let swing = |basis: &str| {
         let mut s = scene.clone();
         s.basis = if basis == "ps" {
             psmpm::bases::BasisKind::Ps
