@@ -159,6 +159,27 @@ def barycentric(A, x):
     return A[:, :, 0] * x[:, 0:1] + A[:, :, 1] * x[:, 1:2] + A[:, :, 2]
 
 
+def bernstein2(tau):
+    """The quadratic Bernstein polynomials 2!/(i!j!k!) τ1^i τ2^j τ3^k of points with
+    barycentric coordinates tau (P, 3), in the order τ1², τ2², τ3², 2τ1τ2, 2τ2τ3,
+    2τ1τ3: values (P, 6) and derivatives ∂B/∂τ_m (P, 6, 3)."""
+    t1, t2, t3 = tau[:, 0], tau[:, 1], tau[:, 2]
+    B = np.stack([t1 * t1, t2 * t2, t3 * t3, 2 * t1 * t2, 2 * t2 * t3, 2 * t1 * t3], axis=1)
+    z = np.zeros(len(tau))
+    dB = np.stack(
+        [
+            np.stack([2 * t1, z, z], axis=1),
+            np.stack([z, 2 * t2, z], axis=1),
+            np.stack([z, z, 2 * t3], axis=1),
+            np.stack([2 * t2, 2 * t1, z], axis=1),
+            np.stack([z, 2 * t3, 2 * t2], axis=1),
+            np.stack([2 * t3, z, 2 * t1], axis=1),
+        ],
+        axis=1,
+    )
+    return B, dB
+
+
 def read_mesh(path):
     import meshio
 
@@ -457,22 +478,7 @@ class PSBasis:
             best = np.where(better, mn, best)
             sub[better] = s
             tau[better] = ts[better]
-        t1, t2, t3 = tau[:, 0], tau[:, 1], tau[:, 2]
-        # Bernstein polynomials of degree 2, 2!/(i!j!k!) τ1^i τ2^j τ3^k
-        B = np.stack([t1 * t1, t2 * t2, t3 * t3, 2 * t1 * t2, 2 * t2 * t3, 2 * t1 * t3], axis=1)
-        # ∂B/∂τ_m (P, 6, 3)
-        z = np.zeros(P)
-        dB = np.stack(
-            [
-                np.stack([2 * t1, z, z], axis=1),
-                np.stack([z, 2 * t2, z], axis=1),
-                np.stack([z, z, 2 * t3], axis=1),
-                np.stack([2 * t2, 2 * t1, z], axis=1),
-                np.stack([z, 2 * t3, 2 * t2], axis=1),
-                np.stack([2 * t3, z, 2 * t1], axis=1),
-            ],
-            axis=1,
-        )
+        B, dB = bernstein2(tau)
         dtau = self.dtau[elem, sub]  # (P, 3, 2)
         dBx = dB[:, :, 0:1] * dtau[:, None, 0] + dB[:, :, 1:2] * dtau[:, None, 1] + dB[:, :, 2:3] * dtau[:, None, 2]
         C = self.coef[elem, sub]  # (P, 9, 6)
@@ -783,20 +789,7 @@ def selftest(mesh, seed=1):
 def eval_sub(ps, x, elem, sub):
     """Evaluation on a given sub-triangle (for the C¹ check)."""
     tau = barycentric(ps.sub_map[elem, sub], x)
-    t1, t2, t3 = tau[:, 0], tau[:, 1], tau[:, 2]
-    B = np.stack([t1 * t1, t2 * t2, t3 * t3, 2 * t1 * t2, 2 * t2 * t3, 2 * t1 * t3], axis=1)
-    z = np.zeros(len(x))
-    dB = np.stack(
-        [
-            np.stack([2 * t1, z, z], axis=1),
-            np.stack([z, 2 * t2, z], axis=1),
-            np.stack([z, z, 2 * t3], axis=1),
-            np.stack([2 * t2, 2 * t1, z], axis=1),
-            np.stack([z, 2 * t3, 2 * t2], axis=1),
-            np.stack([2 * t3, z, 2 * t1], axis=1),
-        ],
-        axis=1,
-    )
+    B, dB = bernstein2(tau)
     dBx = np.einsum("pbm,pmd->pbd", dB, ps.dtau[elem, sub])
     C = ps.coef[elem, sub]
     return np.einsum("pfb,pb->pf", C, B), np.einsum("pfb,pbd->pfd", C, dBx)
