@@ -443,8 +443,10 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     let mut every = diag_every(&s, &args);
     // A Courant-number scene knows its steps at the start of the run: the default
     // of about 20 rows is set then.
+    let time_from_run = s.time.dt.is_none();
     let every_from_run =
-        args.diag_every.is_none() && s.output.diagnostics_every == 0 && s.time.dt.is_none();
+        args.diag_every.is_none() && s.output.diagnostics_every == 0 && time_from_run;
+    let mut too_many: Option<String> = None;
     let mut recorder = match &args.out {
         Some(dir) => {
             let options = out::OutOptions {
@@ -479,6 +481,15 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
         if r.step == 0 {
             if every_from_run && r.dt > 0.0 {
                 every = (out::steps_from_dt(t_end, r.dt) / 20).max(1);
+            }
+            // A Courant-number scene's table is bounded now that its steps are
+            // known: too many rows stop the run before its first step.
+            if time_from_run && r.dt > 0.0 {
+                too_many = too_many_rows(format, every, out::steps_from_dt(t_end, r.dt));
+                if too_many.is_some() {
+                    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                    return;
+                }
             }
             // The time step against the critical one, before the first step.
             let line = time_step_line(r);
@@ -526,6 +537,9 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
         }
     };
     progress.finish();
+    if let Some(message) = too_many {
+        return Err(CliError::Input(message));
+    }
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
@@ -625,13 +639,21 @@ fn check_sizes(s: &Scene, args: &RunArgs, every: usize) -> Result<(), CliError> 
             )));
         }
     }
-    if args.format == Format::Table && every > 0 && steps / every > MAX_TABLE_ROWS {
-        return Err(CliError::Input(format!(
+    match too_many_rows(args.format, every, steps) {
+        Some(message) => Err(CliError::Input(message)),
+        None => Ok(()),
+    }
+}
+
+/// The error of a table of more than [`MAX_TABLE_ROWS`] rows (`every` steps a row
+/// over `steps`), which is kept in memory until the end of the run.
+fn too_many_rows(format: Format, every: usize, steps: usize) -> Option<String> {
+    (format == Format::Table && every > 0 && steps / every > MAX_TABLE_ROWS).then(|| {
+        format!(
             "--diag-every {every}: {steps} steps give {} table rows, above the limit of {MAX_TABLE_ROWS}; use --format csv or json (which stream) or a larger --diag-every",
             steps / every
-        )));
-    }
-    Ok(())
+        )
+    })
 }
 
 /// The particles at the end of a run, in its dimension.

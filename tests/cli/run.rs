@@ -320,3 +320,32 @@ fn a_courant_scene_prints_about_20_rows() {
     assert!(steps > 1000, "{steps} steps");
     assert!((19..=21).contains(&rows), "{rows} rows for {steps} steps");
 }
+
+/// The table of a Courant-number scene is bounded once its steps are known: too
+/// many rows are an input error before the first step, not a table that grows
+/// without bound.
+#[test]
+fn a_courant_scene_with_too_many_table_rows_is_an_input_error() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/stability/b5b-blocks-1x4-p12.toml"
+    );
+    let out = cli()
+        .args(["run", scene, "--t-end", "50", "--diag-every", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "--diag-every 1: 121126 steps give 121126 table rows, above the limit of 100000"
+        ),
+        "{stderr}"
+    );
+    // Nothing ran: not even the time-step line of step 0 was printed.
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}
