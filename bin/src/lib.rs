@@ -102,9 +102,9 @@ enum Command {
     ///
     /// Per case and strategy: stable or not (with the failure and its step, or the
     /// bound the verdict broke), the error against the case's reference (or the
-    /// energy growth), the σ_yy roughness of the column cases, the largest
-    /// condition estimate, lumped rows and deactivated functions, and the wall time
-    /// per step. Cases run in parallel; every column but the wall time is the same
+    /// energy growth), the σ_yy roughness of the column cases (at the end time,
+    /// and its RMS over 50 states of the run), the largest condition estimate,
+    /// lumped rows and deactivated functions, and the wall time per step. Cases run in parallel; every column but the wall time is the same
     /// on any number of threads. See docs/stability.md.
     #[command(after_help = error::EXIT_STATUS)]
     Stability(stability::StabilityArgs),
