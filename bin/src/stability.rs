@@ -255,12 +255,17 @@ fn slide_normal(scene: &Scene) -> Option<[f64; 2]> {
     Some([n[0], n[1]])
 }
 
-/// σ_yy roughness of a column (see the module doc), `None` for other scenes.
-fn column_roughness(scene: &Scene, p: &psmpm::particles::Particles<f64, 2>) -> Option<f64> {
-    if !matches!(
+/// A column case: its reference is the column's (self-weight or equilibrium).
+fn is_column(scene: &Scene) -> bool {
+    matches!(
         scene.reference,
         Some(Reference::ColumnSelfWeight {}) | Some(Reference::ColumnEquilibrium {})
-    ) {
+    )
+}
+
+/// σ_yy roughness of a column (see the module doc), `None` for other scenes.
+fn column_roughness(scene: &Scene, p: &psmpm::particles::Particles<f64, 2>) -> Option<f64> {
+    if !is_column(scene) {
         return None;
     }
     let body = &scene.bodies[0];
@@ -375,10 +380,7 @@ pub const ROUGHNESS_SAMPLES: usize = 50;
 fn run_cell(case: &str, scene: &Scene, on_step: &mut dyn FnMut()) -> Result<Cell, RunError> {
     let (summary, error, measure, roughness, roughness_rms) = if scene.dim == 2 {
         // The roughness of the first state after each `k t_end / ROUGHNESS_SAMPLES`.
-        let is_column = matches!(
-            scene.reference,
-            Some(Reference::ColumnSelfWeight {}) | Some(Reference::ColumnEquilibrium {})
-        );
+        let column = is_column(scene);
         // (a relative 1e-9 below, so that the end state is the last sample)
         let sample_time =
             |k: usize| (k as f64 / ROUGHNESS_SAMPLES as f64 - 1e-9) * scene.time.t_end;
@@ -391,7 +393,7 @@ fn run_cell(case: &str, scene: &Scene, on_step: &mut dyn FnMut()) -> Result<Cell
             let psmpm::simulation::ParticlesRef::Two(p) = p else {
                 return;
             };
-            if !is_column || next > ROUGHNESS_SAMPLES || r.time < sample_time(next) {
+            if !column || next > ROUGHNESS_SAMPLES || r.time < sample_time(next) {
                 return;
             }
             while next <= ROUGHNESS_SAMPLES && r.time >= sample_time(next) {

@@ -13,7 +13,7 @@ mod common_cli;
 
 use common::meshio::{array, read_back};
 use common::TempDir;
-use common_cli::cli;
+use common_cli::{assert_success, cli, stability_scene};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -777,21 +777,14 @@ fn the_tutorial_grid_crossing_shows_pl_velocity_kicks_and_none_for_ps() {
 #[test]
 fn every_frame_of_a_column_run_reads_back_with_meshio() {
     let dir = TempDir::new("column-frames");
-    let scene = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenes/stability/b5b-jitter-1x4-p12.toml"
-    );
+    let scene = stability_scene("b5b-jitter-1x4-p12");
     let out = cli()
-        .args(["run", scene, "--threads", "1", "--diag-every", "0"])
+        .args(["run", &scene, "--threads", "1", "--diag-every", "0"])
         .args(["--out-every", "40", "--out"])
         .arg(dir.path())
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let frames = frames_in(dir.path());
     assert!(frames > 150, "{frames} frames");
     let script = r#"
@@ -810,11 +803,7 @@ print(len(files))
         .arg(dir.path())
         .output()
         .unwrap();
-    assert!(
-        read.status.success(),
-        "{}",
-        String::from_utf8_lossy(&read.stderr)
-    );
+    assert_success(&read);
     assert_eq!(
         String::from_utf8_lossy(&read.stdout).trim(),
         frames.to_string()

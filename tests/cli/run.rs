@@ -3,7 +3,7 @@
 #[path = "../common/cli.rs"]
 mod common_cli;
 
-use common_cli::cli;
+use common_cli::{assert_success, cli, stability_scene};
 use serde_json::Value;
 
 #[test]
@@ -296,19 +296,12 @@ fn too_few_particles_per_element_is_named_as_the_cause_of_a_tiny_critical_step()
 /// step (1212 steps here).
 #[test]
 fn a_courant_scene_prints_about_20_rows() {
-    let scene = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenes/stability/b5b-blocks-1x4-p12.toml"
-    );
+    let scene = stability_scene("b5b-blocks-1x4-p12");
     let out = cli()
-        .args(["run", scene, "--t-end", "0.5", "--format", "csv"])
+        .args(["run", &scene, "--t-end", "0.5", "--format", "csv"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let stderr = String::from_utf8_lossy(&out.stderr);
     let steps: usize = stderr
         .lines()
@@ -326,12 +319,9 @@ fn a_courant_scene_prints_about_20_rows() {
 /// without bound.
 #[test]
 fn a_courant_scene_with_too_many_table_rows_is_an_input_error() {
-    let scene = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenes/stability/b5b-blocks-1x4-p12.toml"
-    );
+    let scene = stability_scene("b5b-blocks-1x4-p12");
     let out = cli()
-        .args(["run", scene, "--t-end", "50", "--diag-every", "1"])
+        .args(["run", &scene, "--t-end", "50", "--diag-every", "1"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));

@@ -11,3 +11,20 @@ pub fn cli() -> Command {
     c.timeout(Duration::from_secs(300));
     c
 }
+
+/// The path of case `name` of `scenes/stability/` (a file the CLI reads).
+pub fn stability_scene(name: &str) -> String {
+    format!(
+        "{}/../scenes/stability/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+/// Asserts that a command succeeded, showing its stderr if not.
+pub fn assert_success(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
