@@ -128,6 +128,11 @@ impl SymmetricPattern {
     pub fn row_idx(&self) -> &[usize] {
         &self.row_idx
     }
+    /// The column pointers and row indices themselves, shared (reference-counted),
+    /// for a holder that keeps the pattern without copying it.
+    pub fn shared_structure(&self) -> (Arc<[usize]>, Arc<[usize]>) {
+        (self.col_ptr.clone(), self.row_idx.clone())
+    }
     /// Value positions of the local pairs of element `e`, row-major over its functions.
     #[inline]
     pub fn element_scatter(&self, e: usize) -> &[u32] {

@@ -28,7 +28,7 @@ where
     fn coverage(&self) -> Vec<Option<f64>> {
         let computed;
         let (support, particle_volume) = match &self.inputs.support {
-            Some(s) if self.inputs.needs.coverage => (s, &self.inputs.particle_volume),
+            Some(s) if self.inputs.needs.coverage => (&**s, &self.inputs.particle_volume),
             _ => {
                 let mut volume = vec![0.0; self.basis.num_functions()];
                 phases::particle_volume(&self.evals, &self.particles.volume, &mut volume);

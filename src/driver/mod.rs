@@ -69,7 +69,7 @@ struct StrategyInputs<T: Scalar> {
     particle_count: Vec<f64>,
     /// Ones, one per particle: the weights of `particle_count`.
     ones: Vec<T>,
-    support: Option<SupportFacts>,
+    support: Option<std::sync::Arc<SupportFacts>>,
 }
 
 /// The MPM driver.
@@ -217,7 +217,7 @@ where
         let pattern = SymmetricPattern::new(&basis);
         let needs = mass.needs();
         let support = (needs.coverage || needs.polynomials)
-            .then(|| SupportFacts::new(&basis, &pattern, needs.polynomials));
+            .then(|| std::sync::Arc::new(SupportFacts::new(&basis, &pattern, needs.polynomials)));
         mass.prepare(&MassSetup {
             pattern: &pattern,
             fixed: &fixed,

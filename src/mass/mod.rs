@@ -45,6 +45,7 @@ pub use partial::{LumpRule, Partial};
 pub use support::SupportFacts;
 
 use crate::sparse::{NotPositiveDefinite, Scalar, SymmetricPattern};
+use std::sync::Arc;
 
 /// The thesis' threshold on `M_ii` below which `deactivate` removes a function.
 pub const DEFAULT_DEACTIVATION_THRESHOLD: f64 = 1e-2;
@@ -383,7 +384,7 @@ pub struct MassSetup<'a> {
     /// `fixed[k][i]`: component `k` of coefficient `i` is held at zero (Dirichlet).
     pub fixed: &'a [Vec<bool>],
     /// Facts of the basis, when the strategy asked for them.
-    pub support: Option<&'a SupportFacts>,
+    pub support: Option<&'a Arc<SupportFacts>>,
 }
 
 /// How to solve the mass systems of a step.

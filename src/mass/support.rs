@@ -21,8 +21,9 @@ pub struct SupportFacts {
     /// Neighbours of `i` (functions sharing an element with it, `i` excluded):
     /// `neighbours[neighbour_ptr[i]..neighbour_ptr[i + 1]]`, ascending.
     pub neighbour_ptr: Vec<usize>,
-    /// See [`neighbour_ptr`](Self::neighbour_ptr).
-    pub neighbours: Vec<usize>,
+    /// See [`neighbour_ptr`](Self::neighbour_ptr); 32-bit (the driver refuses a
+    /// basis of 2³¹ functions or more).
+    pub neighbours: Vec<u32>,
     /// Dimension of the mesh.
     pub dim: usize,
     /// Degree of the polynomials the basis reproduces (0 when not computed).
@@ -58,12 +59,17 @@ impl SupportFacts {
             }
         }
         let mut neighbour_ptr = Vec::with_capacity(n + 1);
-        let mut neighbours = Vec::new();
         neighbour_ptr.push(0);
         for list in &mut lists {
             list.sort_unstable();
             list.dedup();
-            neighbours.extend_from_slice(list);
+        }
+        let mut neighbours = Vec::with_capacity(lists.iter().map(Vec::len).sum());
+        for list in &lists {
+            neighbours
+                .extend(list.iter().map(|&j| {
+                    u32::try_from(j).expect("the driver bounds the functions below 2³¹")
+                }));
             neighbour_ptr.push(neighbours.len());
         }
         drop(lists);
@@ -153,7 +159,7 @@ impl SupportFacts {
     }
 
     /// The neighbours of function `i`.
-    pub fn neighbours_of(&self, i: usize) -> &[usize] {
+    pub fn neighbours_of(&self, i: usize) -> &[u32] {
         &self.neighbours[self.neighbour_ptr[i]..self.neighbour_ptr[i + 1]]
     }
 

@@ -71,7 +71,7 @@ fn prepared(c: &Column, kind: MassKind) -> Box<dyn MassStrategy<f64>> {
     let mut m = kind.build::<f64>();
     let needs = m.needs();
     let support = (needs.coverage || needs.polynomials)
-        .then(|| SupportFacts::new(&c.ps, &c.pattern, needs.polynomials));
+        .then(|| std::sync::Arc::new(SupportFacts::new(&c.ps, &c.pattern, needs.polynomials)));
     m.prepare(&MassSetup {
         pattern: &c.pattern,
         fixed: &fixed,

@@ -16,11 +16,14 @@ use crate::sparse::{NotPositiveDefinite, Scalar, SparseCholesky};
 
 /// Both triangles of the pattern of `M`: for column `c`, the rows `r` with an
 /// entry `(r, c)` or `(c, r)` and the position of that entry in the upper values.
+/// Rows and positions are 32-bit: the driver refuses meshes whose element pairs
+/// reach 2³¹ (`SetupError::TooManyFunctions`), and the full pattern holds at most
+/// as many entries as those pairs.
 #[derive(Default)]
 pub(super) struct FullPattern {
     ptr: Vec<usize>,
-    row: Vec<usize>,
-    position: Vec<usize>,
+    row: Vec<u32>,
+    position: Vec<u32>,
 }
 
 impl FullPattern {
@@ -41,16 +44,17 @@ impl FullPattern {
         }
         let mut cursor = count[..n].to_vec();
         let total = count[n];
-        let (mut row, mut position) = (vec![0; total], vec![0; total]);
+        let (mut row, mut position) = (vec![0u32; total], vec![0u32; total]);
+        let narrow = |i: usize| u32::try_from(i).expect("the driver bounds the pattern below 2³¹");
         for c in 0..n {
             for k in col_ptr[c]..col_ptr[c + 1] {
                 let r = row_idx[k];
-                row[cursor[c]] = r;
-                position[cursor[c]] = k;
+                row[cursor[c]] = narrow(r);
+                position[cursor[c]] = narrow(k);
                 cursor[c] += 1;
                 if r != c {
-                    row[cursor[r]] = c;
-                    position[cursor[r]] = k;
+                    row[cursor[r]] = narrow(c);
+                    position[cursor[r]] = narrow(k);
                     cursor[r] += 1;
                 }
             }
@@ -229,7 +233,7 @@ impl<T: Scalar> Direct<T> {
     #[inline]
     fn add_mass_column(&mut self, op: &Reduced<'_, T>, full: &FullPattern, c: usize, w: T) {
         for k in full.ptr[c]..full.ptr[c + 1] {
-            let r = full.row[k];
+            let r = full.row[k] as usize;
             if op.role[r] == Role::Inactive || op.fixed[r] {
                 continue;
             }
@@ -237,7 +241,7 @@ impl<T: Scalar> Direct<T> {
                 self.y_mark[r] = true;
                 self.y_rows.push(r);
             }
-            self.y[r] += w * op.values[full.position[k]];
+            self.y[r] += w * op.values[full.position[k] as usize];
         }
     }
 

@@ -48,6 +48,7 @@ use super::{
 use crate::sparse::{Scalar, SymmetricPattern};
 use direct::{Direct, FullPattern};
 use solve::{conjugate_gradients, Reduced, Scratch};
+use std::sync::Arc;
 
 mod direct;
 mod solve;
@@ -102,11 +103,12 @@ pub struct Extended<T: Scalar> {
     classified: Option<MassReport>,
     /// Buffer of the row lumping.
     diagonal_add: Vec<T>,
-    support: SupportFacts,
+    support: Arc<SupportFacts>,
     fixed: Vec<Vec<bool>>,
     solver_of: Vec<usize>,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    /// The pattern of `M`, shared with the driver's (not copied).
+    col_ptr: Arc<[usize]>,
+    row_idx: Arc<[usize]>,
     values: Vec<T>,
     role: Vec<Role>,
     active: Vec<usize>,
@@ -160,11 +162,11 @@ impl<T: Scalar> Extended<T> {
             any_lumped: false,
             classified: None,
             diagonal_add: Vec::new(),
-            support: SupportFacts::default(),
+            support: Arc::default(),
             fixed: Vec::new(),
             solver_of: Vec::new(),
-            col_ptr: Vec::new(),
-            row_idx: Vec::new(),
+            col_ptr: Arc::from([]),
+            row_idx: Arc::from([]),
             values: Vec::new(),
             role: Vec::new(),
             active: Vec::new(),
@@ -304,8 +306,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             .support
             .cloned()
             .expect("the extended strategy is prepared with the basis facts");
-        self.col_ptr = pattern.col_ptr().to_vec();
-        self.row_idx = pattern.row_idx().to_vec();
+        (self.col_ptr, self.row_idx) = pattern.shared_structure();
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
         self.lumped = vec![false; n];

@@ -19,6 +19,7 @@ impl<T: Scalar> Extended<T> {
         for idx in 0..self.front.len() {
             let f = self.front[idx];
             for &g in self.support.neighbours_of(f) {
+                let g = g as usize;
                 if self.mark[g] == self.stamp {
                     continue;
                 }
