@@ -174,7 +174,24 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     let stride = local.stride;
     let full = matrix == MassMatrix::Full;
     local.par_elements().for_each(|(e, (lm, lv))| {
-        for &p in bins.particles(e) {
+        let inside = bins.particles(e);
+        // Every particle of an element has the element's functions; with as many
+        // as the stride (every PS and PL element) the block is summed in a
+        // fixed-size array, in the same order (the same bits).
+        let m = inside.first().map_or(0, |&p| evals.range(p).len());
+        match (m == stride, m) {
+            (true, 9) => {
+                return element_block::<T, D, 9, 45>(inside, particles, evals, full, lm, lv)
+            }
+            (true, 3) => {
+                return element_block::<T, D, 3, 6>(inside, particles, evals, full, lm, lv)
+            }
+            (true, 2) => {
+                return element_block::<T, D, 2, 3>(inside, particles, evals, full, lm, lv)
+            }
+            _ => {}
+        }
+        for &p in inside {
             let range = evals.range(p);
             let (base, m) = (range.start, range.len());
             let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
@@ -197,6 +214,58 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     gather.matrix(local, false, values);
     zero(force);
     gather.functions(local, true, force);
+}
+
+/// Phase 2a on one element whose particles have `M` functions each, `M` the
+/// stride, `P = M (M + 1) / 2`: the sums of [`assemble_mass_and_internal_force`]
+/// in fixed-size arrays (no index arithmetic, unrolled), in the same order and
+/// with the same operations, so the result is the same to the last bit.
+#[inline(always)]
+fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
+    inside: &[usize],
+    particles: &Particles<T, D>,
+    evals: &Evaluations<T, D>,
+    full: bool,
+    lm: &mut [T],
+    lv: &mut [T],
+) {
+    debug_assert_eq!(P, M * (M + 1) / 2);
+    // The whole square (vectorised rows); the upper triangle is kept.
+    let mut square = [[T::zero(); M]; M];
+    let mut diagonal = [T::zero(); M];
+    let mut vector = [SVector::<T, D>::zeros(); M];
+    for &p in inside {
+        let base = evals.range(p).start;
+        let phi: &[T; M] = evals.phi[base..base + M].try_into().expect("M functions");
+        let grad: &[SVector<T, D>; M] = evals.grad_phi[base..base + M]
+            .try_into()
+            .expect("M functions");
+        let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+        for a in 0..M {
+            let w = mass * phi[a];
+            if full {
+                for b in 0..M {
+                    square[a][b] += w * phi[b];
+                }
+            } else {
+                diagonal[a] += w;
+            }
+            let f_int = sigma * grad[a] * vol;
+            vector[a] += f_int;
+        }
+    }
+    let mut k = 0;
+    for a in 0..M {
+        if full {
+            lm[k..k + M - a].copy_from_slice(&square[a][a..]);
+        } else {
+            lm[k] = diagonal[a];
+        }
+        k += M - a;
+    }
+    for (a, f) in vector.iter().enumerate() {
+        lv[a * D..(a + 1) * D].copy_from_slice(f.as_slice());
+    }
 }
 
 /// Which part of `M` phase 2a assembles ([`assemble_mass_and_internal_force`]).
