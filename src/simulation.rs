@@ -320,7 +320,8 @@ struct Tally {
 
 /// The tracked particles: the particle nearest each of the scene's tracked points.
 fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>) -> Vec<Tracked> {
-    let (positions, steps) = (&run.positions, run.steps);
+    // The initial positions: the particles' reference positions.
+    let (positions, steps) = (&run.driver.particles.x0, run.steps);
     scene
         .output
         .tracked
@@ -336,7 +337,7 @@ fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>
                 .unwrap_or(0);
             Tracked {
                 particle,
-                x0: positions[particle],
+                x0: std::array::from_fn(|k| if k < D { positions[particle][k] } else { 0.0 }),
                 time: Vec::with_capacity(steps),
                 velocity: Vec::with_capacity(steps),
                 displacement: Vec::with_capacity(steps),

@@ -60,8 +60,6 @@ pub(crate) struct Prepared<const D: usize, B: Basis<f64, D>> {
     pub dt_critical: Option<f64>,
     /// Basis functions.
     pub functions: usize,
-    /// Initial particle positions (the second entry is 0 in 1D).
-    pub positions: Vec<[f64; 2]>,
     /// The reference solution.
     pub solution: Option<Solution>,
     /// The lower corner of the first body's bounding box (the origin of the
@@ -126,7 +124,6 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         steps,
         dt_critical,
         functions,
-        positions: lattice.positions,
         solution,
         origin,
     })
