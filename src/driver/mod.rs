@@ -417,22 +417,34 @@ where
             phases::mark_empty_elements(&self.basis, &self.bins, &mut self.inputs.touches_empty);
         }
         if self.inputs.needs.coverage {
-            phases::particle_volume_by_elements(
-                &self.evals,
-                &self.bins,
-                &self.gather,
-                &mut self.local,
-                &self.particles.volume,
-                &mut self.inputs.particle_volume,
-            );
-            phases::particle_volume_by_elements(
-                &self.evals,
-                &self.bins,
-                &self.gather,
-                &mut self.local,
-                &self.inputs.ones,
-                &mut self.inputs.particle_count,
-            );
+            let inputs = &mut self.inputs;
+            let weights = [&self.particles.volume[..], &inputs.ones[..]];
+            let mut out = [
+                &mut inputs.particle_volume[..],
+                &mut inputs.particle_count[..],
+            ];
+            if D >= 2 {
+                // Both in one pass over the basis data.
+                phases::particle_sums_by_elements(
+                    &self.evals,
+                    &self.bins,
+                    &self.gather,
+                    &mut self.local,
+                    &weights,
+                    &mut out,
+                );
+            } else {
+                for (w, o) in weights.iter().zip(out.iter_mut()) {
+                    phases::particle_sums_by_elements(
+                        &self.evals,
+                        &self.bins,
+                        &self.gather,
+                        &mut self.local,
+                        &[w],
+                        &mut [o],
+                    );
+                }
+            }
         }
         if self.inputs.needs.correction == Correction::InMass {
             let context = StepContext {

@@ -733,15 +733,19 @@ pub fn mark_empty_elements<T: Scalar, const D: usize, B: Basis<T, D>>(
 }
 
 /// [`particle_volume`] summed element by element (the step's version; see the
-/// module's notes on threads).
-pub fn particle_volume_by_elements<T: Scalar, const D: usize>(
+/// module's notes on threads), for several per-particle weights at once
+/// (`weights.len() ≤ D`, one component of the local vectors each: the volumes and
+/// the particle counts of the coverage in one pass over the particles' basis data),
+/// the same sums in the same order as one weight at a time.
+pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
     bins: &Bins,
     gather: &Gather,
     local: &mut Local<T, D>,
-    volume: &[T],
-    out: &mut [f64],
+    weights: &[&[T]],
+    out: &mut [&mut [f64]],
 ) {
+    assert!(weights.len() <= D && weights.len() == out.len());
     let stride = local.stride;
     local
         .vector
@@ -752,21 +756,26 @@ pub fn particle_volume_by_elements<T: Scalar, const D: usize>(
             lv.iter_mut().for_each(|v| *v = T::zero());
             for &p in bins.particles(e) {
                 for (a, s) in evals.range(p).enumerate() {
-                    lv[a * D] += volume[p] * evals.phi[s];
+                    for (k, w) in weights.iter().enumerate() {
+                        lv[a * D + k] += w[p] * evals.phi[s];
+                    }
                 }
             }
         });
-    out.par_iter_mut()
-        .with_min_len(ENTRY_CHUNK)
-        .enumerate()
-        .for_each(|(i, o)| {
-            let mut sum = 0.0;
-            let sources = gather.function_start[i] as usize..gather.function_start[i + 1] as usize;
-            for &s in &gather.function_source[sources] {
-                sum += local.vector[s as usize * D].to_f64();
-            }
-            *o = sum;
-        });
+    for (k, out) in out.iter_mut().enumerate() {
+        out.par_iter_mut()
+            .with_min_len(ENTRY_CHUNK)
+            .enumerate()
+            .for_each(|(i, o)| {
+                let mut sum = 0.0;
+                let sources =
+                    gather.function_start[i] as usize..gather.function_start[i + 1] as usize;
+                for &s in &gather.function_source[sources] {
+                    sum += local.vector[s as usize * D + k].to_f64();
+                }
+                *o = sum;
+            });
+    }
 }
 
 /// `Σ_p V_p phi_i(x_p)`: the particle volume each function sees (its coverage
