@@ -819,3 +819,71 @@ pub fn add_into<T: Scalar>(target: &mut [Vec<T>], source: &[Vec<T>]) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, Vector2};
+
+    /// The fixed-size element block gives the general loop's sums to the last bit,
+    /// for the full matrix and for the row sums (PS: 9 functions, PL: 3).
+    #[test]
+    fn element_blocks_equal_the_general_loop_bit_for_bit() {
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        fn check<const M: usize, const P: usize>(next: &mut dyn FnMut() -> f64) {
+            let n = 7;
+            let positions = (0..n).map(|_| Vector2::new(next(), next())).collect();
+            let volumes = (0..n).map(|_| 0.5 + next()).collect();
+            let mut particles = Particles::<f64, 2>::new(positions, volumes, 1.3);
+            for s in &mut particles.sigma {
+                let off = next() - 0.5;
+                *s = Matrix2::new(next() - 0.5, off, off, next() - 0.5);
+            }
+            let mut evals = Evaluations::<f64, 2>::new(n, M);
+            evals.len.iter_mut().for_each(|l| *l = M);
+            evals.phi.iter_mut().for_each(|v| *v = next());
+            evals
+                .grad_phi
+                .iter_mut()
+                .for_each(|g| *g = Vector2::new(next() - 0.5, next() - 0.5));
+            let inside: Vec<usize> = vec![3, 0, 6, 1, 5, 2, 4];
+            for full in [true, false] {
+                let (mut lm, mut lv) = (vec![0.0; P], vec![0.0; M * 2]);
+                element_block::<f64, 2, M, P>(&inside, &particles, &evals, full, &mut lm, &mut lv);
+                let (mut rm, mut rv) = (vec![0.0; P], vec![0.0; M * 2]);
+                for &p in &inside {
+                    let base = evals.range(p).start;
+                    let (mass, vol, sigma) =
+                        (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+                    for a in 0..M {
+                        let w = mass * evals.phi[base + a];
+                        if full {
+                            for b in a..M {
+                                rm[packed(M, a, b)] += w * evals.phi[base + b];
+                            }
+                        } else {
+                            rm[packed(M, a, a)] += w;
+                        }
+                        let f_int = sigma * evals.grad_phi[base + a] * vol;
+                        for k in 0..2 {
+                            rv[a * 2 + k] += f_int[k];
+                        }
+                    }
+                }
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&lm), bits(&rm), "M = {M}, full = {full}");
+                assert_eq!(bits(&lv), bits(&rv), "M = {M}, full = {full}");
+                assert!(rm.iter().any(|&x| x != 0.0));
+            }
+        }
+        check::<9, 45>(&mut next);
+        check::<3, 6>(&mut next);
+        check::<2, 3>(&mut next);
+    }
+}
