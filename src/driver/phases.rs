@@ -191,29 +191,44 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
             }
             _ => {}
         }
-        for &p in inside {
-            let range = evals.range(p);
-            let (base, m) = (range.start, range.len());
-            let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
-            for a in 0..m {
-                let w = mass * evals.phi[base + a];
-                if full {
-                    for b in a..m {
-                        lm[packed(stride, a, b)] += w * evals.phi[base + b];
-                    }
-                } else {
-                    lm[packed(stride, a, a)] += w;
-                }
-                let f_int = sigma * evals.grad_phi[base + a] * vol;
-                for k in 0..D {
-                    lv[a * D + k] += f_int[k];
-                }
-            }
-        }
+        element_block_any(inside, particles, evals, stride, full, lm, lv);
     });
     gather.matrix(local, false, values);
     zero(force);
     gather.functions(local, true, force);
+}
+
+/// Phase 2a on one element, any number of functions per particle (up to
+/// `stride`): the sums of [`assemble_mass_and_internal_force`] through the packed
+/// index of each pair.
+fn element_block_any<T: Scalar, const D: usize>(
+    inside: &[usize],
+    particles: &Particles<T, D>,
+    evals: &Evaluations<T, D>,
+    stride: usize,
+    full: bool,
+    lm: &mut [T],
+    lv: &mut [T],
+) {
+    for &p in inside {
+        let range = evals.range(p);
+        let (base, m) = (range.start, range.len());
+        let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+        for a in 0..m {
+            let w = mass * evals.phi[base + a];
+            if full {
+                for b in a..m {
+                    lm[packed(stride, a, b)] += w * evals.phi[base + b];
+                }
+            } else {
+                lm[packed(stride, a, a)] += w;
+            }
+            let f_int = sigma * evals.grad_phi[base + a] * vol;
+            for k in 0..D {
+                lv[a * D + k] += f_int[k];
+            }
+        }
+    }
 }
 
 /// Phase 2a on one element whose particles have `M` functions each, `M` the
@@ -857,25 +872,7 @@ mod tests {
                 let (mut lm, mut lv) = (vec![0.0; P], vec![0.0; M * 2]);
                 element_block::<f64, 2, M, P>(&inside, &particles, &evals, full, &mut lm, &mut lv);
                 let (mut rm, mut rv) = (vec![0.0; P], vec![0.0; M * 2]);
-                for &p in &inside {
-                    let base = evals.range(p).start;
-                    let (mass, vol, sigma) =
-                        (particles.mass[p], particles.volume[p], &particles.sigma[p]);
-                    for a in 0..M {
-                        let w = mass * evals.phi[base + a];
-                        if full {
-                            for b in a..M {
-                                rm[packed(M, a, b)] += w * evals.phi[base + b];
-                            }
-                        } else {
-                            rm[packed(M, a, a)] += w;
-                        }
-                        let f_int = sigma * evals.grad_phi[base + a] * vol;
-                        for k in 0..2 {
-                            rv[a * 2 + k] += f_int[k];
-                        }
-                    }
-                }
+                element_block_any(&inside, &particles, &evals, M, full, &mut rm, &mut rv);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&lm), bits(&rm), "M = {M}, full = {full}");
                 assert_eq!(bits(&lv), bits(&rv), "M = {M}, full = {full}");
