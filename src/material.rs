@@ -116,6 +116,11 @@ pub trait Material<T: Scalar, const D: usize>: Sync {
     fn energy_density(&self, f: &SMatrix<T, D, D>) -> T;
     /// The elastic constants.
     fn elastic(&self) -> &Elastic;
+    /// Whether the law is objective: a rigid rotation makes no stress (all laws
+    /// here but the paper's [`LinearElastic`]).
+    fn is_objective(&self) -> bool {
+        true
+    }
 }
 
 /// The paper's linear elasticity on the symmetric part of `F` (eqs. (25)–(26)):
@@ -161,6 +166,9 @@ impl<T: Scalar, const D: usize> Material<T, D> for LinearElastic {
     }
     fn elastic(&self) -> &Elastic {
         &self.constants
+    }
+    fn is_objective(&self) -> bool {
+        false
     }
 }
 
@@ -370,6 +378,9 @@ impl<T: Scalar, const D: usize> Material<T, D> for AnyMaterial {
             AnyMaterial::Corotational(m) => &m.constants,
             AnyMaterial::NeoHookean(m) => &m.constants,
         }
+    }
+    fn is_objective(&self) -> bool {
+        AnyMaterial::is_objective(self)
     }
 }
 

@@ -20,6 +20,11 @@ pub trait ParticleMaterials<T: Scalar, const D: usize>: Sync {
     /// The elastic constants of particle `p` (for the small-strain stiffness of the
     /// critical time step).
     fn elastic(&self, p: usize) -> &Elastic;
+    /// Whether the law of particle `p` is objective ([`Material::is_objective`]).
+    fn is_objective(&self, p: usize) -> bool {
+        let _ = p;
+        true
+    }
 }
 
 /// One law for every particle: each law of [`crate::material`] (a blanket impl over
@@ -38,6 +43,10 @@ macro_rules! one_law_for_all {
             #[inline]
             fn elastic(&self, _p: usize) -> &Elastic {
                 Material::<T, D>::elastic(self)
+            }
+            #[inline]
+            fn is_objective(&self, _p: usize) -> bool {
+                Material::<T, D>::is_objective(self)
             }
         }
     )*};
@@ -162,6 +171,10 @@ impl<T: Scalar, const D: usize> ParticleMaterials<T, D> for MaterialTable {
     #[inline]
     fn elastic(&self, p: usize) -> &Elastic {
         Material::<T, D>::elastic(self.law(p))
+    }
+    #[inline]
+    fn is_objective(&self, p: usize) -> bool {
+        self.law(p).is_objective()
     }
 }
 

@@ -168,8 +168,13 @@ where
         }
         if let Some(critical) = self.dt_critical {
             let dt = self.dt.to_f64();
+            let cause = if self.material.is_objective(particle) {
+                "the deformation there is large, with a stiffer response than at the start (compression, an impact): lower `time.courant` or `time.dt`"
+            } else {
+                "its law, `linear-elastic`, is not objective and builds spurious stress where the body rotates: use `neo-hookean` or `corotational`, or a smaller `time.dt`"
+            };
             return format!(
-                "the element around it inverted (speed {speed:.3e}) although Δt = {dt:.3e} is below the critical step {critical:.3e} estimated at the start: the deformation is large (a stiffer response than at the start, or a law that is not objective, `linear-elastic`, under rotation); try `neo-hookean` or a smaller `time.dt`"
+                "the element around it inverted (speed {speed:.3e}) although Δt = {dt:.3e} is below the critical step {critical:.3e} estimated at the start: {cause}"
             );
         }
         format!(
