@@ -153,7 +153,8 @@ pub struct RunArgs {
     basis: Option<String>,
     /// Mass strategy: default (= extended-hybrid: functions with almost no particles
     /// expressed through well-covered neighbours, poorly covered rows lumped except
-    /// for what an affine field sees), extended-hybrid:C1:C2, extended[:C] (coverage
+    /// for what an affine field sees), extended-hybrid:C1:C2[:W] (W: the functions a
+    /// wall constrains extended, not lumped, below coverage W), extended[:C] (coverage
     /// threshold C), consistent, lumped, partial (lump rows touching empty elements),
     /// partial:TAU (lump rows with M_ii < TAU·max M_jj), partial-coverage:C,
     /// deactivate, deactivate:THRESHOLD, extended-hybrid-apic|-rpic|-plain or fmpm:K.

@@ -67,6 +67,9 @@ struct StrategyInputs<T: Scalar> {
     touches_empty: Vec<bool>,
     particle_volume: Vec<f64>,
     particle_count: Vec<f64>,
+    /// `on_wall[i]`: a wall constrains function `i` (a fixed component or a
+    /// general constraint's term); sized with the coverage.
+    on_wall: Vec<bool>,
     /// Ones, one per particle: the weights of `particle_count`.
     ones: Vec<T>,
     support: Option<std::sync::Arc<SupportFacts>>,
@@ -228,6 +231,11 @@ where
             touches_empty: vec![false; if needs.empty_elements { n } else { 0 }],
             particle_volume: vec![0.0; if needs.coverage { n } else { 0 }],
             particle_count: vec![0.0; if needs.coverage { n } else { 0 }],
+            on_wall: if needs.coverage {
+                on_wall(n, &fixed, &general)
+            } else {
+                Vec::new()
+            },
             ones: vec![T::one(); if needs.coverage { particles.len() } else { 0 }],
             support,
         };
@@ -307,6 +315,11 @@ where
                 }
             }
             general.push(row);
+        }
+        if !self.inputs.on_wall.is_empty() {
+            for &(_, i, _) in general.iter().flatten() {
+                self.inputs.on_wall[i] = true;
+            }
         }
         self.constraints = Constraints::new(general, self.basis.num_functions());
         Ok(())
@@ -451,6 +464,7 @@ where
                 touches_empty: &self.inputs.touches_empty,
                 particle_volume: &self.inputs.particle_volume,
                 particle_count: &self.inputs.particle_count,
+                on_wall: &self.inputs.on_wall,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
                 phases::add_affine_lumping(
@@ -561,6 +575,7 @@ where
             touches_empty: &self.inputs.touches_empty,
             particle_volume: &self.inputs.particle_volume,
             particle_count: &self.inputs.particle_count,
+            on_wall: &self.inputs.on_wall,
         };
         match self.mass.factorize(&self.pattern, &self.values, context) {
             Ok(report) => self.last_report = report,
@@ -666,6 +681,21 @@ where
 enum Which {
     Acceleration,
     Velocity,
+}
+
+/// `on_wall[i]`: some component of function `i` is fixed, or a general
+/// constraint has a term on it.
+fn on_wall<T>(n: usize, fixed: &[Vec<bool>], general: &[Vec<(usize, usize, T)>]) -> Vec<bool> {
+    let mut on_wall = vec![false; n];
+    for component in fixed {
+        for (wall, &f) in on_wall.iter_mut().zip(component) {
+            *wall |= f;
+        }
+    }
+    for &(_, i, _) in general.iter().flatten() {
+        on_wall[i] = true;
+    }
+    on_wall
 }
 
 fn to_f64<T: Scalar, const D: usize>(x: &SVector<T, D>) -> Vec<f64> {

@@ -96,6 +96,9 @@ pub enum MassKind {
         lump: f64,
         /// How the momentum of the lumped rows is corrected.
         correction: Correction,
+        /// Coverage below which a function a wall constrains is extended instead
+        /// of lumped (`0`: none; the third number of `extended-hybrid:C1:C2:W`).
+        walls: f64,
     },
     /// Truncated series for `M⁻¹` preconditioned by the lumped mass.
     Fmpm {
@@ -120,18 +123,20 @@ impl Default for MassKind {
             extend: DEFAULT_HYBRID_EXTEND,
             lump: DEFAULT_HYBRID_LUMP,
             correction: Correction::InMass,
+            walls: 0.0,
         }
     }
 }
 
 /// Names [`MassKind::parse`] knows, for messages.
-pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-apic[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
+pub const MASS_NAMES: &str = "default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2[:W], extended-hybrid-apic[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K";
 
 impl MassKind {
     /// Parses `default`, `consistent`, `lumped`, `partial` (seed rule), `partial:TAU`
     /// (threshold rule), `partial-coverage:C`, `deactivate` (threshold 1e-2),
     /// `deactivate:THRESHOLD`, `extended` (default coverage), `extended:C`,
-    /// `extended-hybrid:C1:C2` (`C1 ≤ C2`), `fmpm:K`.
+    /// `extended-hybrid:C1:C2` (`C1 ≤ C2`), `extended-hybrid:C1:C2:W` (wall
+    /// functions covered below `W` extended), `fmpm:K`.
     pub fn parse(name: &str) -> Result<Self, String> {
         let (head, arg) = match name.split_once(':') {
             Some((h, a)) => (h, Some(a)),
@@ -183,6 +188,7 @@ impl MassKind {
                     extend: DEFAULT_HYBRID_EXTEND,
                     lump: DEFAULT_HYBRID_LUMP,
                     correction: Correction::of_name(hybrid).unwrap_or_default(),
+                    walls: 0.0,
                 })
             }
             ("extended", Some(a)) => Ok(MassKind::Extended {
@@ -191,19 +197,33 @@ impl MassKind {
             (hybrid, Some(a)) if Correction::of_name(hybrid).is_some() => {
                 // `:` between the two (lists of strategies are comma-separated);
                 // `,` is read too.
-                let (c1, c2) = a.split_once([':', ',']).ok_or_else(|| {
-                    format!("`{name}`: expected two coverages `C1:C2`, got `{a}`")
-                })?;
+                let numbers: Vec<&str> = a.split([':', ',']).collect();
+                let [c1, c2, rest @ ..] = &numbers[..] else {
+                    return Err(format!(
+                        "`{shown}`: expected two coverages `C1:C2` (or three, `C1:C2:W`), got `{}`",
+                        crate::scene::limits::echo(a)
+                    ));
+                };
                 let (extend, lump) = (fraction(c1)?, fraction(c2)?);
                 if extend > lump {
                     return Err(format!(
-                        "`{name}`: the extension coverage {extend} is above the lumping coverage {lump}"
+                        "`{shown}`: the extension coverage {extend} is above the lumping coverage {lump}"
                     ));
                 }
+                let walls = match rest {
+                    [] => 0.0,
+                    [w] => fraction(w)?,
+                    _ => {
+                        return Err(format!(
+                            "`{shown}`: expected at most three coverages `C1:C2:W`"
+                        ))
+                    }
+                };
                 Ok(MassKind::ExtendedHybrid {
                     extend,
                     lump,
                     correction: Correction::of_name(hybrid).unwrap_or_default(),
+                    walls,
                 })
             }
             ("fmpm", Some(a)) => a
@@ -236,6 +256,13 @@ impl MassKind {
                 extend,
                 lump,
                 correction,
+                walls,
+            } if walls > 0.0 => format!("{}:{extend}:{lump}:{walls}", correction.hybrid_name()),
+            MassKind::ExtendedHybrid {
+                extend,
+                lump,
+                correction,
+                ..
             } if (extend, lump) != (DEFAULT_HYBRID_EXTEND, DEFAULT_HYBRID_LUMP) => {
                 format!("{}:{extend}:{lump}", correction.hybrid_name())
             }
@@ -269,7 +296,8 @@ impl MassKind {
                 extend,
                 lump,
                 correction,
-            } => Box::new(Extended::hybrid(extend, lump, correction)),
+                walls,
+            } => Box::new(Extended::hybrid(extend, lump, correction).with_walls(walls)),
             MassKind::Fmpm { order } => Box::new(Fmpm::new(order)),
         }
     }
@@ -375,6 +403,9 @@ pub struct StepContext<'a> {
     /// `Σ_p phi_i(x_p)`: how many particles sample function `i` (each weighted by
     /// its value there); measured with the coverage.
     pub particle_count: &'a [f64],
+    /// `on_wall[i]`: a wall constrains function `i` (a fixed component, or a
+    /// slip wall's constraint has a term on it); empty when not measured.
+    pub on_wall: &'a [bool],
 }
 
 /// What a strategy is prepared with once per mesh.

@@ -85,6 +85,7 @@ fn context(c: &Column) -> StepContext<'_> {
         touches_empty: &c.touches_empty,
         particle_volume: &c.particle_volume,
         particle_count: &c.particle_count,
+        on_wall: &[],
     }
 }
 
@@ -286,6 +287,7 @@ fn mass_kinds_parse() {
             extend: 0.02,
             lump: 0.75,
             correction: super::Correction::InMass,
+            walls: 0.0,
         }
     );
     assert_eq!(
@@ -294,6 +296,7 @@ fn mass_kinds_parse() {
             extend: 0.02,
             lump: 0.75,
             correction: super::Correction::Affine,
+            walls: 0.0,
         }
     );
     assert_eq!(
@@ -302,8 +305,23 @@ fn mass_kinds_parse() {
             extend: 0.02,
             lump: 0.75,
             correction: super::Correction::None,
+            walls: 0.0,
         }
     );
+    let walls = MassKind::parse("extended-hybrid:0.02:0.75:0.5").unwrap();
+    assert_eq!(
+        walls,
+        MassKind::ExtendedHybrid {
+            extend: 0.02,
+            lump: 0.75,
+            correction: super::Correction::InMass,
+            walls: 0.5,
+        }
+    );
+    assert_eq!(walls.spec(), "extended-hybrid:0.02:0.75:0.5");
+    assert_eq!(MassKind::parse(&walls.spec()).unwrap(), walls);
+    assert!(MassKind::parse("extended-hybrid:0.02:0.75:1.5").is_err());
+    assert!(MassKind::parse("extended-hybrid:0.02:0.75:0.5:0.5").is_err());
     assert_eq!(
         MassKind::parse("extended-hybrid:0.1,0.5").unwrap().spec(),
         "extended-hybrid:0.1:0.5"

@@ -488,7 +488,7 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("basis: unknown basis `cubic` (known: ps, pl, bspline, pl1d)"),
         case("unknown-mass-strategy", BAR)
             .edit("mass = \"consistent\"", "mass = @@\"heavy\"")
-            .expect("mass: unknown mass strategy `heavy` (known: default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2, extended-hybrid-apic[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K)"),
+            .expect("mass: unknown mass strategy `heavy` (known: default, consistent, lumped, partial, partial:TAU, partial-coverage:C, deactivate, deactivate:THRESHOLD, extended, extended:C, extended-hybrid, extended-hybrid:C1:C2[:W], extended-hybrid-apic[:C1:C2], extended-hybrid-rpic[:C1:C2], extended-hybrid-plain[:C1:C2], fmpm:K)"),
         case("negative-partial-threshold", BAR)
             .edit("mass = \"consistent\"", "mass = @@\"partial:-1\"")
             .expect("mass: `partial:-1`: the threshold must be a positive number, got `-1`"),
