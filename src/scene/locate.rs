@@ -197,8 +197,13 @@ pub(super) fn field_offset(text: &str, path: &str) -> usize {
 pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<String>, String) {
     let mut at = e.span().map_or(0, |s| s.start);
     let message = e.message().trim().to_string();
+    // Errors of a value in a buffered (tagged) table that quote no value: at
+    // their key.
+    let key = (message == super::MESH_HOLE_AS_CORNERS).then_some("holes");
     // An unknown field is reported at its table's header: find its line.
-    if let Some(name) = message
+    if let Some(offset) = key.and_then(|key| key_line_after(text, at, key)) {
+        at = offset;
+    } else if let Some(name) = message
         .strip_prefix("unknown field `")
         .and_then(|r| r.split_once('`'))
         .map(|(n, _)| n)
@@ -230,7 +235,9 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
         let line_start = text[..at.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
         text[line_start..at.min(text.len())].contains('=')
     };
-    let about_key = message.starts_with("unknown field") || message.starts_with("duplicate key");
+    let about_key = message.starts_with("unknown field")
+        || message.starts_with("duplicate key")
+        || key.is_some();
     match field_at(text, at) {
         Some(field) if about_value || about_key => {
             let message = if message.starts_with(&field) {

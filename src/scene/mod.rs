@@ -215,14 +215,48 @@ pub enum MeshSpec {
     },
 }
 
-/// A hole of a polygon mesh.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// The error for a mesh hole written as a body's (located at `holes` by
+/// [`locate::parse_error`]).
+pub(crate) const MESH_HOLE_AS_CORNERS: &str = "each hole of a mesh is a table with `outline` (its corners) and `tag` (its boundary's tag), written `[[mesh.holes]]`, not a list of corners as a body's `holes`";
+
+/// A hole of a polygon mesh: a table (`[[mesh.holes]]`), never a list of corners
+/// (the form of a body's `holes`, which have no tag), which is refused with a
+/// message that says so.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Hole {
     /// Corners.
     pub outline: Vec<[f64; 2]>,
     /// Tag of its boundary.
     pub tag: String,
+}
+
+impl<'de> Deserialize<'de> for Hole {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Table {
+            outline: Vec<[f64; 2]>,
+            tag: String,
+        }
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Hole;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a table with `outline` and `tag`")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, _: A) -> Result<Hole, A::Error> {
+                Err(serde::de::Error::custom(MESH_HOLE_AS_CORNERS))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Hole, A::Error> {
+                let t = Table::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(Hole {
+                    outline: t.outline,
+                    tag: t.tag,
+                })
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
 }
 
 /// How a block is triangulated.

@@ -619,6 +619,9 @@ fn range_cases() -> Vec<Case> {
         case("zero-edge-length", SQUARE)
             .edit("edge_length = 0.25", "edge_length = @@0.0")
             .expect("mesh.edge_length: must be positive and finite, got 0"),
+        case("mesh-hole-as-a-list-of-corners", SQUARE)
+            .edit("edge_length = 0.25", "edge_length = 0.25\n@@holes = [[[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]]")
+            .expect("mesh.holes: each hole of a mesh is a table with `outline` (its corners) and `tag` (its boundary's tag), written `[[mesh.holes]]`, not a list of corners as a body's `holes`"),
         case("infinite-reference-v0", BAR)
             .edit("v0 = 0.1", "v0 = @@inf")
             .expect("reference.v0: must be finite, got inf"),
