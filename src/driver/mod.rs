@@ -317,9 +317,7 @@ where
             general.push(row);
         }
         if !self.inputs.on_wall.is_empty() {
-            for &(_, i, _) in general.iter().flatten() {
-                self.inputs.on_wall[i] = true;
-            }
+            mark_terms(&mut self.inputs.on_wall, &general);
         }
         self.constraints = Constraints::new(general, self.basis.num_functions());
         Ok(())
@@ -692,10 +690,15 @@ fn on_wall<T>(n: usize, fixed: &[Vec<bool>], general: &[Vec<(usize, usize, T)>])
             *wall |= f;
         }
     }
-    for &(_, i, _) in general.iter().flatten() {
+    mark_terms(&mut on_wall, general);
+    on_wall
+}
+
+/// Marks every function a term of the general constraints `rows` acts on.
+fn mark_terms<T>(on_wall: &mut [bool], rows: &[Vec<(usize, usize, T)>]) {
+    for &(_, i, _) in rows.iter().flatten() {
         on_wall[i] = true;
     }
-    on_wall
 }
 
 fn to_f64<T: Scalar, const D: usize>(x: &SVector<T, D>) -> Vec<f64> {
