@@ -128,6 +128,10 @@ where
     /// The size of each element for the affine-preserving lumping
     /// ([`phases::element_scales`]); empty unless the strategy uses it.
     element_scale: Vec<T>,
+    /// The basis's functions are affine on every element (degree 1): the
+    /// affine-preserving lumping keeps only its plain share there
+    /// ([`phases::add_affine_lumping`]).
+    functions_affine: bool,
     /// Per-chunk sums of the particle terms of the step report's energies
     /// (written by [`phases::update_particles`]).
     energy_terms: Vec<[f64; 8]>,
@@ -273,6 +277,7 @@ where
             affine_gradient: vec![SMatrix::zeros(); if momentum_corrects { np } else { 0 }],
             function_points,
             element_scale,
+            functions_affine: basis.degree() == 1,
             particle_force: if effects.iter().any(|e| e.acts_per_particle()) {
                 vec![SVector::zeros(); np]
             } else {
@@ -474,6 +479,7 @@ where
                     &self.particles.x,
                     &self.function_points,
                     &self.element_scale,
+                    self.functions_affine,
                     lumped,
                     &mut self.values,
                 );

@@ -325,6 +325,14 @@ pub enum MassMatrix {
 /// per axis of its functions' points `ξ` (`element_scale`, [`element_scales`])
 /// and `α =` [`AFFINE_SPREAD`].
 ///
+/// A basis whose functions are affine on every element (PL, `functions_affine`)
+/// spans exactly the affine fields there: `grad phi_k · (ξ_i − ξ_j) = δ_ki − δ_kj`,
+/// so `g ≡ 0` and the affine-preserving term adds nothing, whatever the
+/// particles. Every element of such a basis is treated as the degenerate ones
+/// are: its lumped pairs keep the share `θ` of the plain term, `M + θ L`
+/// (without it PL's default was the consistent mass near the body's edge and
+/// gained 18 % energy after a ball struck a post, `docs/stability.md`).
+///
 /// Evaluated per particle in factored form: with `Ξ` the rows `ξ_k`,
 /// `g = H (e_i − e_j)` for `H = I − G_p Ξᵀ`, so the particle's pairs add
 /// `H L Hᵀ = L − G_p Aᵀ − A G_pᵀ + G_p B G_pᵀ`, `L` the Laplacian of its lumped
@@ -342,10 +350,12 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     x: &[SVector<T, D>],
     points: &[SVector<T, D>],
     element_scale: &[T],
+    functions_affine: bool,
     lumped: &[bool],
     values: &mut [T],
 ) {
     let stride = local.stride;
+    let theta = T::of(PLAIN_SHARE);
     let touches_lumped = |p: usize| {
         evals.index[evals.range(p)]
             .iter()
@@ -356,7 +366,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
         if !inside.iter().any(|&p| touches_lumped(p)) {
             return;
         }
-        let affine = determines_affine(inside, mass, x, element_scale[e]);
+        let affine = !functions_affine && determines_affine(inside, mass, x, element_scale[e]);
         for &p in inside {
             if !touches_lumped(p) {
                 continue;
@@ -365,6 +375,22 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             let (base, m) = (range.start, range.len());
             let index = &evals.index[base..base + m];
             let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
+            if functions_affine {
+                // `g ≡ 0`: the share `θ` of the plain pairs alone.
+                for a in 0..m {
+                    for b in a + 1..m {
+                        let (i, j) = (index[a] as usize, index[b] as usize);
+                        if !(lumped[i] || lumped[j]) {
+                            continue;
+                        }
+                        let w = theta * mass[p] * phi[a] * phi[b];
+                        lm[packed(stride, a, a)] += w;
+                        lm[packed(stride, b, b)] += w;
+                        lm[packed(stride, a, b)] -= w;
+                    }
+                }
+                continue;
+            }
             // The pairs' Laplacian `L` goes straight into `lm`; `A = L Ξ` (row `a` in
             // `g[a D..(a + 1) D]`) and `B = Ξᵀ L Ξ` are gathered beside it.
             let a_rows = &mut g[..m * D];
@@ -391,11 +417,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             }
             // `H L Hᵀ − L = −G Aᵀ − A Gᵀ + G B Gᵀ`; where the element's particles do
             // not pin an affine field, a share `θ` of the plain pairs stays.
-            let keep = if affine {
-                T::one()
-            } else {
-                T::one() - T::of(PLAIN_SHARE)
-            };
+            let keep = if affine { T::one() } else { T::one() - theta };
             for c in 0..m {
                 let (gc, ac) = (grad_phi[c], row(a_rows, c));
                 let bgc = b_form * gc;

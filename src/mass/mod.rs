@@ -117,7 +117,9 @@ pub const DEFAULT_HYBRID_LUMP: f64 = 0.75;
 impl Default for MassKind {
     /// The default strategy of every basis: the hybrid extension (functions covered
     /// below 0.02 extended, rows covered below 0.75 lumped in the affine-preserving
-    /// way, [`Correction::InMass`]; `docs/stability.md`).
+    /// way, [`Correction::InMass`]; on a basis of degree 1, PL, that way keeps
+    /// only a share 0.1 of plain lumping, `driver::phases::add_affine_lumping`;
+    /// `docs/stability.md`).
     fn default() -> Self {
         MassKind::ExtendedHybrid {
             extend: DEFAULT_HYBRID_EXTEND,
