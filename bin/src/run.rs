@@ -615,11 +615,18 @@ fn unstable_reason(summary: &Summary) -> String {
             sci(c),
             sci(simulation::STABLE_CONDITION)
         ),
-        _ => format!(
-            "energy growth {:.2e} of the energy scale ≥ {}",
-            summary.energy_growth,
-            simulation::STABLE_ENERGY_GROWTH
-        ),
+        _ => {
+            let mut reason = format!(
+                "energy growth {:.2e} of the energy scale ≥ {}",
+                summary.energy_growth,
+                simulation::STABLE_ENERGY_GROWTH
+            );
+            if let Some(hint) = &summary.energy_growth_hint {
+                reason.push_str(": ");
+                reason.push_str(hint);
+            }
+            reason
+        }
     }
 }
 

@@ -90,15 +90,25 @@ where
         let (critical, lumped) = critical?;
         let ratio = lumped / critical;
         (ratio >= NEARLY_SINGULAR).then(|| {
-            let occupied = (0..self.basis.num_elements())
-                .filter(|&e| self.bins.occupied(e))
-                .count()
-                .max(1);
             format!(
                 "its critical step is {ratio:.1e} times below the lumped mass's ({lumped:.3e}; an invertible mass stays within a few times of it): {:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`",
-                self.particles.len() as f64 / occupied as f64
+                self.particles_per_occupied_element()
             )
         })
+    }
+
+    /// Particles per element that holds at least one, at the last location.
+    pub fn particles_per_occupied_element(&self) -> f64 {
+        let occupied = (0..self.basis.num_elements())
+            .filter(|&e| self.bins.occupied(e))
+            .count()
+            .max(1);
+        self.particles.len() as f64 / occupied as f64
+    }
+
+    /// The basis's largest number of functions on one element.
+    pub fn functions_per_element(&self) -> usize {
+        self.basis.max_functions_per_element()
     }
 
     fn singular_mass_cause_seen(&self) -> Option<String> {
