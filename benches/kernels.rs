@@ -248,7 +248,7 @@ mod assemble {
                 parts,
                 &self.evals,
                 &self.bins,
-                &self.gather,
+                &mut self.gather,
                 &mut self.local,
                 matrix,
                 &mut self.values,

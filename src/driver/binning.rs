@@ -100,30 +100,72 @@ pub(super) fn packed(stride: usize, a: usize, b: usize) -> usize {
 /// Element-local sums: per element an upper-triangular `stride × stride` block of
 /// the mass matrix and `stride × D` coefficients of a vector field (local
 /// function `a` is the element's `a`-th function, as evaluated in phase 1).
+///
+/// The blocks of the elements without particles are kept zero (a block is zeroed
+/// when its element empties, `dirty`), so the element loops visit only the
+/// occupied elements and the gathers read zeros from the others.
 pub struct Local<T: Scalar, const D: usize> {
     pub(super) stride: usize,
     pub(super) matrix: Vec<T>,
     pub(super) vector: Vec<T>,
+    /// Per element: its blocks may hold nonzero values.
+    dirty: Vec<bool>,
 }
 
 impl<T: Scalar, const D: usize> Local<T, D> {
-    /// Each element's local matrix block and vector, zeroed, in parallel tasks of
-    /// at least [`ELEMENT_CHUNK`] elements: `(e, (matrix, vector))`.
-    pub(super) fn par_elements(
-        &mut self,
-    ) -> impl IndexedParallelIterator<Item = (usize, (&mut [T], &mut [T]))> + '_ {
+    /// The local matrix block and vector of each element that holds a particle in
+    /// `bins`, zeroed, in parallel tasks of at least [`ELEMENT_CHUNK`] elements:
+    /// `(e, (matrix, vector))`. The blocks of elements emptied since the last call
+    /// are zeroed.
+    pub(super) fn par_elements<'a>(
+        &'a mut self,
+        bins: &'a Bins,
+    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
         let stride = self.stride;
         (
             self.matrix.par_chunks_mut(packed_len(stride)),
             self.vector.par_chunks_mut(stride * D),
+            self.dirty.par_iter_mut(),
         )
             .into_par_iter()
             .with_min_len(ELEMENT_CHUNK)
             .enumerate()
-            .map(|(e, (lm, lv))| {
-                lm.iter_mut().for_each(|v| *v = T::zero());
-                lv.iter_mut().for_each(|v| *v = T::zero());
-                (e, (lm, lv))
+            .filter_map(move |(e, (lm, lv, dirty))| {
+                let occupied = bins.occupied(e);
+                if occupied || *dirty {
+                    lm.iter_mut().for_each(|v| *v = T::zero());
+                    lv.iter_mut().for_each(|v| *v = T::zero());
+                }
+                *dirty = occupied;
+                occupied.then_some((e, (lm, lv)))
+            })
+    }
+
+    /// The local vector of each element that holds a particle in `bins`, zeroed
+    /// (its matrix block untouched), as [`Local::par_elements`]: `(e, vector)`.
+    pub(super) fn par_vectors<'a>(
+        &'a mut self,
+        bins: &'a Bins,
+    ) -> impl ParallelIterator<Item = (usize, &'a mut [T])> + 'a {
+        let stride = self.stride;
+        (
+            self.matrix.par_chunks_mut(packed_len(stride)),
+            self.vector.par_chunks_mut(stride * D),
+            self.dirty.par_iter_mut(),
+        )
+            .into_par_iter()
+            .with_min_len(ELEMENT_CHUNK)
+            .enumerate()
+            .filter_map(move |(e, (lm, lv, dirty))| {
+                let occupied = bins.occupied(e);
+                if occupied {
+                    lv.iter_mut().for_each(|v| *v = T::zero());
+                } else if *dirty {
+                    lm.iter_mut().for_each(|v| *v = T::zero());
+                    lv.iter_mut().for_each(|v| *v = T::zero());
+                }
+                *dirty = occupied;
+                occupied.then_some((e, lv))
             })
     }
 
@@ -133,6 +175,7 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             stride,
             matrix: vec![T::zero(); elements * packed_len(stride)],
             vector: vec![T::zero(); elements * stride * D],
+            dirty: vec![false; elements],
         }
     }
 }
@@ -143,6 +186,13 @@ type PairVisitor<'a> = dyn Fn(&mut dyn FnMut(usize, usize)) + 'a;
 /// Where each matrix entry and each function coefficient finds its element-local
 /// contributions, in element order (fixed by the mesh, built once). Offsets in
 /// 32 bits (a local buffer of `2³²` entries or more is refused at set-up).
+///
+/// The gathers visit only the *live* functions, those of the elements that hold a
+/// particle this step ([`Gather::mark_live`]), and the matrix columns of live
+/// functions: every other target has only empty elements' blocks, which are zero,
+/// so its sum is `+0` and skipping it changes no bit. A step in a mostly empty
+/// mesh then costs what its body covers, not what the mesh holds (measured:
+/// `docs/performance.md`, "A body in a mostly empty mesh").
 pub struct Gather {
     pub(super) matrix_start: Vec<u32>,
     /// Offsets into [`Local`]'s matrix buffer.
@@ -150,6 +200,18 @@ pub struct Gather {
     pub(super) function_start: Vec<u32>,
     /// `e * stride + a`: local function `a` of element `e`.
     pub(super) function_source: Vec<u32>,
+    /// The pattern's column pointers (entries of column `c`:
+    /// `column_start[c]..column_start[c + 1]`).
+    column_start: Vec<u32>,
+    /// First column of each block of columns the matrix gather splits into
+    /// parallel tasks (about [`ENTRY_CHUNK`] entries each), and the number of
+    /// columns at the end.
+    block_column: Vec<u32>,
+    /// Per function: it belongs to an element that holds a particle.
+    live: Vec<bool>,
+    /// Per column: its entries may be nonzero in the values last assigned by
+    /// [`Gather::matrix_assign`].
+    written: Vec<bool>,
 }
 
 impl Gather {
@@ -209,12 +271,118 @@ impl Gather {
         };
         let (matrix_start, matrix_source) = group(&each_matrix, pattern.nnz());
         let (function_start, function_source) = group(&each_function, n);
+        let column_start: Vec<u32> = pattern.col_ptr().iter().map(|&c| c as u32).collect();
+        let mut block_column = vec![0u32];
+        for c in 0..n {
+            let first = column_start[*block_column.last().unwrap_or(&0) as usize];
+            if (column_start[c + 1] - first) as usize >= ENTRY_CHUNK {
+                block_column.push(c as u32 + 1);
+            }
+        }
+        if *block_column.last().unwrap_or(&0) as usize != n {
+            block_column.push(n as u32);
+        }
         Gather {
             matrix_start,
             matrix_source,
             function_start,
             function_source,
+            column_start,
+            block_column,
+            // Until the first `mark_live`, every target is visited.
+            live: vec![true; n],
+            written: vec![true; n],
         }
+    }
+
+    /// Marks the functions of the elements of `bins` that hold a particle as live,
+    /// the others not (once per step, after the particles are binned).
+    pub fn mark_live<T: Scalar, const D: usize, B: Basis<T, D>>(&mut self, basis: &B, bins: &Bins) {
+        self.live.iter_mut().for_each(|l| *l = false);
+        for e in 0..basis.num_elements() {
+            if bins.occupied(e) {
+                for &i in basis.element_functions(e) {
+                    self.live[i] = true;
+                }
+            }
+        }
+    }
+
+    /// Whether function `i` is live ([`Gather::mark_live`]).
+    #[inline]
+    pub(super) fn is_live(&self, i: usize) -> bool {
+        self.live[i]
+    }
+
+    /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order,
+    /// over the live columns; the entries of a column that is no longer live are
+    /// set to zero (what the sum over its empty elements gives).
+    pub(super) fn matrix_assign<T: Scalar, const D: usize>(
+        &mut self,
+        local: &Local<T, D>,
+        values: &mut [T],
+    ) {
+        let mut written = std::mem::take(&mut self.written);
+        let this = &*self;
+        split_columns(
+            &this.block_column,
+            &this.column_start,
+            values,
+            &mut written,
+            &|columns, first, values, written| {
+                for (w, c) in written.iter_mut().zip(columns) {
+                    let entries = this.column_start[c] as usize..this.column_start[c + 1] as usize;
+                    let slice = &mut values[entries.start - first..entries.end - first];
+                    if this.live[c] {
+                        for (v, j) in slice.iter_mut().zip(entries) {
+                            *v = this.entry_sum(local, j);
+                        }
+                        *w = true;
+                    } else if *w {
+                        slice.iter_mut().for_each(|v| *v = T::zero());
+                        *w = false;
+                    }
+                }
+            },
+        );
+        self.written = written;
+    }
+
+    /// `values_j += Σ` of the local matrix blocks' entries `j`, in element order,
+    /// over the live columns (the others would add `+0`).
+    pub(super) fn matrix_add<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        values: &mut [T],
+    ) {
+        split_columns(
+            &self.block_column,
+            &self.column_start,
+            values,
+            &mut [],
+            &|columns, first, values, _| {
+                for c in columns {
+                    if !self.live[c] {
+                        continue;
+                    }
+                    let entries = self.column_start[c] as usize..self.column_start[c + 1] as usize;
+                    for j in entries {
+                        values[j - first] += self.entry_sum(local, j);
+                    }
+                }
+            },
+        );
+    }
+
+    /// `Σ` of the local matrix blocks' entries `j`, in element order.
+    #[inline]
+    fn entry_sum<T: Scalar, const D: usize>(&self, local: &Local<T, D>, j: usize) -> T {
+        let mut sum = T::zero();
+        let sources = self.matrix_start[j] as usize..self.matrix_start[j + 1] as usize;
+        for &s in &self.matrix_source[sources] {
+            sum += local.matrix[s as usize];
+        }
+        sum
     }
 
     /// Whether the local buffers of `elements` elements of `stride` functions
@@ -223,32 +391,6 @@ impl Gather {
         elements
             .checked_mul(packed_len(stride))
             .is_some_and(|e| e < u32::MAX as usize)
-    }
-
-    /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order
-    /// (`values_j +=` with `add`).
-    pub(super) fn matrix<T: Scalar, const D: usize>(
-        &self,
-        local: &Local<T, D>,
-        add: bool,
-        values: &mut [T],
-    ) {
-        values
-            .par_iter_mut()
-            .with_min_len(ENTRY_CHUNK)
-            .enumerate()
-            .for_each(|(j, v)| {
-                let mut sum = T::zero();
-                let sources = self.matrix_start[j] as usize..self.matrix_start[j + 1] as usize;
-                for &s in &self.matrix_source[sources] {
-                    sum += local.matrix[s as usize];
-                }
-                if add {
-                    *v += sum;
-                } else {
-                    *v = sum;
-                }
-            });
     }
 
     /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in
@@ -264,6 +406,10 @@ impl Gather {
                 .with_min_len(ENTRY_CHUNK)
                 .enumerate()
                 .for_each(|(i, o)| {
+                    // A function that is not live would add `+0`.
+                    if !self.live[i] {
+                        return;
+                    }
                     let mut sum = T::zero();
                     let sources =
                         self.function_start[i] as usize..self.function_start[i + 1] as usize;
@@ -280,6 +426,42 @@ impl Gather {
     }
 }
 
+/// The work on one block of columns: `(columns, first entry, the columns' values,
+/// their flags)`.
+type ColumnBlockTask<'a, T> =
+    dyn Fn(std::ops::Range<usize>, usize, &mut [T], &mut [bool]) + Sync + 'a;
+
+/// Calls `f(columns, first entry, values of those columns, their flags)` on the
+/// blocks of columns `blocks` (first columns, and the number of columns at the
+/// end) in parallel: the slices are split at the blocks' first entries
+/// (`column_start`) by recursive halving, without allocation. `flags` is either
+/// one per column or empty.
+fn split_columns<T: Send>(
+    blocks: &[u32],
+    column_start: &[u32],
+    values: &mut [T],
+    flags: &mut [bool],
+    f: &ColumnBlockTask<'_, T>,
+) {
+    let (c0, c1) = (blocks[0] as usize, blocks[blocks.len() - 1] as usize);
+    if blocks.len() <= 2 {
+        f(c0..c1, column_start[c0] as usize, values, flags);
+        return;
+    }
+    let mid = blocks.len() / 2;
+    let cm = blocks[mid] as usize;
+    let (va, vb) = values.split_at_mut((column_start[cm] - column_start[c0]) as usize);
+    let (fa, fb) = if flags.is_empty() {
+        (&mut [][..], &mut [][..])
+    } else {
+        flags.split_at_mut(cm - c0)
+    };
+    rayon::join(
+        || split_columns(&blocks[..=mid], column_start, va, fa, f),
+        || split_columns(&blocks[mid..], column_start, vb, fb, f),
+    );
+}
+
 /// The element-local sums `Σ_{p in e} q(p, s)` of a per-slot vector `q` (slot
 /// `s` of particle `p`), then gathered: `out_{k,i} += Σ_p q_k(p, s_i)`.
 pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
@@ -292,22 +474,119 @@ pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
 ) where
     Q: Fn(usize, usize) -> SVector<T, D> + Sync,
 {
-    let stride = local.stride;
-    local
-        .vector
-        .par_chunks_mut(stride * D)
-        .with_min_len(ELEMENT_CHUNK)
-        .enumerate()
-        .for_each(|(e, lv)| {
-            lv.iter_mut().for_each(|v| *v = T::zero());
-            for &p in bins.particles(e) {
-                for (a, s) in evals.range(p).enumerate() {
-                    let f = q(p, s);
-                    for k in 0..D {
-                        lv[a * D + k] += f[k];
-                    }
+    local.par_vectors(bins).for_each(|(e, lv)| {
+        for &p in bins.particles(e) {
+            for (a, s) in evals.range(p).enumerate() {
+                let f = q(p, s);
+                for k in 0..D {
+                    lv[a * D + k] += f[k];
                 }
             }
-        });
+        }
+    });
     gather.functions(local, false, out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+
+    /// Fills the blocks of the occupied elements with values that depend on the
+    /// element, the entry and the round, then gathers the matrix and the vector.
+    fn round(
+        basis: &PowellSabin<f64>,
+        gather: &mut Gather,
+        local: &mut Local<f64, 2>,
+        bins: &Bins,
+        round: f64,
+        values: &mut [f64],
+        out: &mut [Vec<f64>],
+    ) {
+        gather.mark_live(basis, bins);
+        local.par_elements(bins).for_each(|(e, (lm, lv))| {
+            for (k, v) in lm.iter_mut().enumerate() {
+                *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
+            }
+            for (k, v) in lv.iter_mut().enumerate() {
+                *v = (e as f64 + 2.0) * 0.23 - k as f64 * 0.017 + round;
+            }
+        });
+        gather.matrix_assign(local, values);
+        out.iter_mut()
+            .for_each(|o| o.iter_mut().for_each(|v| *v = 0.0));
+        gather.functions(local, false, out);
+    }
+
+    /// The gathers over the live functions give, bit for bit, the sums over every
+    /// element of the blocks of the occupied ones, also after elements empty and
+    /// others fill (their blocks and entries are zeroed, not left stale).
+    #[test]
+    fn live_gathers_equal_the_full_sums_as_elements_empty_and_fill() {
+        let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 1.0, 0.0, 1.0, 6, 6).unwrap();
+        let basis = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+        let pattern = SymmetricPattern::new(&basis);
+        let (ne, n) = (basis.num_elements(), basis.num_functions());
+        let stride = basis.max_functions_per_element();
+        let mut gather = Gather::new(&basis, &pattern, stride);
+        let mut local = Local::<f64, 2>::new(ne, stride);
+        let mut bins = Bins::new(ne, 6);
+        let mut values = vec![0.0; pattern.nnz()];
+        let mut out = vec![vec![0.0; n]; 2];
+        for (r, elements) in [
+            [0, 0, 1, 5, 5, 7],
+            [5, 9, 9, 30, 31, 31],
+            [40, 41, 42, 43, 44, 45],
+        ]
+        .iter()
+        .enumerate()
+        {
+            bins.fill(elements);
+            round(
+                &basis,
+                &mut gather,
+                &mut local,
+                &bins,
+                r as f64,
+                &mut values,
+                &mut out,
+            );
+            // The full sums, from the blocks of the occupied elements alone.
+            let occupied = |s: usize, per: usize| bins.occupied(s / per);
+            let per = packed_len(stride);
+            for (j, v) in values.iter().enumerate() {
+                let mut sum = 0.0;
+                for &s in &gather.matrix_source
+                    [gather.matrix_start[j] as usize..gather.matrix_start[j + 1] as usize]
+                {
+                    if occupied(s as usize, per) {
+                        sum += local.matrix[s as usize];
+                    }
+                }
+                assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, entry {j}");
+            }
+            for (k, o) in out.iter().enumerate() {
+                for (i, v) in o.iter().enumerate() {
+                    let mut sum = 0.0;
+                    for &s in &gather.function_source
+                        [gather.function_start[i] as usize..gather.function_start[i + 1] as usize]
+                    {
+                        if occupied(s as usize, stride) {
+                            sum += local.vector[s as usize * 2 + k];
+                        }
+                    }
+                    assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, function {i}");
+                }
+            }
+            assert!(values.iter().any(|&v| v != 0.0));
+        }
+        // The blocks of the elements emptied in the last round are zero.
+        for e in [0, 1, 5, 7, 9, 30, 31] {
+            assert!(
+                local.matrix[e * packed_len(stride)..(e + 1) * packed_len(stride)]
+                    .iter()
+                    .all(|&v| v == 0.0)
+            );
+        }
+    }
 }

@@ -397,6 +397,7 @@ where
             &mut self.scratch,
             &mut self.evals,
         )
+        .inspect(|_| self.gather.mark_live(&self.basis, &self.bins))
         .map_err(|o| {
             let p = o.particle;
             let speed = self.particles.v[p].norm().to_f64();
@@ -419,7 +420,7 @@ where
             &self.particles,
             &self.evals,
             &self.bins,
-            &self.gather,
+            &mut self.gather,
             &mut self.local,
             if self.inputs.needs.row_sums_only {
                 phases::MassMatrix::RowSums

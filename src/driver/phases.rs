@@ -28,7 +28,7 @@ use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 
 pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local};
-use super::binning::{packed, ELEMENT_CHUNK, ENTRY_CHUNK};
+use super::binning::{packed, ENTRY_CHUNK};
 
 /// Particles per parallel task of the per-particle phases: fixed, so that the
 /// split (and with it every result) does not depend on the number of threads.
@@ -165,7 +165,7 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
     bins: &Bins,
-    gather: &Gather,
+    gather: &mut Gather,
     local: &mut Local<T, D>,
     matrix: MassMatrix,
     values: &mut [T],
@@ -173,7 +173,7 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
 ) {
     let stride = local.stride;
     let full = matrix == MassMatrix::Full;
-    local.par_elements().for_each(|(e, (lm, lv))| {
+    local.par_elements(bins).for_each(|(e, (lm, lv))| {
         let inside = bins.particles(e);
         // Every particle of an element has the element's functions; with as many
         // as the stride (every PS and PL element) the block is summed in a
@@ -193,7 +193,7 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
         }
         element_block_any(inside, particles, evals, stride, full, lm, lv);
     });
-    gather.matrix(local, false, values);
+    gather.matrix_assign(local, values);
     zero(force);
     gather.functions(local, true, force);
 }
@@ -361,7 +361,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             .iter()
             .any(|&i| lumped[i as usize])
     };
-    local.par_elements().for_each(|(e, (lm, g))| {
+    local.par_elements(bins).for_each(|(e, (lm, g))| {
         let inside = bins.particles(e);
         if !inside.iter().any(|&p| touches_lumped(p)) {
             return;
@@ -428,7 +428,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             }
         }
     });
-    gather.matrix(local, true, values);
+    gather.matrix_add(local, values);
 }
 
 /// The spread `α` of [`add_affine_lumping`]: an element's particles determine an
@@ -783,27 +783,25 @@ pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
     out: &mut [&mut [f64]],
 ) {
     assert!(weights.len() <= D && weights.len() == out.len());
-    let stride = local.stride;
-    local
-        .vector
-        .par_chunks_mut(stride * D)
-        .with_min_len(ELEMENT_CHUNK)
-        .enumerate()
-        .for_each(|(e, lv)| {
-            lv.iter_mut().for_each(|v| *v = T::zero());
-            for &p in bins.particles(e) {
-                for (a, s) in evals.range(p).enumerate() {
-                    for (k, w) in weights.iter().enumerate() {
-                        lv[a * D + k] += w[p] * evals.phi[s];
-                    }
+    local.par_vectors(bins).for_each(|(e, lv)| {
+        for &p in bins.particles(e) {
+            for (a, s) in evals.range(p).enumerate() {
+                for (k, w) in weights.iter().enumerate() {
+                    lv[a * D + k] += w[p] * evals.phi[s];
                 }
             }
-        });
+        }
+    });
     for (k, out) in out.iter_mut().enumerate() {
         out.par_iter_mut()
             .with_min_len(ENTRY_CHUNK)
             .enumerate()
             .for_each(|(i, o)| {
+                // A function that is not live sums `+0`.
+                if !gather.is_live(i) {
+                    *o = 0.0;
+                    return;
+                }
                 let mut sum = 0.0;
                 let sources =
                     gather.function_start[i] as usize..gather.function_start[i + 1] as usize;
