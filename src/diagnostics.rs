@@ -137,7 +137,7 @@ pub fn particle_terms<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
         &parts.v[p],
         parts.volume0[p],
         &parts.f[p],
-        &parts.sigma0[p],
+        &parts.initial_stress(p),
         material.energy_density(p, &parts.f[p]),
     )
 }

@@ -19,8 +19,9 @@ pub struct Particles<T: Scalar, const D: usize> {
     pub f: Vec<SMatrix<T, D, D>>,
     /// Cauchy stresses `σ_p`.
     pub sigma: Vec<SMatrix<T, D, D>>,
-    /// Initial stresses `σ⁰_p`, added to the material's stress (zero unless a scene
-    /// declares an initial-stress state).
+    /// Initial stresses `σ⁰_p`, added to the material's stress; empty when no
+    /// particle has one (a scene without an initial-stress state), which saves
+    /// their bytes: read them with [`Particles::initial_stress`].
     pub sigma0: Vec<SMatrix<T, D, D>>,
     /// Initial volumes `V_p⁰`.
     pub volume0: Vec<T>,
@@ -43,12 +44,19 @@ impl<T: Scalar, const D: usize> Particles<T, D> {
             u: vec![SVector::zeros(); n],
             f: vec![SMatrix::identity(); n],
             sigma: vec![SMatrix::zeros(); n],
-            sigma0: vec![SMatrix::zeros(); n],
+            sigma0: Vec::new(),
             mass: volumes.iter().map(|&v| v * rho).collect(),
             volume0: volumes.clone(),
             volume: volumes,
             element: vec![0; n],
         }
+    }
+
+    /// The initial stress `σ⁰_p` of particle `p` (zero when [`Particles::sigma0`]
+    /// is empty).
+    #[inline]
+    pub fn initial_stress(&self, p: usize) -> SMatrix<T, D, D> {
+        self.sigma0.get(p).copied().unwrap_or_else(SMatrix::zeros)
     }
 
     /// Number of particles.

@@ -212,7 +212,7 @@ where
                     })
                 }
             }
-            particles.sigma[p] = particles.sigma0[p] + material.stress(p, &particles.f[p]);
+            particles.sigma[p] = particles.initial_stress(p) + material.stress(p, &particles.f[p]);
         }
         let scratch = |needed: bool| {
             if needed {

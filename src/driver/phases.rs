@@ -673,6 +673,8 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
     parts: &mut Particles<T, D>,
     energy: &mut [[f64; 8]],
 ) -> Result<(), UpdateFailure> {
+    // Empty when no particle has an initial stress (then it is zero).
+    let sigma0 = &parts.sigma0;
     let failure = (
         (
             parts.f.par_chunks_mut(CHUNK),
@@ -680,7 +682,6 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
             parts.volume.par_chunks_mut(CHUNK),
             parts.x.par_chunks_mut(CHUNK),
             parts.u.par_chunks_mut(CHUNK),
-            parts.sigma0.par_chunks(CHUNK),
         ),
         (
             parts.volume0.par_chunks(CHUNK),
@@ -692,7 +693,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
         .into_par_iter()
         .enumerate()
         .filter_map(
-            |(c, ((fs, sigma, volume, x, u, sigma0), (volume0, v, mass, energy)))| {
+            |(c, ((fs, sigma, volume, x, u), (volume0, v, mass, energy)))| {
                 *energy = [0.0; 8];
                 for q in 0..fs.len() {
                     let p = c * CHUNK + q;
@@ -717,13 +718,14 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
                         });
                     }
                     fs[q] = f;
-                    sigma[q] = sigma0[q] + material.stress(p, &f);
+                    let s0 = sigma0.get(p).copied().unwrap_or_else(SMatrix::zeros);
+                    sigma[q] = s0 + material.stress(p, &f);
                     volume[q] = volume0[q] * j;
                     x[q] += v_hat * dt;
                     u[q] += v_hat * dt;
                     let w = material.energy_density(p, &f);
                     let terms =
-                        crate::diagnostics::terms_of(mass[q], &v[q], volume0[q], &f, &sigma0[q], w);
+                        crate::diagnostics::terms_of(mass[q], &v[q], volume0[q], &f, &s0, w);
                     crate::diagnostics::accumulate_terms(energy, &terms);
                     if !x[q].iter().all(|c| c.to_f64().is_finite())
                         || !v[q].iter().all(|c| c.to_f64().is_finite())

@@ -313,6 +313,9 @@ fn initial_stress<const D: usize>(
                     k0: *k0,
                 };
                 let s: SMatrix<f64, D, D> = state.sigma0(&particles.x0[p]);
+                if particles.sigma0.is_empty() {
+                    particles.sigma0 = vec![SMatrix::zeros(); particles.len()];
+                }
                 particles.sigma0[p] += s;
             }
         }
