@@ -219,6 +219,13 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
             for s in summaries {
                 if let Some(reason) = &s.failure {
                     println!("{} {}: {reason}", s.basis, s.mass);
+                } else if !s.stable {
+                    println!(
+                        "{} {}: UNSTABLE: {}",
+                        s.basis,
+                        s.mass,
+                        crate::run::unstable_reason(s)
+                    );
                 }
             }
         }

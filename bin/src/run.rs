@@ -607,8 +607,9 @@ pub fn time_step_line(r: &StepReport) -> String {
     }
 }
 
-/// Which bound of the verdict an unstable run that did not fail broke.
-fn unstable_reason(summary: &Summary) -> String {
+/// Which bound of the verdict an unstable run that did not fail broke (with the
+/// energy growth's hint).
+pub fn unstable_reason(summary: &Summary) -> String {
     match summary.max_condition {
         Some(c) if c >= simulation::STABLE_CONDITION => format!(
             "condition estimate {} ≥ {}",

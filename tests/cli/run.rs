@@ -374,5 +374,13 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
     ] {
         assert!(stderr.contains(part), "`{part}` not in: {stderr}");
     }
+    // `compare` says it under its table, for the variant.
+    let out = cli().args(["compare"]).arg(&path).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        stdout.contains("ps extended-hybrid: UNSTABLE: energy growth")
+            && stdout.contains("lower `time.courant` (to 0.25, say)"),
+        "{stdout}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
