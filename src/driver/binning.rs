@@ -121,24 +121,7 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         &'a mut self,
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
-        let stride = self.stride;
-        (
-            self.matrix.par_chunks_mut(packed_len(stride)),
-            self.vector.par_chunks_mut(stride * D),
-            self.dirty.par_iter_mut(),
-        )
-            .into_par_iter()
-            .with_min_len(ELEMENT_CHUNK)
-            .enumerate()
-            .filter_map(move |(e, (lm, lv, dirty))| {
-                let occupied = bins.occupied(e);
-                if occupied || *dirty {
-                    lm.iter_mut().for_each(|v| *v = T::zero());
-                    lv.iter_mut().for_each(|v| *v = T::zero());
-                }
-                *dirty = occupied;
-                occupied.then_some((e, (lm, lv)))
-            })
+        self.occupied_blocks(bins, true)
     }
 
     /// The local vector of each element that holds a particle in `bins`, zeroed
@@ -147,6 +130,18 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         &'a mut self,
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, &'a mut [T])> + 'a {
+        self.occupied_blocks(bins, false)
+            .map(|(e, (_, lv))| (e, lv))
+    }
+
+    /// The blocks of the occupied elements, the vector zeroed and the matrix block
+    /// too with `matrix`; an element emptied since the last call has both zeroed
+    /// and is skipped, so that every unoccupied element's blocks stay zero.
+    fn occupied_blocks<'a>(
+        &'a mut self,
+        bins: &'a Bins,
+        matrix: bool,
+    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
         let stride = self.stride;
         (
             self.matrix.par_chunks_mut(packed_len(stride)),
@@ -158,14 +153,14 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             .enumerate()
             .filter_map(move |(e, (lm, lv, dirty))| {
                 let occupied = bins.occupied(e);
-                if occupied {
-                    lv.iter_mut().for_each(|v| *v = T::zero());
-                } else if *dirty {
+                if (occupied && matrix) || (!occupied && *dirty) {
                     lm.iter_mut().for_each(|v| *v = T::zero());
+                }
+                if occupied || *dirty {
                     lv.iter_mut().for_each(|v| *v = T::zero());
                 }
                 *dirty = occupied;
-                occupied.then_some((e, lv))
+                occupied.then_some((e, (lm, lv)))
             })
     }
 
@@ -504,13 +499,20 @@ mod tests {
         out: &mut [Vec<f64>],
     ) {
         gather.mark_live(basis, bins);
+        let vector = |e: usize, lv: &mut [f64]| {
+            for (k, v) in lv.iter_mut().enumerate() {
+                *v = (e as f64 + 2.0) * 0.23 - k as f64 * 0.017 + round;
+            }
+        };
+        // The odd rounds visit the vectors first, as a step's first scatter does.
+        if round as usize % 2 == 1 {
+            local.par_vectors(bins).for_each(|(e, lv)| vector(e, lv));
+        }
         local.par_elements(bins).for_each(|(e, (lm, lv))| {
             for (k, v) in lm.iter_mut().enumerate() {
                 *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
             }
-            for (k, v) in lv.iter_mut().enumerate() {
-                *v = (e as f64 + 2.0) * 0.23 - k as f64 * 0.017 + round;
-            }
+            vector(e, lv);
         });
         gather.matrix_assign(local, values);
         out.iter_mut()
