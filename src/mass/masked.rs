@@ -51,6 +51,144 @@ pub(super) fn modify_rows<T: Scalar>(
     }
 }
 
+/// Kept rows below this share of the functions are factorised alone
+/// ([`Compact`]); above it the whole pattern is, masked rows on the diagonal.
+const COMPACT_BELOW: f64 = 0.25;
+
+/// One fixed set's system restricted to its kept rows (neither fixed nor
+/// inactive), for a body that covers a small part of the mesh: the same entries
+/// as the masked system's kept block (`modify_rows`' rules, in the same order),
+/// factorised without the masked rows, whose solution is zero anyway. The
+/// symbolic factorisation is kept while the kept rows stay the same.
+struct Compact<T: Scalar> {
+    /// The kept rows, ascending.
+    rows: Vec<usize>,
+    /// Upper triangle in compressed columns over the kept rows.
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// Per compact entry, the position of its entry in the full pattern.
+    source: Vec<usize>,
+    values: Vec<T>,
+    solver: SparseCholesky<T>,
+    /// Right-hand side and work vectors over the kept rows.
+    rhs: Vec<T>,
+    work: [Vec<T>; 2],
+}
+
+impl<T: Scalar> Compact<T> {
+    /// The compact pattern of `rows` (ascending) in `pattern`; `slot` maps a
+    /// function to its compact index (`usize::MAX` when not kept), restored to
+    /// `usize::MAX` before returning.
+    fn new(pattern: &SymmetricPattern, rows: Vec<usize>, slot: &mut [usize]) -> Self {
+        for (q, &i) in rows.iter().enumerate() {
+            slot[i] = q;
+        }
+        let (ptr, idx) = (pattern.col_ptr(), pattern.row_idx());
+        let mut col_ptr = Vec::with_capacity(rows.len() + 1);
+        let (mut row_idx, mut source) = (Vec::new(), Vec::new());
+        col_ptr.push(0);
+        for &c in &rows {
+            // Rows are sorted within a column and `slot` grows with the index, so
+            // the compact rows stay sorted.
+            for k in ptr[c]..ptr[c + 1] {
+                let q = slot[idx[k]];
+                if q != usize::MAX {
+                    row_idx.push(q);
+                    source.push(k);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        for &i in &rows {
+            slot[i] = usize::MAX;
+        }
+        let m = rows.len();
+        let solver = SparseCholesky::from_upper(col_ptr.clone(), row_idx.clone(), 1);
+        Compact {
+            values: vec![T::zero(); source.len()],
+            rhs: vec![T::zero(); m],
+            work: [vec![T::zero(); m], vec![T::zero(); m]],
+            rows,
+            col_ptr,
+            row_idx,
+            source,
+            solver,
+        }
+    }
+
+    /// `M'` on the kept rows (`modify_rows` restricted to them: a lumped row's
+    /// off-diagonal entries onto both diagonals), then its factorisation.
+    fn factorize(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        lumped: &[bool],
+        diagonal_add: &mut [T],
+    ) -> Result<(), NotPositiveDefinite> {
+        let idx = pattern.row_idx();
+        for &i in &self.rows {
+            diagonal_add[i] = T::zero();
+        }
+        for (q, &c) in self.rows.iter().enumerate() {
+            for t in self.col_ptr[q]..self.col_ptr[q + 1] {
+                let k = self.source[t];
+                let r = idx[k];
+                self.values[t] = if r == c {
+                    values[k]
+                } else if lumped[r] || lumped[c] {
+                    diagonal_add[r] += values[k];
+                    diagonal_add[c] += values[k];
+                    T::zero()
+                } else {
+                    values[k]
+                };
+            }
+        }
+        for (q, &i) in self.rows.iter().enumerate() {
+            // The diagonal is the last entry of its (upper) column.
+            self.values[self.col_ptr[q + 1] - 1] += diagonal_add[i];
+        }
+        self.solver.factorize(&self.values)
+    }
+
+    /// Solves for the kept rows of `rhs` (its other rows are zero, and stay so).
+    fn solve(&mut self, rhs: &mut [T]) {
+        for (v, &i) in self.rhs.iter_mut().zip(&self.rows) {
+            *v = rhs[i];
+        }
+        self.solver.solve_in_place(&mut self.rhs, 1);
+        for (v, &i) in self.rhs.iter().zip(&self.rows) {
+            rhs[i] = *v;
+        }
+    }
+
+    /// The condition estimate of the kept system.
+    fn condition_estimate(&mut self) -> f64 {
+        let (col_ptr, row_idx, values) = (&self.col_ptr, &self.row_idx, &self.values);
+        let solver = &mut self.solver;
+        let mut op = Operator {
+            apply: &mut |x: &[T], y: &mut [T]| {
+                y.iter_mut().for_each(|v| *v = T::zero());
+                for c in 0..col_ptr.len() - 1 {
+                    for k in col_ptr[c]..col_ptr[c + 1] {
+                        let (r, a) = (row_idx[k], values[k]);
+                        y[r] += a * x[c];
+                        if r != c {
+                            y[c] += a * x[r];
+                        }
+                    }
+                }
+            },
+            solve: &mut |y: &mut [T]| {
+                solver.solve_in_place(y, 1);
+                Ok(())
+            },
+        };
+        let [x, y] = &mut self.work;
+        estimate(&mut op, x, y)
+    }
+}
+
 /// One factorisation per distinct set of fixed coefficients.
 #[derive(Default)]
 pub(super) struct MaskedCholesky<T: Scalar> {
@@ -69,6 +207,13 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     /// The failure of each set's last factorisation.
     failed: Vec<Option<NotPositiveDefinite>>,
     work: [Vec<T>; 2],
+    /// Per fixed set, its kept rows' system when they are fewer than
+    /// [`COMPACT_BELOW`] of the functions, and whether this step uses it.
+    compact: Vec<Option<Compact<T>>>,
+    use_compact: Vec<bool>,
+    /// Function → compact index, `usize::MAX` between uses; kept rows of a set.
+    slot: Vec<usize>,
+    kept: Vec<usize>,
 }
 
 impl<T: Scalar> MaskedCholesky<T> {
@@ -91,12 +236,34 @@ impl<T: Scalar> MaskedCholesky<T> {
         self.diagonal_add = vec![vec![T::zero(); n]; self.fixed.len()];
         self.failed = vec![None; self.fixed.len()];
         self.work = [vec![T::zero(); n], vec![T::zero(); n]];
+        self.compact = self.fixed.iter().map(|_| None).collect();
+        self.use_compact = vec![false; self.fixed.len()];
+        self.slot = vec![usize::MAX; n];
+        self.kept = Vec::with_capacity(n);
+    }
+
+    /// For each fixed set, whether its kept rows are few enough to be factorised
+    /// alone, and (re)builds their compact pattern when they changed.
+    fn choose_compact(&mut self, pattern: &SymmetricPattern) {
+        let n = pattern.dim();
+        for s in 0..self.fixed.len() {
+            let fixed = &self.fixed[s];
+            self.kept.clear();
+            self.kept
+                .extend((0..n).filter(|&i| !(fixed[i] || self.inactive[i])));
+            let compact = (self.kept.len() as f64) < COMPACT_BELOW * n as f64;
+            self.use_compact[s] = compact;
+            if compact && self.compact[s].as_ref().is_none_or(|c| c.rows != self.kept) {
+                self.compact[s] = Some(Compact::new(pattern, self.kept.clone(), &mut self.slot));
+            }
+        }
     }
 
     /// Factorises `M'` for the current [`inactive`](Self::inactive) and
     /// [`lumped`](Self::lumped) marks.
     pub fn factorize(&mut self, pattern: &SymmetricPattern, values: &[T]) -> Result<(), MassError> {
         let n = pattern.dim();
+        self.choose_compact(pattern);
         // Masked rows get the mean active diagonal: the value does not matter for the
         // solution (their right-hand side is zero) but keeps the condition estimate
         // about the active system.
@@ -115,25 +282,39 @@ impl<T: Scalar> MaskedCholesky<T> {
         // failure in set order reported.
         let (inactive, lumped) = (&self.inactive, &self.lumped);
         (
-            self.fixed.par_iter(),
-            self.diagonal_add.par_iter_mut(),
-            self.modified.par_iter_mut(),
-            self.solvers.par_iter_mut(),
-            self.failed.par_iter_mut(),
+            (
+                self.fixed.par_iter(),
+                self.diagonal_add.par_iter_mut(),
+                self.modified.par_iter_mut(),
+                self.solvers.par_iter_mut(),
+            ),
+            (
+                self.failed.par_iter_mut(),
+                self.compact.par_iter_mut(),
+                self.use_compact.par_iter(),
+            ),
         )
             .into_par_iter()
-            .for_each(|(fixed, diagonal_add, modified, solver, failed)| {
-                modify_rows(
-                    pattern,
-                    values,
-                    lumped,
-                    |i| fixed[i] || inactive[i],
-                    scale,
-                    diagonal_add,
-                    modified,
-                );
-                *failed = solver.factorize(modified).err();
-            });
+            .for_each(
+                |((fixed, diagonal_add, modified, solver), (failed, compact, &use_compact))| {
+                    if let (true, Some(compact)) = (use_compact, compact.as_mut()) {
+                        *failed = compact
+                            .factorize(pattern, values, lumped, diagonal_add)
+                            .err();
+                        return;
+                    }
+                    modify_rows(
+                        pattern,
+                        values,
+                        lumped,
+                        |i| fixed[i] || inactive[i],
+                        scale,
+                        diagonal_add,
+                        modified,
+                    );
+                    *failed = solver.factorize(modified).err();
+                },
+            );
         if let Some(failure) = self.failed.iter().flatten().next() {
             return Err(MassError::from(failure.clone()));
         }
@@ -142,7 +323,11 @@ impl<T: Scalar> MaskedCholesky<T> {
 
     pub fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         self.mask(k, rhs);
-        self.solvers[self.solver_of[k]].solve_in_place(rhs, 1);
+        let s = self.solver_of[k];
+        match (self.use_compact[s], self.compact[s].as_mut()) {
+            (true, Some(compact)) => compact.solve(rhs),
+            _ => self.solvers[s].solve_in_place(rhs, 1),
+        }
         Ok(())
     }
 
@@ -170,11 +355,31 @@ impl<T: Scalar> MaskedCholesky<T> {
                 } else {
                     (&mut high[0], &mut low[b])
                 };
-                rayon::join(|| s0.solve_in_place(r0, 1), || s1.solve_in_place(r1, 1));
+                let (clow, chigh) = self.compact.split_at_mut(a.max(b));
+                let (c0, c1) = if a < b {
+                    (&mut clow[a], &mut chigh[0])
+                } else {
+                    (&mut chigh[0], &mut clow[b])
+                };
+                let (u0, u1) = (self.use_compact[a], self.use_compact[b]);
+                let one = |solver: &mut SparseCholesky<T>,
+                           compact: &mut Option<Compact<T>>,
+                           use_compact: bool,
+                           r: &mut [T]| {
+                    match (use_compact, compact.as_mut()) {
+                        (true, Some(c)) => c.solve(r),
+                        _ => solver.solve_in_place(r, 1),
+                    }
+                };
+                rayon::join(|| one(s0, c0, u0, r0), || one(s1, c1, u1, r1));
             }
             (rhs, _) => {
                 for (k, r) in rhs.iter_mut().enumerate() {
-                    self.solvers[self.solver_of[k]].solve_in_place(r, 1);
+                    let s = self.solver_of[k];
+                    match (self.use_compact[s], self.compact[s].as_mut()) {
+                        (true, Some(c)) => c.solve(r),
+                        _ => self.solvers[s].solve_in_place(r, 1),
+                    }
                 }
             }
         }
@@ -186,6 +391,10 @@ impl<T: Scalar> MaskedCholesky<T> {
     pub fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         let mut worst = 0.0f64;
         for s in 0..self.solvers.len() {
+            if let (true, Some(compact)) = (self.use_compact[s], self.compact[s].as_mut()) {
+                worst = worst.max(compact.condition_estimate());
+                continue;
+            }
             let (values, solver) = (&self.modified[s], &mut self.solvers[s]);
             let mut op = Operator {
                 apply: &mut |x: &[T], y: &mut [T]| pattern.mul_vec(values, x, y),
