@@ -7,7 +7,7 @@
 
 use super::condition::{estimate, Operator};
 use super::{distinct_fixed_sets, MassError, MassSetup};
-use crate::sparse::{NotPositiveDefinite, Scalar, SparseCholesky, SymmetricPattern};
+use crate::sparse::{mul_upper, NotPositiveDefinite, Scalar, SparseCholesky, SymmetricPattern};
 use rayon::prelude::*;
 
 /// `out = M'`: `values` (`M` in `pattern`) with the rows and columns where
@@ -37,12 +37,8 @@ pub(super) fn modify_rows<T: Scalar>(
                 }
             } else if masked(r) || masked(c) {
                 T::zero()
-            } else if lumped[r] || lumped[c] {
-                diagonal_add[r] += values[k];
-                diagonal_add[c] += values[k];
-                T::zero()
             } else {
-                values[k]
+                off_diagonal(r, c, values[k], lumped, diagonal_add)
             };
         }
     }
@@ -135,12 +131,8 @@ impl<T: Scalar> Compact<T> {
                 let r = idx[k];
                 self.values[t] = if r == c {
                     values[k]
-                } else if lumped[r] || lumped[c] {
-                    diagonal_add[r] += values[k];
-                    diagonal_add[c] += values[k];
-                    T::zero()
                 } else {
-                    values[k]
+                    off_diagonal(r, c, values[k], lumped, diagonal_add)
                 };
             }
         }
@@ -167,18 +159,7 @@ impl<T: Scalar> Compact<T> {
         let (col_ptr, row_idx, values) = (&self.col_ptr, &self.row_idx, &self.values);
         let solver = &mut self.solver;
         let mut op = Operator {
-            apply: &mut |x: &[T], y: &mut [T]| {
-                y.iter_mut().for_each(|v| *v = T::zero());
-                for c in 0..col_ptr.len() - 1 {
-                    for k in col_ptr[c]..col_ptr[c + 1] {
-                        let (r, a) = (row_idx[k], values[k]);
-                        y[r] += a * x[c];
-                        if r != c {
-                            y[c] += a * x[r];
-                        }
-                    }
-                }
-            },
+            apply: &mut |x: &[T], y: &mut [T]| mul_upper(col_ptr, row_idx, values, x, y),
             solve: &mut |y: &mut [T]| {
                 solver.solve_in_place(y, 1);
                 Ok(())
@@ -186,6 +167,25 @@ impl<T: Scalar> Compact<T> {
         };
         let [x, y] = &mut self.work;
         estimate(&mut op, x, y)
+    }
+}
+
+/// The entry `(r, c)`, `r ≠ c`, of `M'` for `M_rc = value`: moved onto both
+/// diagonals (`diagonal_add`) when either row is lumped, else kept.
+#[inline]
+fn off_diagonal<T: Scalar>(
+    r: usize,
+    c: usize,
+    value: T,
+    lumped: &[bool],
+    diagonal_add: &mut [T],
+) -> T {
+    if lumped[r] || lumped[c] {
+        diagonal_add[r] += value;
+        diagonal_add[c] += value;
+        T::zero()
+    } else {
+        value
     }
 }
 
