@@ -56,7 +56,7 @@ impl<T: Scalar, const D: usize> Particles<T, D> {
     /// is empty).
     #[inline]
     pub fn initial_stress(&self, p: usize) -> SMatrix<T, D, D> {
-        self.sigma0.get(p).copied().unwrap_or_else(SMatrix::zeros)
+        initial_stress(&self.sigma0, p)
     }
 
     /// Number of particles.
@@ -68,4 +68,14 @@ impl<T: Scalar, const D: usize> Particles<T, D> {
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
     }
+}
+
+/// `σ⁰_p` from [`Particles::sigma0`] (zero when it is empty), for loops that
+/// borrow the particles' fields apart.
+#[inline]
+pub fn initial_stress<T: Scalar, const D: usize>(
+    sigma0: &[SMatrix<T, D, D>],
+    p: usize,
+) -> SMatrix<T, D, D> {
+    sigma0.get(p).copied().unwrap_or_else(SMatrix::zeros)
 }

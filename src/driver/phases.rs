@@ -375,24 +375,9 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             let (base, m) = (range.start, range.len());
             let index = &evals.index[base..base + m];
             let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
-            if functions_affine {
-                // `g ≡ 0`: the share `θ` of the plain pairs alone.
-                for a in 0..m {
-                    for b in a + 1..m {
-                        let (i, j) = (index[a] as usize, index[b] as usize);
-                        if !(lumped[i] || lumped[j]) {
-                            continue;
-                        }
-                        let w = theta * mass[p] * phi[a] * phi[b];
-                        lm[packed(stride, a, a)] += w;
-                        lm[packed(stride, b, b)] += w;
-                        lm[packed(stride, a, b)] -= w;
-                    }
-                }
-                continue;
-            }
             // The pairs' Laplacian `L` goes straight into `lm`; `A = L Ξ` (row `a` in
-            // `g[a D..(a + 1) D]`) and `B = Ξᵀ L Ξ` are gathered beside it.
+            // `g[a D..(a + 1) D]`) and `B = Ξᵀ L Ξ` are gathered beside it. With
+            // affine functions `g ≡ 0`: the share `θ` of `L` alone.
             let a_rows = &mut g[..m * D];
             a_rows.iter_mut().for_each(|v| *v = T::zero());
             let row = |a: &[T], c: usize| SVector::<T, D>::from_fn(|r, _| a[c * D + r]);
@@ -400,13 +385,20 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             for a in 0..m {
                 for b in a + 1..m {
                     let (i, j) = (index[a] as usize, index[b] as usize);
-                    let w = mass[p] * phi[a] * phi[b];
+                    let w = if functions_affine {
+                        theta * mass[p] * phi[a] * phi[b]
+                    } else {
+                        mass[p] * phi[a] * phi[b]
+                    };
                     if !(lumped[i] || lumped[j]) || w == T::zero() {
                         continue;
                     }
                     lm[packed(stride, a, a)] += w;
                     lm[packed(stride, b, b)] += w;
                     lm[packed(stride, a, b)] -= w;
+                    if functions_affine {
+                        continue;
+                    }
                     let d = points[i] - points[j];
                     for r in 0..D {
                         a_rows[a * D + r] += d[r] * w;
@@ -414,6 +406,9 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                     }
                     b_form += d * d.transpose() * w;
                 }
+            }
+            if functions_affine {
+                continue;
             }
             // `H L Hᵀ − L = −G Aᵀ − A Gᵀ + G B Gᵀ`; where the element's particles do
             // not pin an affine field, a share `θ` of the plain pairs stays.
@@ -718,7 +713,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
                         });
                     }
                     fs[q] = f;
-                    let s0 = sigma0.get(p).copied().unwrap_or_else(SMatrix::zeros);
+                    let s0 = crate::particles::initial_stress(sigma0, p);
                     sigma[q] = s0 + material.stress(p, &f);
                     volume[q] = volume0[q] * j;
                     x[q] += v_hat * dt;

@@ -189,6 +189,18 @@ fn off_diagonal<T: Scalar>(
     }
 }
 
+/// Solves one fixed set's system: on its kept rows when it has a compact one.
+fn solve_one<T: Scalar>(
+    solver: &mut SparseCholesky<T>,
+    compact: &mut Option<Compact<T>>,
+    rhs: &mut [T],
+) {
+    match compact {
+        Some(c) => c.solve(rhs),
+        None => solver.solve_in_place(rhs, 1),
+    }
+}
+
 /// One factorisation per distinct set of fixed coefficients.
 #[derive(Default)]
 pub(super) struct MaskedCholesky<T: Scalar> {
@@ -208,9 +220,8 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     failed: Vec<Option<NotPositiveDefinite>>,
     work: [Vec<T>; 2],
     /// Per fixed set, its kept rows' system when they are fewer than
-    /// [`COMPACT_BELOW`] of the functions, and whether this step uses it.
+    /// [`COMPACT_BELOW`] of the functions (else `None`: the whole pattern).
     compact: Vec<Option<Compact<T>>>,
-    use_compact: Vec<bool>,
     /// Function → compact index, `usize::MAX` between uses; kept rows of a set.
     slot: Vec<usize>,
     kept: Vec<usize>,
@@ -237,7 +248,6 @@ impl<T: Scalar> MaskedCholesky<T> {
         self.failed = vec![None; self.fixed.len()];
         self.work = [vec![T::zero(); n], vec![T::zero(); n]];
         self.compact = self.fixed.iter().map(|_| None).collect();
-        self.use_compact = vec![false; self.fixed.len()];
         self.slot = vec![usize::MAX; n];
         self.kept = Vec::with_capacity(n);
     }
@@ -251,9 +261,9 @@ impl<T: Scalar> MaskedCholesky<T> {
             self.kept.clear();
             self.kept
                 .extend((0..n).filter(|&i| !(fixed[i] || self.inactive[i])));
-            let compact = (self.kept.len() as f64) < COMPACT_BELOW * n as f64;
-            self.use_compact[s] = compact;
-            if compact && self.compact[s].as_ref().is_none_or(|c| c.rows != self.kept) {
+            if (self.kept.len() as f64) >= COMPACT_BELOW * n as f64 {
+                self.compact[s] = None;
+            } else if self.compact[s].as_ref().is_none_or(|c| c.rows != self.kept) {
                 self.compact[s] = Some(Compact::new(pattern, self.kept.clone(), &mut self.slot));
             }
         }
@@ -288,16 +298,12 @@ impl<T: Scalar> MaskedCholesky<T> {
                 self.modified.par_iter_mut(),
                 self.solvers.par_iter_mut(),
             ),
-            (
-                self.failed.par_iter_mut(),
-                self.compact.par_iter_mut(),
-                self.use_compact.par_iter(),
-            ),
+            (self.failed.par_iter_mut(), self.compact.par_iter_mut()),
         )
             .into_par_iter()
             .for_each(
-                |((fixed, diagonal_add, modified, solver), (failed, compact, &use_compact))| {
-                    if let (true, Some(compact)) = (use_compact, compact.as_mut()) {
+                |((fixed, diagonal_add, modified, solver), (failed, compact))| {
+                    if let Some(compact) = compact.as_mut() {
                         *failed = compact
                             .factorize(pattern, values, lumped, diagonal_add)
                             .err();
@@ -324,10 +330,7 @@ impl<T: Scalar> MaskedCholesky<T> {
     pub fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         self.mask(k, rhs);
         let s = self.solver_of[k];
-        match (self.use_compact[s], self.compact[s].as_mut()) {
-            (true, Some(compact)) => compact.solve(rhs),
-            _ => self.solvers[s].solve_in_place(rhs, 1),
-        }
+        solve_one(&mut self.solvers[s], &mut self.compact[s], rhs);
         Ok(())
     }
 
@@ -361,25 +364,12 @@ impl<T: Scalar> MaskedCholesky<T> {
                 } else {
                     (&mut chigh[0], &mut clow[b])
                 };
-                let (u0, u1) = (self.use_compact[a], self.use_compact[b]);
-                let one = |solver: &mut SparseCholesky<T>,
-                           compact: &mut Option<Compact<T>>,
-                           use_compact: bool,
-                           r: &mut [T]| {
-                    match (use_compact, compact.as_mut()) {
-                        (true, Some(c)) => c.solve(r),
-                        _ => solver.solve_in_place(r, 1),
-                    }
-                };
-                rayon::join(|| one(s0, c0, u0, r0), || one(s1, c1, u1, r1));
+                rayon::join(|| solve_one(s0, c0, r0), || solve_one(s1, c1, r1));
             }
             (rhs, _) => {
                 for (k, r) in rhs.iter_mut().enumerate() {
                     let s = self.solver_of[k];
-                    match (self.use_compact[s], self.compact[s].as_mut()) {
-                        (true, Some(c)) => c.solve(r),
-                        _ => self.solvers[s].solve_in_place(r, 1),
-                    }
+                    solve_one(&mut self.solvers[s], &mut self.compact[s], r);
                 }
             }
         }
@@ -391,7 +381,7 @@ impl<T: Scalar> MaskedCholesky<T> {
     pub fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         let mut worst = 0.0f64;
         for s in 0..self.solvers.len() {
-            if let (true, Some(compact)) = (self.use_compact[s], self.compact[s].as_mut()) {
+            if let Some(compact) = self.compact[s].as_mut() {
                 worst = worst.max(compact.condition_estimate());
                 continue;
             }
