@@ -176,7 +176,7 @@ mod eval {
         let basis = super::ps();
         let x = positions(0.1);
         let mut element = elements(&basis, &positions(0.0));
-        let mut evals = Evaluations::new(x.len(), basis.max_functions_per_element());
+        let mut evals = Evaluations::for_basis(&basis, x.len());
         let mut bins = Bins::new(basis.num_elements(), x.len());
         let mut scratch: Vec<BasisEval<f64, 2>> = (0..psmpm::driver::phases::chunks(x.len()))
             .map(|_| BasisEval::for_basis(&basis))
@@ -215,7 +215,7 @@ mod assemble {
             let pattern = SymmetricPattern::new(basis);
             let stride = basis.max_functions_per_element();
             let mut element = elements(basis, &parts.x);
-            let mut evals = Evaluations::new(parts.len(), stride);
+            let mut evals = Evaluations::for_basis(basis, parts.len());
             let mut scratch: Vec<BasisEval<f64, 2>> =
                 (0..psmpm::driver::phases::chunks(parts.len()))
                     .map(|_| BasisEval::for_basis(basis))

@@ -17,6 +17,7 @@
 //! `W += Δt Σ_i F_i · v̂_i` with the projected velocity coefficients of the step, so
 //! that `kinetic + strain + potential − W` is the conserved total.
 
+use crate::driver::phases::Evaluations;
 use crate::particles::Particles;
 use crate::sparse::Scalar;
 use crate::studies::exact::AxisAligned;
@@ -26,29 +27,15 @@ use nalgebra::{SMatrix, SVector};
 /// them: particle `p` has `len[slot[p]]` entries at `slot[p] * stride ..` (the
 /// driver stores them in element order; see `driver::phases::Evaluations`).
 pub struct ParticleBasis<'a, T: Scalar, const D: usize> {
-    /// Entries per slot.
-    pub(crate) stride: usize,
-    /// Valid entries per slot.
-    pub(crate) len: &'a [usize],
-    /// The slot of each particle.
-    pub(crate) slot: &'a [usize],
-    /// Function indices.
-    pub(crate) index: &'a [u32],
-    /// Values `phi_i(x_p)`.
-    pub(crate) phi: &'a [T],
+    /// The step's basis values at the particles.
+    pub(crate) evals: &'a Evaluations<T, D>,
 }
 
 impl<T: Scalar, const D: usize> ParticleBasis<'_, T, D> {
     /// The functions `i` non-zero at particle `p` with their values `phi_i(x_p)`.
     #[inline]
     pub fn functions(&self, p: usize) -> impl Iterator<Item = (usize, T)> + '_ {
-        let s = self.slot[p];
-        let base = s * self.stride;
-        let range = base..base + self.len[s];
-        self.index[range.clone()]
-            .iter()
-            .zip(&self.phi[range])
-            .map(|(&i, &phi)| (i as usize, phi))
+        self.evals.entries(p).map(|(s, i)| (i, self.evals.phi[s]))
     }
 
     /// Adds `phi_i(x_p) f` to `forces[k][i]` for the functions of particle `p`.

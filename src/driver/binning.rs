@@ -47,7 +47,7 @@ impl Bins {
 
     /// [`fill`](Self::fill), and `slot[p]` = the position of particle `p` in the
     /// order (when `slot` is not empty).
-    pub fn fill_with_slots(&mut self, element: &[usize], slot: &mut [usize]) {
+    pub fn fill_with_slots(&mut self, element: &[usize], slot: &mut [u32]) {
         self.start.iter_mut().for_each(|s| *s = 0);
         for &e in element {
             self.start[e + 1] += 1;
@@ -62,7 +62,7 @@ impl Bins {
             let s = self.cursor[e];
             self.order[s] = p;
             if with_slots {
-                slot[p] = s;
+                slot[p] = s as u32;
             }
             self.cursor[e] += 1;
         }

@@ -44,8 +44,8 @@ where
         let mut lumped = vec![0.0; n];
         for p in 0..self.particles.len() {
             let m = self.particles.mass[p].to_f64();
-            for s in self.evals.range(p) {
-                lumped[self.evals.function(s)] += m * self.evals.phi[s].to_f64();
+            for (s, i) in self.evals.entries(p) {
+                lumped[i] += m * self.evals.phi[s].to_f64();
             }
         }
         self.power_iteration(Some(&lumped))
@@ -139,8 +139,7 @@ fn stiffness_product<T: Scalar, const D: usize>(
     for p in 0..volume.len() {
         let (lambda, mu) = lame(p);
         let mut grad = SMatrix::<T, D, D>::zeros();
-        for s in evals.range(p) {
-            let i = evals.function(s);
+        for (s, i) in evals.entries(p) {
             for k in 0..D {
                 for l in 0..D {
                     grad[(k, l)] += v[k][i] * evals.grad_phi[s][l];
@@ -150,10 +149,10 @@ fn stiffness_product<T: Scalar, const D: usize>(
         let eps = (grad + grad.transpose()) * T::of(0.5);
         let sigma =
             SMatrix::<T, D, D>::identity() * (T::of(lambda) * eps.trace()) + eps * T::of(2.0 * mu);
-        for s in evals.range(p) {
+        for (s, i) in evals.entries(p) {
             let g = sigma * evals.grad_phi[s] * volume[p];
             for k in 0..D {
-                f[k][evals.function(s)] += g[k];
+                f[k][i] += g[k];
             }
         }
     }
@@ -205,11 +204,11 @@ mod tests {
         let mut m = DMatrix::<f64>::zeros(2 * n, 2 * n);
         for p in 0..n_p {
             let mass = driver.particles.mass[p];
-            for s in e.range(p) {
-                for r in e.range(p) {
+            for (s, i) in e.entries(p) {
+                for (r, j) in e.entries(p) {
                     let v = mass * e.phi[s] * e.phi[r];
                     for k in 0..2 {
-                        m[(k * n + e.function(s), k * n + e.function(r))] += v;
+                        m[(k * n + i, k * n + j)] += v;
                     }
                 }
             }

@@ -142,8 +142,9 @@ where
         let coverage = self.coverage();
         let worst = self
             .evals
-            .range(particle)
-            .map(|s| self.evals.function(s))
+            .functions(particle)
+            .iter()
+            .map(|&i| i as usize)
             .map(|i| (i, coverage[i].unwrap_or(0.0)))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((i, c)) =
@@ -284,6 +285,10 @@ pub enum SetupError {
     ParticleOutside { particle: usize, position: Vec<f64> },
     #[error("the basis has {functions} functions on {elements} elements; the driver stores function indices and matrix positions in 32 bits (below 2^31 functions and 2^31 element-local entries)")]
     TooManyFunctions { functions: usize, elements: usize },
+    #[error(
+        "{particles} particles: the driver stores particle slots in 32 bits (below 2^32 particles)"
+    )]
+    TooManyParticles { particles: usize },
 }
 
 /// A position for a message: `[0.00312378, 0.947718]`, six significant digits per

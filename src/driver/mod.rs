@@ -62,7 +62,7 @@ pub struct Fix {
 }
 
 /// The per-step facts a mass strategy asked for.
-struct StrategyInputs<T: Scalar> {
+struct StrategyInputs {
     needs: Needs,
     touches_empty: Vec<bool>,
     particle_volume: Vec<f64>,
@@ -70,8 +70,6 @@ struct StrategyInputs<T: Scalar> {
     /// `on_wall[i]`: a wall constrains function `i` (a fixed component or a
     /// general constraint's term); sized with the coverage.
     on_wall: Vec<bool>,
-    /// Ones, one per particle: the weights of `particle_count`.
-    ones: Vec<T>,
     support: Option<std::sync::Arc<SupportFacts>>,
 }
 
@@ -136,7 +134,7 @@ where
     /// (written by [`phases::update_particles`]).
     energy_terms: Vec<[f64; 8]>,
     work: f64,
-    inputs: StrategyInputs<T>,
+    inputs: StrategyInputs,
     last_report: MassReport,
     last_condition: Option<f64>,
     phases: PhaseTimes,
@@ -176,6 +174,11 @@ where
             return Err(SetupError::TooManyFunctions {
                 functions: n,
                 elements: basis.num_elements(),
+            });
+        }
+        if u32::try_from(particles.len()).is_err() {
+            return Err(SetupError::TooManyParticles {
+                particles: particles.len(),
             });
         }
         let mut fixed = vec![vec![false; n]; D];
@@ -240,7 +243,6 @@ where
             } else {
                 Vec::new()
             },
-            ones: vec![T::one(); if needs.coverage { particles.len() } else { 0 }],
             support,
         };
         let np = particles.len();
@@ -263,7 +265,7 @@ where
             scratch: (0..phases::chunks(np))
                 .map(|_| BasisEval::for_basis(&basis))
                 .collect(),
-            evals: Evaluations::new(np, stride),
+            evals: Evaluations::for_basis(&basis, np),
             bins: Bins::new(basis.num_elements(), np),
             local: Local::new(basis.num_elements(), stride),
             gather: Gather::new(&basis, &pattern, stride),
@@ -435,7 +437,10 @@ where
         }
         if self.inputs.needs.coverage {
             let inputs = &mut self.inputs;
-            let weights = [&self.particles.volume[..], &inputs.ones[..]];
+            let weights = [
+                phases::Weight::Each(&self.particles.volume[..]),
+                phases::Weight::One,
+            ];
             let mut out = [
                 &mut inputs.particle_volume[..],
                 &mut inputs.particle_count[..],
@@ -457,7 +462,7 @@ where
                         &self.bins,
                         &self.gather,
                         &mut self.local,
-                        &[w],
+                        &[*w],
                         &mut [o],
                     );
                 }
@@ -498,13 +503,7 @@ where
         let state = StepState {
             time: self.time,
             dt: self.dt.to_f64(),
-            basis: ParticleBasis {
-                stride: self.evals.stride,
-                len: &self.evals.len,
-                slot: &self.evals.slot,
-                index: &self.evals.index,
-                phi: &self.evals.phi,
-            },
+            basis: ParticleBasis { evals: &self.evals },
         };
         let tracks_work = !self.work_force.is_empty();
         if tracks_work {

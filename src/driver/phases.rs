@@ -39,19 +39,27 @@ pub const CHUNK: usize = 1024;
 /// The entries are stored by slot, in element order: phase 1 puts particle `p`
 /// at slot `slot[p]`, its position in the step's [`Bins`], so that the sums
 /// element by element stream through them and the evaluation reads each
-/// element's data for all its particles at once. Slot `s` has `len[s]` entries
-/// (function index, `phi`, `grad_phi`) at `s * stride ..`; [`Self::range`] finds a
-/// particle's.
+/// element's data for all its particles at once. Slot `s` holds the values and
+/// gradients of the functions of its element `element[s]` at `s * stride ..`;
+/// [`Self::range`] finds a particle's entries and [`Self::functions`] their
+/// function indices.
+///
+/// The function indices are kept once per element, not per particle: every
+/// particle of an element has the element's functions, in the order
+/// [`Basis::element_functions`] gives and [`Basis::eval`] writes (36 bytes per PS
+/// particle fewer than one index per entry).
 pub struct Evaluations<T: Scalar, const D: usize> {
     /// Entries per slot (the basis's largest number of functions per element).
     pub stride: usize,
-    /// Valid entries per slot.
-    pub len: Vec<usize>,
     /// `slot[p]`: the slot of particle `p`.
-    pub slot: Vec<usize>,
-    /// Function indices `i` (`u32`: a basis has fewer than 2³² functions, see
-    /// [`Self::new`]; half the bytes of `usize` in the step's busiest arrays).
-    pub index: Vec<u32>,
+    pub slot: Vec<u32>,
+    /// `element[s]`: the element of the particle in slot `s`.
+    pub element: Vec<u32>,
+    /// The functions of element `e` at `e * stride ..` (`u32`: the driver refuses a
+    /// basis of 2³² functions or more).
+    element_functions: Vec<u32>,
+    /// The number of functions of element `e`.
+    element_len: Vec<u32>,
     /// Values `phi_i(x_p)`.
     pub phi: Vec<T>,
     /// Gradients `grad phi_i(x_p)`.
@@ -59,32 +67,70 @@ pub struct Evaluations<T: Scalar, const D: usize> {
 }
 
 impl<T: Scalar, const D: usize> Evaluations<T, D> {
-    /// Buffers for `particles` particles with up to `stride` functions each
-    /// (particle `p` in slot `p` until phase 1 orders them). Function indices are
-    /// stored as `u32`; the driver refuses a basis with 2³² functions or more.
-    pub fn new(particles: usize, stride: usize) -> Self {
+    /// Buffers for `particles` particles of `basis` (particle `p` in slot `p`, and
+    /// every slot in element 0, until phase 1 orders them). The caller bounds the
+    /// particles and the functions and elements of the basis below 2³².
+    pub fn for_basis<B: Basis<T, D>>(basis: &B, particles: usize) -> Self {
+        let stride = basis.max_functions_per_element();
+        let elements = basis.num_elements();
+        let mut element_functions = vec![0; elements * stride];
+        let mut element_len = vec![0; elements];
+        for e in 0..elements {
+            let functions = basis.element_functions(e);
+            element_len[e] = functions.len() as u32;
+            for (to, &i) in element_functions[e * stride..].iter_mut().zip(functions) {
+                *to = i as u32;
+            }
+        }
+        Self::with_elements(particles, stride, element_functions, element_len)
+    }
+
+    /// Buffers for `particles` particles on elements whose functions are
+    /// `element_functions` (`stride` per element, `element_len[e]` of them valid).
+    pub fn with_elements(
+        particles: usize,
+        stride: usize,
+        element_functions: Vec<u32>,
+        element_len: Vec<u32>,
+    ) -> Self {
         Evaluations {
             stride,
-            len: vec![0; particles],
-            slot: (0..particles).collect(),
-            index: vec![0; particles * stride],
+            slot: (0..particles as u32).collect(),
+            element: vec![0; particles],
+            element_functions,
+            element_len,
             phi: vec![T::zero(); particles * stride],
             grad_phi: vec![SVector::zeros(); particles * stride],
         }
     }
 
-    /// The function index of entry `s`.
+    /// The functions of element `e`.
     #[inline]
-    pub fn function(&self, s: usize) -> usize {
-        self.index[s] as usize
+    pub fn element_functions(&self, e: usize) -> &[u32] {
+        let base = e * self.stride;
+        &self.element_functions[base..base + self.element_len[e] as usize]
     }
 
     /// The entry range of particle `p`.
     #[inline]
     pub fn range(&self, p: usize) -> std::ops::Range<usize> {
-        let s = self.slot[p];
+        let s = self.slot[p] as usize;
         let base = s * self.stride;
-        base..base + self.len[s]
+        base..base + self.element_len[self.element[s] as usize] as usize
+    }
+
+    /// The functions of particle `p`, one per entry of [`Self::range`].
+    #[inline]
+    pub fn functions(&self, p: usize) -> &[u32] {
+        self.element_functions(self.element[self.slot[p] as usize] as usize)
+    }
+
+    /// The entries `s` of particle `p` with their functions `i`.
+    #[inline]
+    pub fn entries(&self, p: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.range(p)
+            .zip(self.functions(p))
+            .map(|(s, &i)| (s, i as usize))
     }
 }
 
@@ -126,24 +172,30 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
     bins.fill_with_slots(element, &mut out.slot);
     let stride = out.stride;
     let (order, element) = (&bins.order, &*element);
+    let (functions, lens) = (&out.element_functions, &out.element_len);
     (
         order.par_chunks(CHUNK),
-        out.len.par_chunks_mut(CHUNK),
-        out.index.par_chunks_mut(CHUNK * stride),
+        out.element.par_chunks_mut(CHUNK),
         out.phi.par_chunks_mut(CHUNK * stride),
         out.grad_phi.par_chunks_mut(CHUNK * stride),
         scratch.par_iter_mut(),
     )
         .into_par_iter()
-        .for_each(|(order, len, index, phi, grad_phi, scratch)| {
+        .for_each(|(order, slot_element, phi, grad_phi, scratch)| {
             for (q, &p) in order.iter().enumerate() {
-                basis.eval(element[p], &x[p], scratch);
+                let e = element[p];
+                basis.eval(e, &x[p], scratch);
                 let base = q * stride;
                 let m = scratch.len();
-                len[q] = m;
-                for (to, &from) in index[base..base + m].iter_mut().zip(&scratch.index[..m]) {
-                    *to = from as u32;
-                }
+                slot_element[q] = e as u32;
+                debug_assert!(
+                    m == lens[e] as usize
+                        && scratch.index[..m]
+                            .iter()
+                            .zip(&functions[e * stride..])
+                            .all(|(&i, &j)| i == j as usize),
+                    "the basis evaluated other functions than its element's"
+                );
                 phi[base..base + m].copy_from_slice(&scratch.phi[..m]);
                 grad_phi[base..base + m].copy_from_slice(&scratch.grad_phi[..m]);
             }
@@ -356,11 +408,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
 ) {
     let stride = local.stride;
     let theta = T::of(PLAIN_SHARE);
-    let touches_lumped = |p: usize| {
-        evals.index[evals.range(p)]
-            .iter()
-            .any(|&i| lumped[i as usize])
-    };
+    let touches_lumped = |p: usize| evals.functions(p).iter().any(|&i| lumped[i as usize]);
     local.par_elements(bins).for_each(|(e, (lm, g))| {
         let inside = bins.particles(e);
         if !inside.iter().any(|&p| touches_lumped(p)) {
@@ -373,7 +421,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
             }
             let range = evals.range(p);
             let (base, m) = (range.start, range.len());
-            let index = &evals.index[base..base + m];
+            let index = evals.functions(p);
             let (phi, grad_phi) = (&evals.phi[base..base + m], &evals.grad_phi[base..base + m]);
             // The pairs' Laplacian `L` goes straight into `lm`; `A = L Ξ` (row `a` in
             // `g[a D..(a + 1) D]`) and `B = Ξᵀ L Ξ` are gathered beside it. With
@@ -550,8 +598,7 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
 ) {
     let increment = |p: usize| {
         let mut a = SVector::<T, D>::zeros();
-        for s in evals.range(p) {
-            let i = evals.function(s);
+        for (s, i) in evals.entries(p) {
             for k in 0..D {
                 a[k] += acceleration[k][i] * evals.phi[s];
             }
@@ -588,8 +635,7 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
                 let p = c * CHUNK + q;
                 *v += increment(p);
                 *g = SMatrix::zeros();
-                for s in evals.range(p) {
-                    let i = evals.function(s);
+                for (s, i) in evals.entries(p) {
                     for k in 0..D {
                         let c = old[k][i] + dt * acceleration[k][i];
                         for l in 0..D {
@@ -607,10 +653,9 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     scatter_by_elements(bins, evals, gather, local, momentum, |p, s| {
         let w = mass[p] * evals.phi[s];
         let mut out = v[p] * w;
-        let i = evals.function(s);
+        let i = evals.functions(p)[s - evals.range(p).start] as usize;
         let mut lever = SVector::<T, D>::zeros();
-        for t in evals.range(p) {
-            let j = evals.function(t);
+        for (t, j) in evals.entries(p) {
             if j != i && (decoupled[i] || decoupled[j]) {
                 lever += (points[i] - points[j]) * evals.phi[t];
             }
@@ -694,8 +739,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
                     let p = c * CHUNK + q;
                     let mut grad_v = SMatrix::<T, D, D>::zeros();
                     let mut v_hat = SVector::<T, D>::zeros();
-                    for s in evals.range(p) {
-                        let i = evals.function(s);
+                    for (s, i) in evals.entries(p) {
                         for k in 0..D {
                             let c = velocity[k][i];
                             v_hat[k] += c * evals.phi[s];
@@ -766,6 +810,16 @@ pub fn mark_empty_elements<T: Scalar, const D: usize, B: Basis<T, D>>(
     }
 }
 
+/// A per-particle weight of [`particle_sums_by_elements`].
+#[derive(Clone, Copy)]
+pub enum Weight<'a, T> {
+    /// `w_p`, one per particle.
+    Each(&'a [T]),
+    /// `w_p = 1` (the particle count), without an array of ones (`1 · phi` is
+    /// `phi` exactly).
+    One,
+}
+
 /// [`particle_volume`] summed element by element (the step's version; see the
 /// module's notes on threads), for several per-particle weights at once
 /// (`weights.len() ≤ D`, one component of the local vectors each: the volumes and
@@ -776,7 +830,7 @@ pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
     bins: &Bins,
     gather: &Gather,
     local: &mut Local<T, D>,
-    weights: &[&[T]],
+    weights: &[Weight<'_, T>],
     out: &mut [&mut [f64]],
 ) {
     assert!(weights.len() <= D && weights.len() == out.len());
@@ -784,7 +838,10 @@ pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
         for &p in bins.particles(e) {
             for (a, s) in evals.range(p).enumerate() {
                 for (k, w) in weights.iter().enumerate() {
-                    lv[a * D + k] += w[p] * evals.phi[s];
+                    lv[a * D + k] += match w {
+                        Weight::Each(w) => w[p] * evals.phi[s],
+                        Weight::One => evals.phi[s],
+                    };
                 }
             }
         }
@@ -819,8 +876,8 @@ pub fn particle_volume<T: Scalar, const D: usize>(
 ) {
     out.iter_mut().for_each(|v| *v = 0.0);
     for p in 0..volume.len() {
-        for s in evals.range(p) {
-            out[evals.function(s)] += (volume[p] * evals.phi[s]).to_f64();
+        for (s, i) in evals.entries(p) {
+            out[i] += (volume[p] * evals.phi[s]).to_f64();
         }
     }
 }
@@ -877,8 +934,8 @@ mod tests {
                 let off = next() - 0.5;
                 *s = Matrix2::new(next() - 0.5, off, off, next() - 0.5);
             }
-            let mut evals = Evaluations::<f64, 2>::new(n, M);
-            evals.len.iter_mut().for_each(|l| *l = M);
+            let mut evals =
+                Evaluations::<f64, 2>::with_elements(n, M, (0..M as u32).collect(), vec![M as u32]);
             evals.phi.iter_mut().for_each(|v| *v = next());
             evals
                 .grad_phi

@@ -83,8 +83,7 @@ where
     (0..driver.particles.len())
         .map(|p| {
             let mut v = nalgebra::Vector2::zeros();
-            for s in driver.evals.range(p) {
-                let i = driver.evals.function(s);
+            for (s, i) in driver.evals.entries(p) {
                 for k in 0..2 {
                     v[k] += driver.velocity[k][i] * driver.evals.phi[s];
                 }

@@ -74,13 +74,17 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     domain: Domain<B>,
 ) -> Result<Prepared<D, B>, RunError> {
     let solution = Solution::new(scene);
-    let lattice = particle_lattice(scene)?;
+    let mut lattice = particle_lattice(scene)?;
     let material = materials::<D>(scene, &lattice)?;
     let mut origin = [0.0; 2];
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
     let mut particles = particles::place::<D>(scene, &lattice);
     particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles);
     let effects = build_effects(scene, &particles)?;
+    // The lattice's positions and volumes are in `particles` now: free them before
+    // the driver allocates (they would otherwise count in the run's peak memory).
+    let body_sizes = std::mem::take(&mut lattice.body_sizes);
+    drop(lattice);
     let Domain { basis, h, walls } = domain;
     let functions = basis.num_functions();
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
@@ -102,7 +106,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         effects,
         dt,
         &walls,
-        &lattice.body_sizes,
+        &body_sizes,
     )?;
     let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt)?;
     if let (Some(critical), None, false) = (
@@ -220,6 +224,9 @@ fn driver<const D: usize, B: Basis<f64, D>>(
         SetupError::Basis(e) => SceneError::new("basis", ErrorKind::Conflict, e.to_string()),
         e @ SetupError::TooManyFunctions { .. } => {
             SceneError::new("mesh", ErrorKind::Value, e.to_string())
+        }
+        e @ SetupError::TooManyParticles { .. } => {
+            SceneError::new("body", ErrorKind::Value, e.to_string())
         }
     })?;
     driver.estimate_condition = scene.output.condition;

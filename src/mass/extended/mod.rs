@@ -87,6 +87,9 @@ enum Role {
     Extended,
 }
 
+/// Extended functions the extension rows have room for before a step grows them.
+const EXTENSION_ROOM: usize = 1024;
+
 /// Extension of the functions covered below `coverage`, solved matrix-free.
 pub struct Extended<T: Scalar> {
     coverage: f64,
@@ -340,10 +343,13 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.active = Vec::with_capacity(n);
         self.extended = Vec::with_capacity(n);
         self.ext_ptr = vec![0; n + 1];
-        // Room for every function extended through 16 neighbours: steps then
-        // allocate only in the rare case of wider extensions.
-        self.ext_idx = Vec::with_capacity(16 * n);
-        self.ext_w = Vec::with_capacity(16 * n);
+        // Room for `EXTENSION_ROOM` functions extended through 16 neighbours each
+        // (under-supported functions lie along the body's edge, a small share of a
+        // large mesh): a step that extends more grows the buffers, which keep their
+        // capacity for the next steps.
+        let room = 16 * n.min(EXTENSION_ROOM);
+        self.ext_idx = Vec::with_capacity(room);
+        self.ext_w = Vec::with_capacity(room);
         self.scratch = Scratch::new(n);
         self.estimate = std::array::from_fn(|_| vec![T::zero(); n]);
         self.rhs = vec![T::zero(); n];
