@@ -3,8 +3,9 @@
 //! calls them in order; none of them knows which basis, mass strategy or
 //! material it serves.
 //!
-//! Per-particle basis data are stored as [`Evaluations`]: particle `p` has
-//! `len[p]` entries (function index, `phi`, `grad_phi`) at `p * stride ..`.
+//! Per-particle basis data are stored as [`Evaluations`]: the particle in slot
+//! `s` has the values `phi` and gradients `grad_phi` of its element's functions at
+//! `s * stride ..`, the function indices kept once per element.
 //!
 //! # Threads and determinism
 //!
