@@ -155,9 +155,9 @@ impl<T: Scalar> Extended<T> {
 
     /// In the hybrid, the functions a wall constrains (a fixed component, or a
     /// term of a slip wall's constraint) are extended below `walls` coverage, as
-    /// in `extended`, instead of lumped (`extended-hybrid:C1:C2:W`). A lumped
-    /// wall row takes the body's normal force on its function as the wall's
-    /// reaction, acting at the function's point; on a frictionless wall the moment
+    /// in `extended`, instead of lumped (`extended-hybrid:C1:C2:W`). Solved for
+    /// (lumped or not), a poorly covered wall function carries part of the wall's
+    /// reaction at its point beyond the contact; on a frictionless wall the moment
     /// of those reactions turns a body that should slide without turning.
     /// Measured (`docs/stability.md`): a disk on a 30° slope turns by 7.4e-3 rad in
     /// 0.4 s with `W = 0.5`, 4.6e-2 without; the damped column B5c 1 × 4 loses
