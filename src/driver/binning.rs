@@ -24,9 +24,10 @@ pub fn chunks(particles: usize) -> usize {
 /// Particles grouped by element, in particle order within each element (a
 /// stable counting sort, refilled every step).
 pub struct Bins {
-    /// Particles of element `e`: `order[start[e]..start[e + 1]]`.
+    /// Particles of element `e`: `order[start[e]..start[e + 1]]` (32 bits: the
+    /// driver refuses 2³² particles or more).
     pub(super) start: Vec<usize>,
-    pub(super) order: Vec<usize>,
+    pub(super) order: Vec<u32>,
     pub(super) cursor: Vec<usize>,
 }
 
@@ -60,7 +61,7 @@ impl Bins {
         let with_slots = !slot.is_empty();
         for (p, &e) in element.iter().enumerate() {
             let s = self.cursor[e];
-            self.order[s] = p;
+            self.order[s] = p as u32;
             if with_slots {
                 slot[p] = s as u32;
             }
@@ -70,7 +71,7 @@ impl Bins {
 
     /// The particles in element `e`, in increasing order.
     #[inline]
-    pub fn particles(&self, e: usize) -> &[usize] {
+    pub fn particles(&self, e: usize) -> &[u32] {
         &self.order[self.start[e]..self.start[e + 1]]
     }
 
@@ -471,6 +472,7 @@ pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
 {
     local.par_vectors(bins).for_each(|(e, lv)| {
         for &p in bins.particles(e) {
+            let p = p as usize;
             for (a, s) in evals.range(p).enumerate() {
                 let f = q(p, s);
                 for k in 0..D {

@@ -184,6 +184,7 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
         .into_par_iter()
         .for_each(|(order, slot_element, phi, grad_phi, scratch)| {
             for (q, &p) in order.iter().enumerate() {
+                let p = p as usize;
                 let e = element[p];
                 basis.eval(e, &x[p], scratch);
                 let base = q * stride;
@@ -231,7 +232,7 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
         // Every particle of an element has the element's functions; with as many
         // as the stride (every PS and PL element) the block is summed in a
         // fixed-size array, in the same order (the same bits).
-        let m = inside.first().map_or(0, |&p| evals.range(p).len());
+        let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
         match (m == stride, m) {
             (true, 9) => {
                 return element_block::<T, D, 9, 45>(inside, particles, evals, full, lm, lv)
@@ -255,7 +256,7 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
 /// `stride`): the sums of [`assemble_mass_and_internal_force`] through the packed
 /// index of each pair.
 fn element_block_any<T: Scalar, const D: usize>(
-    inside: &[usize],
+    inside: &[u32],
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
     stride: usize,
@@ -264,6 +265,7 @@ fn element_block_any<T: Scalar, const D: usize>(
     lv: &mut [T],
 ) {
     for &p in inside {
+        let p = p as usize;
         let range = evals.range(p);
         let (base, m) = (range.start, range.len());
         let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
@@ -290,7 +292,7 @@ fn element_block_any<T: Scalar, const D: usize>(
 /// with the same operations, so the result is the same to the last bit.
 #[inline(always)]
 fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
-    inside: &[usize],
+    inside: &[u32],
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
     full: bool,
@@ -303,6 +305,7 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
     let mut diagonal = [T::zero(); M];
     let mut vector = [SVector::<T, D>::zeros(); M];
     for &p in inside {
+        let p = p as usize;
         let base = evals.range(p).start;
         let phi: &[T; M] = evals.phi[base..base + M].try_into().expect("M functions");
         let grad: &[SVector<T, D>; M] = evals.grad_phi[base..base + M]
@@ -412,11 +415,12 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     let touches_lumped = |p: usize| evals.functions(p).iter().any(|&i| lumped[i as usize]);
     local.par_elements(bins).for_each(|(e, (lm, g))| {
         let inside = bins.particles(e);
-        if !inside.iter().any(|&p| touches_lumped(p)) {
+        if !inside.iter().any(|&p| touches_lumped(p as usize)) {
             return;
         }
         let affine = !functions_affine && determines_affine(inside, mass, x, element_scale[e]);
         for &p in inside {
+            let p = p as usize;
             if !touches_lumped(p) {
                 continue;
             }
@@ -487,7 +491,7 @@ pub const PLAIN_SHARE: f64 = 0.1;
 /// Whether the particles `inside` one element determine an affine field
 /// ([`add_affine_lumping`]).
 fn determines_affine<T: Scalar, const D: usize>(
-    inside: &[usize],
+    inside: &[u32],
     mass: &[T],
     x: &[SVector<T, D>],
     scale: T,
@@ -497,12 +501,14 @@ fn determines_affine<T: Scalar, const D: usize>(
     }
     let (mut total, mut mean) = (T::zero(), SVector::<T, D>::zeros());
     for &p in inside {
+        let p = p as usize;
         total += mass[p];
         mean += x[p] * mass[p];
     }
     mean /= total;
     let mut s = SMatrix::<T, D, D>::zeros();
     for &p in inside {
+        let p = p as usize;
         let d = x[p] - mean;
         s += d * d.transpose() * (mass[p] / total);
     }
@@ -837,6 +843,7 @@ pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
     assert!(weights.len() <= D && weights.len() == out.len());
     local.par_vectors(bins).for_each(|(e, lv)| {
         for &p in bins.particles(e) {
+            let p = p as usize;
             for (a, s) in evals.range(p).enumerate() {
                 for (k, w) in weights.iter().enumerate() {
                     lv[a * D + k] += match w {
@@ -942,7 +949,7 @@ mod tests {
                 .grad_phi
                 .iter_mut()
                 .for_each(|g| *g = Vector2::new(next() - 0.5, next() - 0.5));
-            let inside: Vec<usize> = vec![3, 0, 6, 1, 5, 2, 4];
+            let inside: Vec<u32> = vec![3, 0, 6, 1, 5, 2, 4];
             for full in [true, false] {
                 let (mut lm, mut lv) = (vec![0.0; P], vec![0.0; M * 2]);
                 element_block::<f64, 2, M, P>(&inside, &particles, &evals, full, &mut lm, &mut lv);
