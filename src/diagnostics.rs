@@ -221,12 +221,27 @@ pub fn energies_from_terms<T: Scalar, const D: usize>(
 }
 
 /// Tracks the energy balance and the condition of a run, and gives the verdict.
-#[derive(Debug, Clone, Copy, Default)]
+///
+/// The drift and growth of the total energy `E = K + S + P − W` are measured
+/// against the *energy scale*: the largest kinetic plus strain energy `K + S` seen,
+/// or the range the potential energy `P` or the work `W` of the effects has swept,
+/// whichever is largest. Unlike `|E|` or `|P|`, these do not change when the scene
+/// is moved or gravity's zero level is put elsewhere, or when gravity is written as
+/// a body force: the verdict of a run is that of its motion.
+#[derive(Debug, Clone, Copy)]
 pub struct Verdict {
     e0: f64,
-    scale: f64,
+    /// Largest `K + S` seen.
+    motion: f64,
+    /// Least and largest potential energy seen.
+    potential: (f64, f64),
+    /// Least and largest work of the effects seen.
+    work: (f64, f64),
     drift: f64,
     growth: f64,
+    /// The first step (and its time) at which the growth reached
+    /// [`STABLE_ENERGY_GROWTH`] of the energy scale seen so far.
+    pub growth_crossed: Option<(usize, f64)>,
     /// Largest condition estimate seen.
     pub max_condition: Option<f64>,
 }
@@ -234,32 +249,45 @@ pub struct Verdict {
 impl Verdict {
     /// Starts from the initial state.
     pub fn new(start: &StepReport) -> Self {
-        let e0 = start.total_energy();
         Verdict {
-            e0,
-            scale: e0
-                .abs()
-                .max(start.kinetic)
-                .max(start.strain)
-                .max(start.potential.abs()),
+            e0: start.total_energy(),
+            motion: start.kinetic + start.strain,
+            potential: (start.potential, start.potential),
+            work: (start.work, start.work),
             drift: 0.0,
             growth: 0.0,
+            growth_crossed: None,
             max_condition: None,
         }
     }
 
     /// Takes the report of a step.
     pub fn observe(&mut self, r: &StepReport) {
-        self.scale = self
-            .scale
-            .max(r.kinetic)
-            .max(r.strain)
-            .max(r.potential.abs());
-        self.drift = self.drift.max((r.total_energy() - self.e0).abs());
-        self.growth = self.growth.max(r.total_energy() - self.e0);
+        self.motion = self.motion.max(r.kinetic + r.strain);
+        self.potential = (
+            self.potential.0.min(r.potential),
+            self.potential.1.max(r.potential),
+        );
+        self.work = (self.work.0.min(r.work), self.work.1.max(r.work));
+        let change = r.total_energy() - self.e0;
+        self.drift = self.drift.max(change.abs());
+        self.growth = self.growth.max(change);
+        if self.growth_crossed.is_none()
+            && self.growth > 0.0
+            && self.growth >= STABLE_ENERGY_GROWTH * self.scale()
+        {
+            self.growth_crossed = Some((r.step, r.time));
+        }
         if let Some(c) = r.condition {
             self.max_condition = Some(self.max_condition.map_or(c, |m: f64| m.max(c)));
         }
+    }
+
+    /// The energy scale (see [`Verdict`]).
+    pub fn scale(&self) -> f64 {
+        self.motion
+            .max(self.potential.1 - self.potential.0)
+            .max(self.work.1 - self.work.0)
     }
 
     /// Initial total energy.
@@ -267,10 +295,20 @@ impl Verdict {
         self.e0
     }
 
-    /// `(drift, growth)` of the total energy relative to the energy scale.
+    /// `(drift, growth)` of the total energy relative to the energy scale (0 for
+    /// a run in which nothing moved and nothing changed).
     pub fn energy_drift_and_growth(&self) -> (f64, f64) {
-        let scale = self.scale.max(f64::MIN_POSITIVE);
-        (self.drift / scale, self.growth / scale)
+        let scale = self.scale();
+        let relative = |e: f64| {
+            if e == 0.0 {
+                0.0
+            } else if scale > 0.0 {
+                e / scale
+            } else {
+                f64::INFINITY
+            }
+        };
+        (relative(self.drift), relative(self.growth))
     }
 
     /// Stable: no failure, energy growth below [`STABLE_ENERGY_GROWTH`], every
@@ -279,5 +317,81 @@ impl Verdict {
         !failed
             && self.energy_drift_and_growth().1 < STABLE_ENERGY_GROWTH
             && self.max_condition.is_none_or(|c| c < STABLE_CONDITION)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A body falling and bouncing: `(kinetic, strain, potential)` per step, with a
+    /// total that creeps up by 9 of a motion of about 100.
+    fn falling(shift: f64) -> Vec<StepReport> {
+        [
+            (0.0, 0.0, 100.0),
+            (50.0, 0.0, 50.5),
+            (99.0, 3.0, 1.0),
+            (20.0, 83.0, 0.0),
+            (60.0, 1.0, 48.0),
+        ]
+        .iter()
+        .enumerate()
+        .map(|(step, &(kinetic, strain, potential))| StepReport {
+            step,
+            time: step as f64,
+            kinetic,
+            strain,
+            potential: potential + shift,
+            ..StepReport::default()
+        })
+        .collect()
+    }
+
+    fn verdict(reports: &[StepReport]) -> Verdict {
+        let mut v = Verdict::new(&reports[0]);
+        reports[1..].iter().for_each(|r| v.observe(r));
+        v
+    }
+
+    /// The verdict is that of the motion: moving gravity's zero level (or the
+    /// scene) changes no number of it, and writing gravity as a body force (its
+    /// work instead of its potential) changes none either.
+    #[test]
+    fn the_energy_verdict_does_not_depend_on_the_potential_zero_or_its_form() {
+        let base = verdict(&falling(0.0));
+        assert_eq!(base.scale(), 103.0);
+        let (drift, growth) = base.energy_drift_and_growth();
+        assert!((drift - 9.0 / 103.0).abs() < 1e-15 && drift == growth);
+        for shift in [1e3, -5e4, 1e7] {
+            let moved = verdict(&falling(shift));
+            assert_eq!(moved.scale(), base.scale(), "shift {shift}");
+            let (d, g) = moved.energy_drift_and_growth();
+            assert!(
+                (d - drift).abs() < 1e-9 && (g - growth).abs() < 1e-9,
+                "shift {shift}"
+            );
+        }
+        let as_work: Vec<StepReport> = falling(0.0)
+            .into_iter()
+            .map(|r| StepReport {
+                potential: 0.0,
+                work: 100.0 - r.potential,
+                ..r
+            })
+            .collect();
+        let worked = verdict(&as_work);
+        assert_eq!(worked.scale(), base.scale());
+        assert_eq!(worked.energy_drift_and_growth(), (drift, growth));
+        assert_eq!(worked.growth_crossed, Some((4, 4.0)));
+    }
+
+    /// Nothing moving and nothing changing is no growth, not 0/0.
+    #[test]
+    fn a_run_at_rest_has_no_drift() {
+        let rest = StepReport::default();
+        let mut v = Verdict::new(&rest);
+        v.observe(&rest);
+        assert_eq!(v.energy_drift_and_growth(), (0.0, 0.0));
+        assert!(v.stable(false));
     }
 }

@@ -12,9 +12,12 @@
 //! "Stable" follows the benchmark definitions of the seeds (paper and thesis, as checked against their tables): no failure, the total energy
 //! (kinetic + strain + gravitational − work of the non-conservative effects) never
 //! exceeds its initial value by more than [`STABLE_ENERGY_GROWTH`] of the energy
-//! scale, and every condition estimate (when requested) stays below
-//! [`STABLE_CONDITION`].
+//! scale (the largest kinetic plus strain energy, or the range swept by the potential
+//! energy or the work of the effects, so that moving a scene or writing gravity as a
+//! body force does not change the verdict: [`crate::diagnostics::Verdict`]), and
+//! every condition estimate (when requested) stays below [`STABLE_CONDITION`].
 
+use crate::diagnostics::Verdict;
 use crate::driver::{PhaseTimes, StepError, StepReport};
 use crate::particles::Particles;
 use crate::scene::{Scene, SceneError};
@@ -26,10 +29,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 pub use crate::setup::{build_effects, particle_lattice, triangulation, Lattice};
 
-/// Energy growth (relative to the energy scale) above which a run is unstable.
-pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
-/// Condition-number estimate above which a run is unstable.
-pub const STABLE_CONDITION: f64 = 1e8;
+pub use crate::diagnostics::{STABLE_CONDITION, STABLE_ENERGY_GROWTH};
 
 /// Steps between two samples of [`Summary::max_rotation`].
 pub const ROTATION_EVERY: usize = 10;
@@ -90,7 +90,9 @@ pub struct Summary {
     pub energy_initial: f64,
     /// Total energy at the end.
     pub energy_final: f64,
-    /// Largest `|E(t) − E(0)|` relative to the largest energy scale seen.
+    /// Largest `|E(t) − E(0)|` relative to the energy scale of the run (the largest
+    /// kinetic plus strain energy, or the range swept by the potential energy or by
+    /// the work of the effects: [`crate::diagnostics::Verdict`]).
     pub energy_drift: f64,
     /// Largest `E(t) − E(0)` relative to the energy scale (growth only).
     pub energy_growth: f64,
@@ -304,19 +306,11 @@ where
 /// What the loop gathers over the steps.
 struct Tally {
     tracked: Vec<Tracked>,
-    /// Total energy at the start.
-    e0: f64,
-    /// Largest energy scale seen.
-    scale: f64,
-    drift: f64,
-    growth: f64,
-    /// The first step (and its time) at which the growth reached
-    /// [`STABLE_ENERGY_GROWTH`] of the energy scale seen so far.
-    growth_crossed: Option<(usize, f64)>,
+    /// The energy balance and the condition estimates.
+    verdict: Verdict,
     lumped: usize,
     deactivated: usize,
     extended: usize,
-    max_condition: Option<f64>,
     phases: PhaseTimes,
     rms: exact::RmsPositionError,
     failure: Option<StepError>,
@@ -325,6 +319,22 @@ struct Tally {
     max_rotation: f64,
     /// The largest rotation of the particles of the paper's non-objective law.
     max_rotation_non_objective: f64,
+    /// Particles per occupied element at the start.
+    sampling: f64,
+}
+
+/// Particles per occupied element at the start below which a run warns that its
+/// bodies are sampled by about one particle per element or fewer.
+pub const SPARSE_SAMPLING: f64 = 1.5;
+
+/// The warning for bodies sampled by `sampling` particles per occupied element at
+/// the start, if that is below [`SPARSE_SAMPLING`].
+pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
+    (sampling < SPARSE_SAMPLING).then(|| {
+        format!(
+            "the bodies are sampled by {sampling:.2} particles per occupied element at the start: with about one particle per element or fewer, the elements between particles hold none, the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element (`per_block`, `count` or `spacing`; `--particles`)"
+        )
+    })
 }
 
 /// The tracked particles: the particle nearest each of the scene's tracked points.
@@ -379,19 +389,12 @@ where
     // The initial state (step 0); the public entry points other than
     // `observe_2d`/`observe_1d` pass only steps > 0 on.
     on_step(&start, driver.particles.view());
-    let e0 = start.total_energy();
-    let mut scale = e0
-        .abs()
-        .max(start.kinetic)
-        .max(start.strain)
-        .max(start.potential.abs());
-    let (mut drift, mut growth) = (0.0f64, 0.0f64);
-    let mut growth_crossed = None;
+    let mut verdict = Verdict::new(&start);
     let (mut lumped, mut deactivated, mut extended) = (0usize, 0usize, 0usize);
-    let mut max_condition: Option<f64> = None;
     let mut phases = PhaseTimes::default();
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
+    let sampling = driver.particles_per_occupied_element();
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
     let mut max_rotation_non_objective = driver
         .material()
@@ -439,12 +442,7 @@ where
             );
         }
         on_step(&r, driver.particles.view());
-        scale = scale.max(r.kinetic).max(r.strain).max(r.potential.abs());
-        drift = drift.max((r.total_energy() - e0).abs());
-        growth = growth.max(r.total_energy() - e0);
-        if growth_crossed.is_none() && growth >= STABLE_ENERGY_GROWTH * scale {
-            growth_crossed = Some((r.step, r.time));
-        }
+        verdict.observe(&r);
         lumped = lumped.max(r.mass_report.lumped_rows);
         deactivated = deactivated.max(r.mass_report.deactivated);
         extended = extended.max(r.mass_report.extended);
@@ -452,21 +450,13 @@ where
         phases.assemble += r.phases.assemble;
         phases.solve += r.phases.solve;
         phases.update += r.phases.update;
-        if let Some(c) = r.condition {
-            max_condition = Some(max_condition.map_or(c, |m: f64| m.max(c)));
-        }
     }
     Tally {
         tracked,
-        e0,
-        scale,
-        drift,
-        growth,
-        growth_crossed,
+        verdict,
         lumped,
         deactivated,
         extended,
-        max_condition,
         phases,
         rms,
         failure,
@@ -474,6 +464,7 @@ where
         seconds: clock.elapsed().as_secs_f64(),
         max_rotation,
         max_rotation_non_objective,
+        sampling,
     }
 }
 
@@ -575,17 +566,16 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
 ) -> Outcome<D> {
     let end = run.driver.report();
     let error = error(&run, &tally.rms);
-    let scale = tally.scale.max(f64::MIN_POSITIVE);
-    let (energy_drift, energy_growth) = (tally.drift / scale, tally.growth / scale);
+    let (energy_drift, energy_growth) = tally.verdict.energy_drift_and_growth();
     let failure = tally.failure;
-    let max_condition = tally.max_condition;
+    let max_condition = tally.verdict.max_condition;
     let stable = failure.is_none()
         && energy_growth < STABLE_ENERGY_GROWTH
         && max_condition.is_none_or(|c| c < STABLE_CONDITION);
     let energy_growth_hint =
         (failure.is_none() && energy_growth >= STABLE_ENERGY_GROWTH).then(|| {
             energy_growth_hint(
-                tally.growth_crossed,
+                tally.verdict.growth_crossed,
                 run.driver.steps(),
                 run.dt,
                 run.dt_critical,
@@ -621,7 +611,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             max_extended: tally.extended,
             dt_critical: run.dt_critical,
             max_condition,
-            energy_initial: tally.e0,
+            energy_initial: tally.verdict.initial_energy(),
             energy_final: end.total_energy(),
             energy_drift,
             energy_growth,
@@ -629,7 +619,10 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             energy_growth_hint,
             failure: failure.as_ref().map(|e| e.to_string()),
             max_rotation,
-            warnings: warnings.into_iter().collect(),
+            warnings: warnings
+                .into_iter()
+                .chain(sparse_sampling_warning(tally.sampling))
+                .collect(),
             interrupted: tally.interrupted,
             seconds: tally.seconds,
             phases: tally.phases,

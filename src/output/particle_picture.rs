@@ -45,7 +45,8 @@ pub enum ParticleField {
     SigmaXy,
     /// `p = −tr(σ) / d`.
     Pressure,
-    /// von Mises stress `√(3/2 s:s)`, `s` the deviator of `σ` (in the plane in 2D).
+    /// von Mises stress `√(3/2 s:s)`, `s` the deviator of `σ` (in the plane in 2D;
+    /// `|σ_xx|` in 1D, the uniaxial stress of a bar).
     VonMises,
 }
 
@@ -120,6 +121,9 @@ impl ParticleField {
                 ParticleField::SigmaYy => sigma(p)[(D.min(2) - 1, D.min(2) - 1)],
                 ParticleField::SigmaXy => sigma(p)[(0, D.min(2) - 1)],
                 ParticleField::Pressure => -sigma(p).trace() / D as f64,
+                // A 1D bar is in uniaxial stress: its von Mises stress is |σ_xx| (the
+                // deviator on the line alone would vanish).
+                ParticleField::VonMises if D == 1 => sigma(p)[(0, 0)].abs(),
                 ParticleField::VonMises => {
                     let s = sigma(p);
                     let mean = s.trace() / D as f64;
@@ -362,6 +366,10 @@ mod tests {
         // s = diag(8, −8) + offdiag 0.5: √(3/2 (64 + 64 + 0.5)) .
         let vm = ParticleField::VonMises.values(&p)[q];
         assert!((vm - (1.5f64 * 128.5).sqrt()).abs() < 1e-12);
+        // A 1D bar in compression: |σ_xx|.
+        let mut bar = Particles::<f64, 1>::new(vec![nalgebra::Vector1::new(0.0)], vec![1.0], 1.0);
+        bar.sigma[0] = SMatrix::<f64, 1, 1>::new(-9.9e3);
+        assert_eq!(ParticleField::VonMises.values(&bar), vec![9.9e3]);
         assert!((ParticleField::Displacement.values(&p)[q] - 0.1 * p.x0[q][0]).abs() < 1e-15);
         assert_eq!(
             ParticleField::parse("von-mises", 2),

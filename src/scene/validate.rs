@@ -24,6 +24,19 @@ impl Scene {
                 ),
             ));
         }
+        // Names and descriptions are printed and written into SVG and JSON files.
+        for (field, text) in [("name", &self.name), ("description", &self.description)] {
+            if let Some(c) = text.chars().find(|c| c.is_control()) {
+                return Err(bad(
+                    field,
+                    format!(
+                        "contains the control character {:?} (U+{:04X}): it is printed and written into the output files; use printable text",
+                        c,
+                        c as u32
+                    ),
+                ));
+            }
+        }
         let finite = |field: &str, v: f64| -> Result<(), SceneError> {
             if v.is_finite() {
                 Ok(())

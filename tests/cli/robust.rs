@@ -222,6 +222,16 @@ fn scene_cases() -> Vec<Case> {
             "above the limit of 10000000",
         ),
         scene_case(
+            "courant-at-or-above-one",
+            bar(&[("dt = 1e-3", "courant = 1.5")]),
+            "time.courant: 1.5 puts the time step at or above the critical step",
+        ),
+        scene_case(
+            "control-character-in-the-name",
+            bar(&[("name = \"bar\"", "name = \"a\\u001b[31mred\\u0007\"")]),
+            "name: contains the control character",
+        ),
+        scene_case(
             "blocks-per-axis",
             bar(&[("blocks = [4, 1]", "blocks = [5000, 1]")]),
             "mesh.blocks: each count must be in 1..=4096",
@@ -837,4 +847,57 @@ fn check_validates_command_lines_without_running_them() {
             Ok(other) => panic!("{args:?}: {other:?}"),
         }
     }
+}
+
+/// A scene that fails at set-up (its body reaches outside the mesh) is bad input:
+/// exit status 2, "nothing was run", and `--out` holds nothing of it (a new
+/// directory is not left behind, an existing empty one stays empty), so that the
+/// corrected scene runs into the same directory without `--overwrite`.
+#[test]
+fn a_scene_error_leaves_nothing_in_out() {
+    let dir = temp_dir("scene-error-out");
+    let good = edited(BAR, &[("mass = \"consistent\"", "mass = \"lumped\"")]);
+    let bad = edited(&good, &[("max = [4.0, 1.0]", "max = [4.5, 1.0]")]);
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, &bad).unwrap();
+    let fresh = dir.join("fresh");
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    for out in [&fresh, &empty] {
+        let o = cli()
+            .arg("run")
+            .arg(&scene)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("lies outside the mesh"), "{stderr}");
+    }
+    assert!(!fresh.exists(), "{} was left behind", fresh.display());
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
+    // The corrected scene runs into the same directory.
+    std::fs::write(&scene, &good).unwrap();
+    let o = cli()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&empty)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(empty.join("diagnostics.csv").exists());
+    // A Courant number of 1 or more runs only when asked to.
+    let fast = edited(&good, &[("dt = 1e-3", "courant = 1.5")]);
+    std::fs::write(&scene, fast).unwrap();
+    let o = cli()
+        .arg("run")
+        .arg(&scene)
+        .args(["--allow-above-critical", "--diag-every", "0"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("time.courant"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
 }
