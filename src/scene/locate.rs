@@ -229,6 +229,18 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
             }
         }
     }
+    // A missing field, or an array of the wrong length, inside a table is reported
+    // at the table's header: name the table and the field.
+    if let Some((table, field)) = header_field(text, at, &message) {
+        let name = format!("{table}.{field}");
+        // A value that is there is pointed at; a missing one at its table.
+        let at = if message.starts_with("missing field") {
+            at
+        } else {
+            key_line_after(text, at, &field).unwrap_or(at)
+        };
+        return (at, Some(name.clone()), format!("{name}: {message}"));
+    }
     // Name the field when the error is about a key or a value (not about the
     // syntax between them).
     let about_value = {
@@ -248,5 +260,60 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
             (at, Some(field), message)
         }
         _ => (at, None, message),
+    }
+}
+
+/// For an error reported at a table header `[T]` (or the `k`-th `[[T]]`): the
+/// table's path and the field it is about, when the message says: `missing field
+/// `X`` names `X`; `invalid length N, …` names the one key of the table whose
+/// value is an array of `N` entries.
+fn header_field(text: &str, at: usize, message: &str) -> Option<(String, String)> {
+    let at = at.min(text.len());
+    let line_start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[line_start..].lines().next()?.trim();
+    let (name, array) = if let Some(r) = line.strip_prefix("[[") {
+        (r.split_once("]]")?.0.trim(), true)
+    } else {
+        (line.strip_prefix('[')?.split_once(']')?.0.trim(), false)
+    };
+    // The path with the index of this `[[T]]` among those before it.
+    let path = if array {
+        let before = text[..line_start]
+            .lines()
+            .filter(|l| {
+                l.trim()
+                    .strip_prefix("[[")
+                    .and_then(|r| r.split_once("]]"))
+                    .is_some_and(|(n, _)| n.trim() == name)
+            })
+            .count();
+        format!("{name}[{before}]")
+    } else {
+        name.to_string()
+    };
+    if let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|r| r.split_once('`'))
+        .map(|(f, _)| f)
+    {
+        return Some((path, field.to_string()));
+    }
+    let length: usize = message
+        .strip_prefix("invalid length ")?
+        .split(|c: char| !c.is_ascii_digit())
+        .next()?
+        .parse()
+        .ok()?;
+    // The table's own lines, up to the next header.
+    let body = &text[line_start + line.len().min(text.len() - line_start)..];
+    let body = body.find("\n[").map_or(body, |end| &body[..end]);
+    let table: toml::Table = body.parse().ok()?;
+    let mut keys = table
+        .iter()
+        .filter(|(_, v)| v.as_array().is_some_and(|a| a.len() == length))
+        .map(|(k, _)| k.clone());
+    match (keys.next(), keys.next()) {
+        (Some(key), None) => Some((path, key)),
+        _ => None,
     }
 }

@@ -472,9 +472,8 @@ fn type_cases() -> Vec<Case> {
             .edit("blocks = [4, 1]", "blocks = [4.5, 1]")
             .at(13, 11).expect("mesh.blocks: invalid type: floating point `4.5`, expected usize"),
         case("three-block-counts", BAR)
-            .edit("[mesh]", "@@[mesh]")
-            .edit("blocks = [4, 1]", "blocks = [4, 1, 1]")
-            .expect("invalid length 3, expected 2 elements in sequence"),
+            .edit("blocks = [4, 1]", "@@blocks = [4, 1, 1]")
+            .expect("mesh.blocks: invalid length 3, expected 2 elements in sequence"),
         case("huge-integer", BAR)
             .edit("blocks = [4, 1]", "blocks = [@@99999999999999999999, 1]")
             .expect("mesh.blocks: invalid type: integer `99999999999999999999` as i128, expected any value"),
@@ -772,27 +771,27 @@ fn missing_cases() -> Vec<Case> {
         case("missing-young", BAR)
             .edit("[material]", "@@[material]")
             .edit("young = 100.0\n", "")
-            .expect("missing field `young`"),
+            .expect("material.young: missing field `young`"),
         case("missing-t-end", BAR)
             .edit("[time]", "@@[time]")
             .edit("t_end = 0.01\n", "")
-            .expect("missing field `t_end`"),
+            .expect("time.t_end: missing field `t_end`"),
         case("missing-boundary-fix", BAR)
             .edit("[[boundary]]\ntag = \"right\"", "@@[[boundary]]\ntag = \"right\"")
             .edit("fix = [\"x\", \"y\"]\n\n[time]", "\n[time]")
-            .expect("missing field `fix`"),
+            .expect("boundary[1].fix: missing field `fix`"),
         case("missing-mesh-kind", BAR)
             .edit("[mesh]", "@@[mesh]")
             .edit("kind = \"blocks\"\n", "")
-            .expect("missing field `kind`"),
+            .expect("mesh.kind: missing field `kind`"),
         case("missing-gmsh-file", GMSH)
             .edit("[mesh]", "@@[mesh]")
             .edit("file = \"meshes/square.msh\"\n", "")
-            .expect("missing field `file`"),
+            .expect("mesh.file: missing field `file`"),
         case("missing-gravity-g", COLUMN)
             .edit("[[effect]]\nkind = \"gravity\"", "@@[[effect]]\nkind = \"gravity\"")
             .edit("g = [0.0, -9.81]\n", "")
-            .expect("missing field `g`"),
+            .expect("effect[0].g: missing field `g`"),
         case("empty-file", "")
             .map(|_| "@@".into())
             .expect("missing field `name`"),

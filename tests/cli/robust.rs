@@ -222,6 +222,16 @@ fn scene_cases() -> Vec<Case> {
             "above the limit of 10000000",
         ),
         scene_case(
+            "array-of-the-wrong-length-in-a-tagged-table",
+            bar(&[("blocks = [4, 1]", "blocks = [4, 1, 1]")]),
+            ".toml:10:1: mesh.blocks: invalid length 3",
+        ),
+        scene_case(
+            "missing-field-named-with-its-table",
+            bar(&[("young = 100.0\n", "")]),
+            "material.young: missing field `young`",
+        ),
+        scene_case(
             "courant-at-or-above-one",
             bar(&[("dt = 1e-3", "courant = 1.5")]),
             "time.courant: 1.5 puts the time step at or above the critical step",
