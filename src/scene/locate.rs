@@ -196,7 +196,20 @@ pub(super) fn field_offset(text: &str, path: &str) -> usize {
 /// its message, prefixed with that field.
 pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<String>, String) {
     let mut at = e.span().map_or(0, |s| s.start);
-    let message = e.message().trim().to_string();
+    let mut message = e.message().trim().to_string();
+    // An integer beyond 64 bits: say so instead of the parser's internal type.
+    if let Some(value) = message
+        .strip_prefix("invalid type: integer `")
+        .and_then(|r| r.split_once("` as i128"))
+        .map(|(v, _)| v.to_string())
+    {
+        message =
+            format!("the integer `{value}` is out of range (integers in a scene file are 64-bit)");
+    }
+    // A tagged table given as something else: say what it must be.
+    if let Some((head, _)) = message.split_once("expected internally tagged enum") {
+        message = format!("{head}expected a table with a `kind` key");
+    }
     // Errors of a value in a buffered (tagged) table that quote no value: at
     // their key.
     let key = (message == super::MESH_HOLE_AS_CORNERS).then_some("holes");

@@ -476,7 +476,7 @@ fn type_cases() -> Vec<Case> {
             .expect("mesh.blocks: invalid length 3, expected 2 elements in sequence"),
         case("huge-integer", BAR)
             .edit("blocks = [4, 1]", "blocks = [@@99999999999999999999, 1]")
-            .expect("mesh.blocks: invalid type: integer `99999999999999999999` as i128, expected any value"),
+            .expect("mesh.blocks: the integer `99999999999999999999` is out of range (integers in a scene file are 64-bit)"),
     ]
 }
 

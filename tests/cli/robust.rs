@@ -232,6 +232,14 @@ fn scene_cases() -> Vec<Case> {
             "material.young: missing field `young`",
         ),
         scene_case(
+            "a-tagged-table-given-as-a-number",
+            bar(&[(
+                "[mesh]\nkind = \"blocks\"\nx = [0.0, 4.0]\ny = [0.0, 1.0]\nblocks = [4, 1]\n",
+                "mesh = 5\n",
+            )]),
+            "mesh: invalid type: integer `5`, expected a table with a `kind` key",
+        ),
+        scene_case(
             "courant-at-or-above-one",
             bar(&[("dt = 1e-3", "courant = 1.5")]),
             "time.courant: 1.5 puts the time step at or above the critical step",
