@@ -491,7 +491,7 @@ impl Recorder {
         self.tracked_panel(
             tracked,
             format!("{}: tracked particles", self.scene),
-            "displacement (m)",
+            "displacement",
             "u",
             |t| (&t.displacement, &t.exact_displacement),
         )
@@ -502,7 +502,7 @@ impl Recorder {
         self.tracked_panel(
             tracked,
             format!("{}: tracked particles, velocity", self.scene),
-            "velocity (m/s)",
+            "velocity",
             "v",
             |t| (&t.velocity, &t.exact_velocity),
         )
@@ -521,7 +521,7 @@ impl Recorder {
         symbol: &str,
         series: impl Fn(&Tracked) -> (&Vec<[f64; 2]>, &Vec<[f64; 2]>),
     ) -> LinePlot {
-        let mut plot = LinePlot::new(title, "time (s)", label);
+        let mut plot = LinePlot::new(title, "time", label);
         let axis = ["x", "y"];
         for t in tracked {
             let (computed, exact) = series(t);
@@ -569,15 +569,16 @@ impl Recorder {
     }
 
     fn energy_plot(&self) -> LinePlot {
-        let (per, unit) = if self.dim == 2 {
-            ("thickness", "energy (J/m)")
+        // No units: a scene's are whatever consistent system it is written in.
+        let per = if self.dim == 2 {
+            "thickness"
         } else {
-            ("cross-section", "energy (J/m²)")
+            "cross-section"
         };
         let mut plot = LinePlot::new(
             format!("{}: energy (per unit {per})", self.scene),
-            "time (s)",
-            unit,
+            "time",
+            format!("energy per unit {per}"),
         );
         for (k, name) in ["kinetic", "strain", "potential", "total"]
             .iter()
