@@ -371,6 +371,39 @@ fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>
         .collect()
 }
 
+/// A warning for each tracked point of the scene that lies more than two particle
+/// spacings (`V_p^(1/D)`) from the particle it picks (the nearest): a point outside
+/// every body tracks a particle the user did not mean.
+fn tracked_warnings<const D: usize>(
+    scene: &Scene,
+    particles: &Particles<f64, D>,
+    tracked: &[Tracked],
+) -> Vec<String> {
+    scene
+        .output
+        .tracked
+        .iter()
+        .zip(tracked)
+        .enumerate()
+        .filter_map(|(k, (point, t))| {
+            let p = t.particle;
+            let distance = (0..D)
+                .map(|i| (particles.x0[p][i] - point[i]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let spacing = particles.volume0.get(p)?.powf(1.0 / D as f64);
+            (distance > 2.0 * spacing).then(|| {
+                format!(
+                    "output.tracked[{k}] at {} lies {distance:.3e} from the particle it tracks (particle {p} at {}, the nearest; {:.1} particle spacings away): put the point inside a body",
+                    crate::driver::point(&point[..D]),
+                    crate::driver::point(&t.x0[..D]),
+                    distance / spacing
+                )
+            })
+        })
+        .collect()
+}
+
 /// Shows `on_step` the initial state, then takes the steps (until the first
 /// failure), recording the tracked particles and the energy and mass facts.
 fn step_loop<const D: usize, B: Basis<f64, D>>(
@@ -622,6 +655,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             warnings: warnings
                 .into_iter()
                 .chain(sparse_sampling_warning(tally.sampling))
+                .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .collect(),
             interrupted: tally.interrupted,
             seconds: tally.seconds,

@@ -73,6 +73,27 @@ pub fn variants(
             .map(|m| MassKind::parse(m).map_err(|e| CliError::Input(format!("--mass: {e}"))))
             .collect::<Result<_, _>>()?
     };
+    // A variant listed twice would run twice and print two identical rows.
+    if let Some(b) = bases
+        .iter()
+        .enumerate()
+        .find_map(|(i, b)| bases[..i].contains(b).then_some(b))
+    {
+        return Err(CliError::Input(format!(
+            "--basis: `{}` is listed twice",
+            b.name()
+        )));
+    }
+    if let Some(m) = masses
+        .iter()
+        .enumerate()
+        .find_map(|(i, m)| masses[..i].contains(m).then_some(m))
+    {
+        return Err(CliError::Input(format!(
+            "--mass: `{}` is listed twice",
+            m.spec()
+        )));
+    }
     let mut out = Vec::new();
     for &b in &bases {
         let with_basis = base

@@ -31,6 +31,7 @@ mod failure;
 pub mod phases;
 
 pub use critical::CRITICAL_ITERATIONS;
+pub(crate) use failure::point;
 pub use failure::{SetupError, StepError, NEARLY_SINGULAR};
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};

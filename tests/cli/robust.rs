@@ -396,6 +396,8 @@ fn command_line_cases() -> Vec<Case> {
         args_case("1d-builtin-blocks", None, &["run", "vibrating-bar-1d", "--blocks", "8x2"], "the second number must be 1"),
         args_case("compare-1d-blocks", rod.clone(), &["compare", "@", "--blocks", "8x3"], "--blocks 8x3"),
         args_case("converge-1d-particles", None, &["converge", "vibrating-bar-1d", "--particles", "4x9"], "--particles 4x9"),
+        args_case("compare-a-basis-twice", None, &["compare", "vibrating-bar", "--basis", "ps,pl,ps"], "--basis: `ps` is listed twice"),
+        args_case("compare-a-mass-twice", None, &["compare", "vibrating-bar", "--mass", "lumped,partial,lumped"], "--mass: `lumped` is listed twice"),
         args_case("blocks-per-axis", None, &["run", "vibrating-bar", "--blocks", "5000x1"], "--blocks 5000x1: mesh.blocks: each count must be in 1..=4096"),
         args_case("blocks-in-all", None, &["run", "vibrating-bar", "--blocks", "4096x4096"], "above the limit of 1000000"),
         args_case("blocks-overflow", None, &["run", "vibrating-bar", "--blocks", "99999999999999999999999x1"], "--blocks must look like 4x1"),

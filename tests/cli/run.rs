@@ -423,3 +423,38 @@ fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
     assert!(!fine.contains("particles per occupied element"), "{fine}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A tracked point picks the particle nearest it; one outside every body (here far
+/// outside the mesh, and in the empty space above the block) is warned about with
+/// the particle it picked, one inside the block is not.
+#[test]
+fn a_tracked_point_outside_every_body_is_warned_about() {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/scenes.md")).unwrap();
+    let start = text.find("name = \"falling-block\"").unwrap();
+    let scene = text[start..start + text[start..].find("```").unwrap()].replace(
+        "[time]",
+        "[output]\ntracked = [[100.0, 100.0], [2.0, 3.5], [2.0, 2.5]]\n\n[time]",
+    );
+    let dir = std::env::temp_dir().join(format!("psmpm-tracked-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("falling.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = cli()
+        .arg("run")
+        .arg(&path)
+        .args(["--t-end", "0.05", "--diag-every", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    for part in [
+        "warning: output.tracked[0] at [100, 100] lies",
+        "warning: output.tracked[1] at [2, 3.5] lies",
+        "put the point inside a body",
+    ] {
+        assert!(stderr.contains(part), "`{part}` not in: {stderr}");
+    }
+    assert!(!stderr.contains("output.tracked[2]"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
