@@ -602,9 +602,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let (energy_drift, energy_growth) = tally.verdict.energy_drift_and_growth();
     let failure = tally.failure;
     let max_condition = tally.verdict.max_condition;
-    let stable = failure.is_none()
-        && energy_growth < STABLE_ENERGY_GROWTH
-        && max_condition.is_none_or(|c| c < STABLE_CONDITION);
+    let stable = tally.verdict.stable(failure.is_some());
     let energy_growth_hint =
         (failure.is_none() && energy_growth >= STABLE_ENERGY_GROWTH).then(|| {
             energy_growth_hint(

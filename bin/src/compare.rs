@@ -74,21 +74,13 @@ pub fn variants(
             .collect::<Result<_, _>>()?
     };
     // A variant listed twice would run twice and print two identical rows.
-    if let Some(b) = bases
-        .iter()
-        .enumerate()
-        .find_map(|(i, b)| bases[..i].contains(b).then_some(b))
-    {
+    if let Some(b) = listed_twice(&bases) {
         return Err(CliError::Input(format!(
             "--basis: `{}` is listed twice",
             b.name()
         )));
     }
-    if let Some(m) = masses
-        .iter()
-        .enumerate()
-        .find_map(|(i, m)| masses[..i].contains(m).then_some(m))
-    {
+    if let Some(m) = listed_twice(&masses) {
         return Err(CliError::Input(format!(
             "--mass: `{}` is listed twice",
             m.spec()
@@ -106,6 +98,13 @@ pub fn variants(
         }
     }
     Ok(out)
+}
+
+/// The first entry of `list` that an earlier one equals.
+fn listed_twice<T: PartialEq>(list: &[T]) -> Option<&T> {
+    list.iter()
+        .enumerate()
+        .find_map(|(i, x)| list[..i].contains(x).then_some(x))
 }
 
 /// Runs `scenes`, up to `jobs` at the same time, their steps on `pool`; results in

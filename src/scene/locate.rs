@@ -58,9 +58,9 @@ fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
     None
 }
 
-/// The dotted field (`mesh.blocks`, `effect[1].kind`, `basis`) set on the line of
-/// byte offset `at`, if that line is a `key = value` line.
-fn field_at(text: &str, at: usize) -> Option<String> {
+/// The table (`mesh`, `effect[1]`; `None` at the top level) of the line of byte
+/// offset `at`, a header line naming its own table, and that line.
+fn table_at(text: &str, at: usize) -> Option<(Option<String>, &str)> {
     let mut table: Option<String> = None;
     let mut counts = std::collections::HashMap::<String, usize>::new();
     let mut offset = 0;
@@ -75,24 +75,31 @@ fn field_at(text: &str, at: usize) -> Option<String> {
             table = Some(name.0.trim().to_string());
         }
         if at < offset + line.len() {
-            let (key, _) = line.split_once('=')?;
-            let key = key.trim();
-            if key.is_empty()
-                || key.starts_with('#')
-                || !key
-                    .chars()
-                    .all(|c| c.is_alphanumeric() || c == '_' || c == '-')
-            {
-                return None;
-            }
-            return Some(match table {
-                Some(t) => format!("{t}.{key}"),
-                None => key.to_string(),
-            });
+            return Some((table, line));
         }
         offset += line.len();
     }
     None
+}
+
+/// The dotted field (`mesh.blocks`, `effect[1].kind`, `basis`) set on the line of
+/// byte offset `at`, if that line is a `key = value` line.
+fn field_at(text: &str, at: usize) -> Option<String> {
+    let (table, line) = table_at(text, at)?;
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim();
+    if key.is_empty()
+        || key.starts_with('#')
+        || !key
+            .chars()
+            .all(|c| c.is_alphanumeric() || c == '_' || c == '-')
+    {
+        return None;
+    }
+    Some(match table {
+        Some(t) => format!("{t}.{key}"),
+        None => key.to_string(),
+    })
 }
 
 /// Byte offset of the value of field `path` (`time.dt`, `body[1].count`, `mesh`) in
@@ -281,29 +288,11 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
 /// `X`` names `X`; `invalid length N, …` names the one key of the table whose
 /// value is an array of `N` entries.
 fn header_field(text: &str, at: usize, message: &str) -> Option<(String, String)> {
-    let at = at.min(text.len());
-    let line_start = text[..at].rfind('\n').map_or(0, |i| i + 1);
-    let line = text[line_start..].lines().next()?.trim();
-    let (name, array) = if let Some(r) = line.strip_prefix("[[") {
-        (r.split_once("]]")?.0.trim(), true)
-    } else {
-        (line.strip_prefix('[')?.split_once(']')?.0.trim(), false)
-    };
-    // The path with the index of this `[[T]]` among those before it.
-    let path = if array {
-        let before = text[..line_start]
-            .lines()
-            .filter(|l| {
-                l.trim()
-                    .strip_prefix("[[")
-                    .and_then(|r| r.split_once("]]"))
-                    .is_some_and(|(n, _)| n.trim() == name)
-            })
-            .count();
-        format!("{name}[{before}]")
-    } else {
-        name.to_string()
-    };
+    let (table, line) = table_at(text, at)?;
+    if !line.trim_start().starts_with('[') {
+        return None;
+    }
+    let path = table?;
     if let Some(field) = message
         .strip_prefix("missing field `")
         .and_then(|r| r.split_once('`'))
@@ -318,7 +307,8 @@ fn header_field(text: &str, at: usize, message: &str) -> Option<(String, String)
         .parse()
         .ok()?;
     // The table's own lines, up to the next header.
-    let body = &text[line_start + line.len().min(text.len() - line_start)..];
+    let line_end = text[..at.min(text.len())].rfind('\n').map_or(0, |i| i + 1) + line.len();
+    let body = &text[line_end.min(text.len())..];
     let body = body.find("\n[").map_or(body, |end| &body[..end]);
     let table: toml::Table = body.parse().ok()?;
     let mut keys = table

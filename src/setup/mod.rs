@@ -73,6 +73,19 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     domain: Domain<B>,
 ) -> Result<Prepared<D, B>, RunError> {
+    // A Courant number of 1 or more is refused before anything is built.
+    if let (Some(c), false) = (scene.time.courant, scene.time.allow_above_critical) {
+        if c >= 1.0 {
+            return Err(SceneError::new(
+                "time.courant",
+                ErrorKind::Value,
+                format!(
+                    "{c} puts the time step at or above the critical step, where the explicit update is unstable: give a value below 1 (0.5 serves smooth motion, 0.25 impacts and large strains), or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway"
+                ),
+            )
+            .into());
+        }
+    }
     let solution = Solution::new(scene);
     let mut lattice = particle_lattice(scene)?;
     let material = materials::<D>(scene, &lattice)?;
@@ -89,18 +102,6 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     let functions = basis.num_functions();
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
     // one (a mesh-based guess) only sets the driver up.
-    if let (Some(c), false) = (scene.time.courant, scene.time.allow_above_critical) {
-        if c >= 1.0 {
-            return Err(SceneError::new(
-                "time.courant",
-                ErrorKind::Value,
-                format!(
-                    "{c} puts the time step at or above the critical step, where the explicit update is unstable: give a value below 1 (0.5 serves smooth motion, 0.25 impacts and large strains), or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway"
-                ),
-            )
-            .into());
-        }
-    }
     let dt = scene.dt(h);
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(SceneError::new(

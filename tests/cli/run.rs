@@ -386,6 +386,20 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The complete scene of `docs/scenes.md` (the falling block), with `edit` applied,
+/// written to a fresh directory `name`; the file's path.
+fn scenes_md_example(name: &str, edit: impl Fn(&str) -> String) -> std::path::PathBuf {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/scenes.md")).unwrap();
+    let start = text.find("name = \"falling-block\"").unwrap();
+    let scene = edit(&text[start..start + text[start..].find("```").unwrap()]);
+    let dir = std::env::temp_dir().join(format!("psmpm-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("falling.toml");
+    std::fs::write(&path, scene).unwrap();
+    path
+}
+
 /// A body sampled by about one particle per element or fewer can come apart while
 /// its energy stays bounded, so the run warns at the start's sampling (the
 /// `docs/scenes.md` example with one particle per block of four triangles: 1.00
@@ -393,14 +407,7 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
 /// per block.
 #[test]
 fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/scenes.md")).unwrap();
-    let start = text.find("name = \"falling-block\"").unwrap();
-    let scene = &text[start..start + text[start..].find("```").unwrap()];
-    let dir = std::env::temp_dir().join(format!("psmpm-sparse-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("falling.toml");
-    std::fs::write(&path, scene).unwrap();
+    let path = scenes_md_example("sparse", str::to_string);
     let run = |extra: &[&str]| {
         let out = cli()
             .arg("run")
@@ -421,7 +428,7 @@ fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
     );
     let fine = run(&[]);
     assert!(!fine.contains("particles per occupied element"), "{fine}");
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(path.parent().unwrap()).ok();
 }
 
 /// A tracked point picks the particle nearest it; one outside every body (here far
@@ -429,17 +436,12 @@ fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
 /// the particle it picked, one inside the block is not.
 #[test]
 fn a_tracked_point_outside_every_body_is_warned_about() {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/scenes.md")).unwrap();
-    let start = text.find("name = \"falling-block\"").unwrap();
-    let scene = text[start..start + text[start..].find("```").unwrap()].replace(
-        "[time]",
-        "[output]\ntracked = [[100.0, 100.0], [2.0, 3.5], [2.0, 2.5]]\n\n[time]",
-    );
-    let dir = std::env::temp_dir().join(format!("psmpm-tracked-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("falling.toml");
-    std::fs::write(&path, scene).unwrap();
+    let path = scenes_md_example("tracked", |scene| {
+        scene.replace(
+            "[time]",
+            "[output]\ntracked = [[100.0, 100.0], [2.0, 3.5], [2.0, 2.5]]\n\n[time]",
+        )
+    });
     let out = cli()
         .arg("run")
         .arg(&path)
@@ -456,5 +458,5 @@ fn a_tracked_point_outside_every_body_is_warned_about() {
         assert!(stderr.contains(part), "`{part}` not in: {stderr}");
     }
     assert!(!stderr.contains("output.tracked[2]"), "{stderr}");
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(path.parent().unwrap()).ok();
 }
