@@ -238,19 +238,21 @@ fn scene_files_run_and_bad_ones_name_file_line_and_column() {
 }
 
 /// A fixed `dt` above a critical step that a nearly singular mass makes tiny (the
-/// column refined to 2 × 20 blocks with 3 × 3 particles each: 2.25 per triangle for
-/// the 9 PS functions of each) names that cause and its fix, not a smaller step.
+/// column on 1 × 10 blocks with 3 × 4 particles each: 3 per triangle for the 9 PS
+/// functions of each) names that cause and its fix, not a smaller step; a sparser
+/// sampling (2 × 20 blocks, 3 × 3 particles) makes the consistent mass singular,
+/// and the default then fails later, naming the particles per element.
 #[test]
 fn too_few_particles_per_element_is_named_as_the_cause_of_a_tiny_critical_step() {
-    let run = |mass: &str, t_end: &str| {
+    let run = |blocks: &str, particles: &str, mass: &str, t_end: &str| {
         cli()
             .args([
                 "run",
                 "column-large",
                 "--blocks",
-                "2x20",
+                blocks,
                 "--particles",
-                "3x3",
+                particles,
                 "--mass",
                 mass,
                 "--t-end",
@@ -261,13 +263,13 @@ fn too_few_particles_per_element_is_named_as_the_cause_of_a_tiny_critical_step()
             .output()
             .unwrap()
     };
-    let out = run("consistent", "0.01");
+    let out = run("1x10", "3x4", "consistent", "0.01");
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8(out.stderr).unwrap();
     for part in [
         "time.dt: the time step 0.001 is above the critical step",
-        "times below the lumped mass's (2.273e-3",
-        "2.2 particles per occupied element are too few",
+        "times below the lumped mass's (4.395e-3",
+        "3.0 particles per occupied element are too few",
         "use more particles per element",
     ] {
         assert!(stderr.contains(part), "{part}: {stderr}");
@@ -277,7 +279,15 @@ fn too_few_particles_per_element_is_named_as_the_cause_of_a_tiny_critical_step()
     // critical step is not tiny and the run starts; it breaks later (2.25
     // particles per triangle for 9 PS functions), and the failure names the
     // particles per element, not the time step.
-    let out = run("default", "2.5");
+    let out = run("2x20", "3x3", "consistent", "0.01");
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("step 1: the mass system could not be solved")
+            && stderr.contains("functions with almost no particle in their support"),
+        "{stderr}"
+    );
+    let out = run("2x20", "3x3", "default", "2.5");
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(

@@ -7,7 +7,12 @@
 //!   to the bisector of the wedge and pushed out to the farthest PS point;
 //! - every triple of hull lines whose half-planes bound a triangle.
 //!
-//! The candidate of smallest area wins. On a straight stretch of boundary only
+//! The candidate of smallest area wins, except where the PS points are
+//! mirror-symmetric about the vertical (else the horizontal) line through `V_i`:
+//! there the smallest candidate with the same mirror symmetry wins, so that a mesh
+//! symmetric about a line gets a basis symmetric about it (the smallest triangle of
+//! a symmetric point set is often not symmetric, and which way it points would
+//! otherwise be decided by the order of the hull). On a straight stretch of boundary only
 //! candidates with an edge on the boundary line are allowed; at a convex corner the
 //! apex is `V_i` with edges along both boundary lines. With these choices the
 //! homogeneous Dirichlet condition on a straight boundary fixes exactly the
@@ -174,6 +179,10 @@ pub const CORNER_AREA_RATIO: f64 = 4.0;
 ///   Falls back to the best `Straight` candidate on either line when the wedge is
 ///   more than [`CORNER_AREA_RATIO`] times larger.
 ///
+/// Where the PS points are mirror-symmetric about the vertical line through
+/// `vertex` (else about the horizontal one), only candidates with that symmetry
+/// compete, when there is one: see [`Mirror`].
+///
 /// Ties between candidates of equal area go to the first one found (hull lines in
 /// counter-clockwise order from the lowest-leftmost point), so the choice is
 /// deterministic. `None` if no candidate contains the points (cannot happen on a
@@ -250,8 +259,51 @@ fn corner_candidate(
     contains_all(&t, points, tolerance(vertex, points)).then_some(t)
 }
 
+/// A mirror line through a vertex, axis-aligned. A mesh symmetric about a line
+/// (a box, a column, the block grids) has a symmetric basis only if each vertex on
+/// the line gets a triangle symmetric about it and each pair of mirrored vertices
+/// gets mirrored triangles. The smallest triangle around a symmetric point set is
+/// often not symmetric (around the octagon of PS points of a `four-triangles` grid
+/// vertex of valence 8 the smallest ones lean left or right), so where the points
+/// are symmetric the choice is made among symmetric candidates: the basis of a
+/// block dropped onto the middle of a floor is then mirror-symmetric, and the block
+/// does not come back turning. Vertical first: it is the mirror of a scene under
+/// gravity along `y`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Mirror {
+    /// The line `x = vertex.x`.
+    Vertical,
+    /// The line `y = vertex.y`.
+    Horizontal,
+}
+
+impl Mirror {
+    fn reflect(self, vertex: Vec2, p: Vec2) -> Vec2 {
+        match self {
+            Mirror::Vertical => Vec2::new(2.0 * vertex.x - p.x, p.y),
+            Mirror::Horizontal => Vec2::new(p.x, 2.0 * vertex.y - p.y),
+        }
+    }
+
+    /// `true` when the reflection maps `points` onto themselves, up to `tol`.
+    fn maps_onto_itself(self, vertex: Vec2, points: &[Vec2], tol: f64) -> bool {
+        points.iter().all(|p| {
+            let r = self.reflect(vertex, *p);
+            points.iter().any(|q| (q - r).norm() <= tol)
+        })
+    }
+
+    /// The mirror of the vertex's PS points, vertical first, if they have one.
+    fn of(vertex: Vec2, points: &[Vec2], tol: f64) -> Option<Mirror> {
+        [Mirror::Vertical, Mirror::Horizontal]
+            .into_iter()
+            .find(|m| m.maps_onto_itself(vertex, points, tol))
+    }
+}
+
 /// The smallest candidate (wedge or triple of hull lines) containing `points`; with
-/// `required`, only candidates having that line as one of theirs.
+/// `required`, only candidates having that line as one of theirs. Where the points
+/// have a [`Mirror`], the smallest candidate with the same symmetry, if any.
 fn smallest_candidate(
     vertex: Vec2,
     points: &[Vec2],
@@ -273,7 +325,9 @@ fn smallest_candidate(
         })
     });
     let allowed = |ids: &[usize]| required.is_none_or(|r| ids.contains(&r));
+    let mirror = Mirror::of(vertex, points, tol);
     let mut best: Option<([Vec2; 3], f64)> = None;
+    let mut best_mirrored: Option<([Vec2; 3], f64)> = None;
     let mut consider = |t: [Vec2; 3]| {
         let t = orient(t);
         let a = area(&t);
@@ -282,6 +336,11 @@ fn smallest_candidate(
         }
         if best.is_none_or(|(_, b)| a < b * (1.0 - 1e-12)) {
             best = Some((t, a));
+        }
+        if mirror.is_some_and(|m| m.maps_onto_itself(vertex, &t, tol))
+            && best_mirrored.is_none_or(|(_, b)| a < b * (1.0 - 1e-12))
+        {
+            best_mirrored = Some((t, a));
         }
     };
     let n = lines.len();
@@ -301,7 +360,7 @@ fn smallest_candidate(
             }
         }
     }
-    best.map(|(t, _)| t)
+    best_mirrored.or(best).map(|(t, _)| t)
 }
 
 #[cfg(test)]
@@ -357,6 +416,71 @@ mod tests {
         // The smallest triangle around a regular hexagon has 1.5× its area.
         let hex = 1.5 * 3f64.sqrt();
         assert!((area(&t) - 1.5 * hex).abs() < 1e-9, "area {}", area(&t));
+    }
+
+    /// The PS points of a valence-8 vertex of the `four-triangles` grid (unit
+    /// blocks, incentre split): a regular octagon, whose eight smallest triangles
+    /// tie. Two of them are symmetric about the vertical through the vertex; the
+    /// choice is one of those.
+    #[test]
+    fn a_mirror_symmetric_point_set_gets_a_mirror_symmetric_triangle() {
+        let v = Vec2::new(2.0, 1.0);
+        // The incentre of the triangle (0, 0), (1, 0), (½, ½), halfway to the vertex.
+        let r = Vec2::new(0.25, 0.25 * (2f64.sqrt() - 1.0)).norm();
+        let mut pts = vec![v];
+        for k in 0..8 {
+            let a = std::f64::consts::FRAC_PI_4 * k as f64;
+            // Edge points at ¼ along the axes and ⅛ along the diagonals (the block
+            // centres at ½), the triangles' points between them.
+            let e = if k % 2 == 0 {
+                0.25
+            } else {
+                0.125 * 2f64.sqrt()
+            };
+            pts.push(v + e * Vec2::new(a.cos(), a.sin()));
+            let b = a + std::f64::consts::FRAC_PI_8;
+            pts.push(v + r * Vec2::new(b.cos(), b.sin()));
+        }
+        let t = control_triangle(v, &pts, VertexKind::Interior).unwrap();
+        for q in &t {
+            let image = Vec2::new(2.0 * v.x - q.x, q.y);
+            assert!(
+                t.iter().any(|p| (p - image).norm() < 1e-12),
+                "{t:?} not symmetric"
+            );
+        }
+        assert!(margin(&t, &pts) > 0.0);
+        // As small as the smallest candidate of all (a regular octagon's smallest
+        // triangle, flush with edges 0, 3 and 5 of the eight).
+        let octagon =
+            8.0 * r * r * std::f64::consts::FRAC_PI_8.sin() * std::f64::consts::FRAC_PI_8.cos();
+        let smallest = {
+            let tol = tolerance(v, &pts);
+            let hull = convex_hull(&pts);
+            let lines: Vec<HalfPlane> = (0..hull.len())
+                .map(|k| HalfPlane::left_of(hull[k], hull[(k + 1) % hull.len()]))
+                .collect();
+            let mut best = f64::INFINITY;
+            for i in 0..lines.len() {
+                for j in i + 1..lines.len() {
+                    for k in j + 1..lines.len() {
+                        if let Some(c) = triple_candidate([&lines[i], &lines[j], &lines[k]], tol) {
+                            let c = orient(c);
+                            if contains_all(&c, &pts, tol) {
+                                best = best.min(area(&c));
+                            }
+                        }
+                    }
+                }
+            }
+            best
+        };
+        assert!(smallest > octagon);
+        assert!(
+            (area(&t) / smallest - 1.0).abs() < 1e-9,
+            "{} {smallest}",
+            area(&t)
+        );
     }
 
     #[test]

@@ -938,6 +938,65 @@ mod tests {
         assert!(PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).is_ok());
     }
 
+    /// A grid symmetric about a line has a basis symmetric about it: every function
+    /// has a mirror image among the functions (the one whose control point is the
+    /// mirrored one, at the mirrored vertex) with the mirrored values and gradients.
+    /// Without the symmetric choice of `control_triangle::Mirror` the valence-8
+    /// vertices of the block grid get triangles leaning left or right, and a block
+    /// dropped onto the middle of a floor comes back turning.
+    #[test]
+    fn a_mirror_symmetric_grid_has_a_mirror_symmetric_basis() {
+        let mesh = generators::block_grid(0.0, 4.0, 0.0, 3.0, 4, 3).unwrap();
+        let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+        let mirror = |p: Vec2| Vec2::new(4.0 - p.x, p.y);
+        let vertices = ps.mesh().vertices();
+        let image: Vec<usize> = (0..ps.num_functions())
+            .map(|i| {
+                let v = i / 3;
+                let w = vertices
+                    .iter()
+                    .position(|p| (p - mirror(vertices[v])).norm() < 1e-12)
+                    .unwrap();
+                let q = mirror(ps.function_point(i));
+                (3 * w..3 * w + 3)
+                    .find(|&j| (ps.function_point(j) - q).norm() < 1e-12)
+                    .unwrap_or_else(|| panic!("function {i} at vertex {v}: no mirror image"))
+            })
+            .collect();
+        let (mut a, mut b) = (BasisEval::for_basis(&ps), BasisEval::for_basis(&ps));
+        for k in 0..400 {
+            // A deterministic scatter over the domain (additive recurrence).
+            let x = Vec2::new(
+                4.0 * (0.5 + k as f64 * 0.618_033_988_749_895).fract(),
+                3.0 * (0.5 + k as f64 * 0.754_877_666_246_693).fract(),
+            );
+            let (ea, eb) = (
+                ps.locate(&x, None).unwrap(),
+                ps.locate(&mirror(x), None).unwrap(),
+            );
+            ps.eval(ea, &x, &mut a);
+            ps.eval(eb, &mirror(x), &mut b);
+            for s in 0..a.len() {
+                let j = image[a.index[s]];
+                // On an edge the two points may lie in elements that do not share
+                // every function: one absent there is zero with its gradient (C¹).
+                let (phi_b, gb) = (0..b.len())
+                    .find(|&t| b.index[t] == j)
+                    .map_or((0.0, Vec2::zeros()), |t| (b.phi[t], b.grad_phi[t]));
+                let ga = a.grad_phi[s];
+                assert!(
+                    (a.phi[s] - phi_b).abs() < 1e-13
+                        && (ga.x + gb.x).abs() < 1e-12
+                        && (ga.y - gb.y).abs() < 1e-12,
+                    "function {} at {x:?}: {} {ga:?} against its image {j}: {} {gb:?}",
+                    a.index[s],
+                    a.phi[s],
+                    phi_b
+                );
+            }
+        }
+    }
+
     #[test]
     fn f32_basis_is_a_partition_of_unity_to_single_precision() {
         let mesh =
