@@ -304,6 +304,11 @@ impl Gather {
         }
     }
 
+    /// Which functions are live ([`Gather::mark_live`]).
+    pub(super) fn live(&self) -> &[bool] {
+        &self.live
+    }
+
     /// Whether function `i` is live ([`Gather::mark_live`]).
     #[inline]
     pub(super) fn is_live(&self, i: usize) -> bool {

@@ -475,6 +475,7 @@ where
                 particle_volume: &self.inputs.particle_volume,
                 particle_count: &self.inputs.particle_count,
                 on_wall: &self.inputs.on_wall,
+                live: self.gather.live(),
                 diagonal_only: self.inputs.needs.row_sums_only,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
@@ -582,6 +583,7 @@ where
             particle_volume: &self.inputs.particle_volume,
             particle_count: &self.inputs.particle_count,
             on_wall: &self.inputs.on_wall,
+            live: self.gather.live(),
             diagonal_only: self.inputs.needs.row_sums_only,
         };
         match self.mass.factorize(&self.pattern, &self.values, context) {

@@ -408,6 +408,9 @@ pub struct StepContext<'a> {
     /// `on_wall[i]`: a wall constrains function `i` (a fixed component, or a
     /// slip wall's constraint has a term on it); empty when not measured.
     pub on_wall: &'a [bool],
+    /// `live[i]`: an element holding a particle has function `i` (empty when not
+    /// measured).
+    pub live: &'a [bool],
     /// The values hold the row sums on the diagonal and zero elsewhere (the
     /// driver assembled only those, as [`Needs::row_sums_only`] asked).
     pub diagonal_only: bool,

@@ -86,6 +86,7 @@ fn context(c: &Column) -> StepContext<'_> {
         particle_volume: &c.particle_volume,
         particle_count: &c.particle_count,
         on_wall: &[],
+        live: &[],
         diagonal_only: false,
     }
 }

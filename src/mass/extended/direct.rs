@@ -234,7 +234,7 @@ impl<T: Scalar> Direct<T> {
     fn add_mass_column(&mut self, op: &Reduced<'_, T>, full: &FullPattern, c: usize, w: T) {
         for k in full.ptr[c]..full.ptr[c + 1] {
             let r = full.row[k] as usize;
-            if op.role[r] == Role::Inactive || op.fixed[r] {
+            if matches!(op.role[r], Role::Inactive | Role::Ghost) || op.fixed[r] {
                 continue;
             }
             if !self.y_mark[r] {

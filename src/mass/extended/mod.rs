@@ -85,6 +85,14 @@ enum Role {
     Solved,
     /// Under-supported: expressed through its row of `E`.
     Extended,
+    /// No mass, but an element that holds a particle has it: the particles lie
+    /// on the edge of its support, where it vanishes. Outside the system, and
+    /// given its row of `E` after each solve: a C⁰ basis's gradient does not
+    /// vanish there (PL on a particle lying on a triangle edge), and held at zero
+    /// the function would put a kink into the velocity field at the particle,
+    /// strain in a body that only translates. A C¹ basis vanishes there with its
+    /// gradient, so nothing a particle sees changes.
+    Ghost,
 }
 
 /// Extended functions the extension rows have room for before a step grows them.
@@ -119,6 +127,8 @@ pub struct Extended<T: Scalar> {
     role: Vec<Role>,
     active: Vec<usize>,
     extended: Vec<usize>,
+    /// The [`Role::Ghost`] functions, ascending.
+    ghosts: Vec<usize>,
     ext_ptr: Vec<usize>,
     ext_idx: Vec<usize>,
     ext_w: Vec<T>,
@@ -193,6 +203,7 @@ impl<T: Scalar> Extended<T> {
             role: Vec::new(),
             active: Vec::new(),
             extended: Vec::new(),
+            ghosts: Vec::new(),
             ext_ptr: Vec::new(),
             ext_idx: Vec::new(),
             ext_w: Vec::new(),
@@ -244,7 +255,12 @@ impl<T: Scalar> Extended<T> {
         for i in 0..n {
             let d = values[pattern.diagonal_position(i)];
             if d <= T::zero() {
-                self.role[i] = Role::Inactive;
+                let live = context.live.get(i).copied().unwrap_or(false);
+                self.role[i] = if live && !self.support.coefficients.is_empty() {
+                    Role::Ghost
+                } else {
+                    Role::Inactive
+                };
                 self.lumped[i] = false;
                 continue;
             }
@@ -283,10 +299,56 @@ impl<T: Scalar> Extended<T> {
                     self.role[j] = Role::Solved;
                     self.lumped[j] = self.lump > self.coverage;
                 }
+            } else if self.role[j] == Role::Ghost && !self.extend(j) {
+                self.role[j] = Role::Inactive;
             }
         }
         self.ext_ptr[n] = self.ext_idx.len();
         report
+    }
+}
+
+impl<T: Scalar> Extended<T> {
+    /// The reduced system `Eᵀ M E` of component `k`: its factorisation, else the
+    /// conjugate gradients.
+    fn solve_reduced(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
+        let s = self.solver_of[k];
+        let mut b = std::mem::take(&mut self.rhs);
+        let mut scratch = std::mem::take(&mut self.scratch);
+        if self.reduced_factor[s].ready {
+            let mut factor = std::mem::take(&mut self.reduced_factor[s]);
+            factor.solve(&self.reduced(s), rhs, &mut b, &mut scratch.x);
+            self.reduced_factor[s] = factor;
+            self.rhs = b;
+            self.scratch = scratch;
+            return Ok(());
+        }
+        let result = {
+            let op = self.reduced(s);
+            op.restrict(rhs, &mut b);
+            let result = conjugate_gradients(&op, &self.precond[s], &b, &mut scratch);
+            op.expand_all(&scratch.x, rhs);
+            result
+        };
+        self.rhs = b;
+        self.scratch = scratch;
+        result.map(|_| ())
+    }
+
+    /// The [`Role::Ghost`] functions of component `k` from their rows of `E`
+    /// (their carriers are solved functions), except where a wall holds them.
+    fn fill_ghosts(&self, k: usize, rhs: &mut [T]) {
+        let fixed = &self.fixed[self.solver_of[k]];
+        for &j in &self.ghosts {
+            if fixed[j] {
+                continue;
+            }
+            let mut value = T::zero();
+            for t in self.ext_ptr[j]..self.ext_ptr[j + 1] {
+                value += self.ext_w[t] * rhs[self.ext_idx[t]];
+            }
+            rhs[j] = value;
+        }
     }
 }
 
@@ -342,6 +404,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.diagonal_add = vec![T::zero(); n];
         self.active = Vec::with_capacity(n);
         self.extended = Vec::with_capacity(n);
+        self.ghosts = Vec::new();
         self.ext_ptr = vec![0; n + 1];
         // Room for `EXTENSION_ROOM` functions extended through 16 neighbours each
         // (under-supported functions lie along the body's edge, a small share of a
@@ -405,9 +468,11 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.any_lumped = report.lumped_rows > 0;
         self.active.clear();
         self.extended.clear();
+        self.ghosts.clear();
         for i in 0..n {
             match self.role[i] {
                 Role::Inactive => {}
+                Role::Ghost => self.ghosts.push(i),
                 Role::Solved => self.active.push(i),
                 Role::Extended => {
                     self.active.push(i);
@@ -434,7 +499,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.direct = false;
         if self.extended.is_empty() {
             for i in 0..n {
-                self.cholesky.inactive[i] = self.role[i] == Role::Inactive;
+                self.cholesky.inactive[i] = matches!(self.role[i], Role::Inactive | Role::Ghost);
                 self.cholesky.lumped[i] = false;
             }
             // `self.values` holds the lumped rows of the hybrid (else `values`).
@@ -482,35 +547,23 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
     }
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         if self.direct {
-            return self.cholesky.solve_all(rhs);
+            self.cholesky.solve_all(rhs)?;
+            for (k, r) in rhs.iter_mut().enumerate() {
+                self.fill_ghosts(k, r);
+            }
+            return Ok(());
         }
         super::solve_each(self, rhs)
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         if self.direct {
-            return self.cholesky.solve(k, rhs);
-        }
-        let s = self.solver_of[k];
-        let mut b = std::mem::take(&mut self.rhs);
-        let mut scratch = std::mem::take(&mut self.scratch);
-        if self.reduced_factor[s].ready {
-            let mut factor = std::mem::take(&mut self.reduced_factor[s]);
-            factor.solve(&self.reduced(s), rhs, &mut b, &mut scratch.x);
-            self.reduced_factor[s] = factor;
-            self.rhs = b;
-            self.scratch = scratch;
+            self.cholesky.solve(k, rhs)?;
+            self.fill_ghosts(k, rhs);
             return Ok(());
         }
-        let result = {
-            let op = self.reduced(s);
-            op.restrict(rhs, &mut b);
-            let result = conjugate_gradients(&op, &self.precond[s], &b, &mut scratch);
-            op.expand_all(&scratch.x, rhs);
-            result
-        };
-        self.rhs = b;
-        self.scratch = scratch;
-        result.map(|_| ())
+        let result = self.solve_reduced(k, rhs);
+        self.fill_ghosts(k, rhs);
+        result
     }
     /// `κ(Eᵀ M E)` on the solved functions, from Lanczos steps (no solves).
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
