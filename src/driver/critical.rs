@@ -4,6 +4,8 @@
 //! stiffness `K v = Σ_p V_p σ(∇v_p) ∇phi_i` with each particle's Lamé constants at
 //! the current particle positions. `λ_max` by power iteration: a lower bound, so the
 //! estimate is an upper bound on `Δt_crit` that tightens with the iterations.
+//! Local damping makes the update up to `1 + α` times stiffer: the step is divided
+//! by `√(1 + α)` ([`crate::effect::Effect::force_amplification`]).
 
 use super::{phases, Driver, StepError};
 use crate::mass::MassStrategy;
@@ -28,9 +30,18 @@ where
         self.locate_and_evaluate()?;
         self.assemble_mass();
         self.factorize()?;
-        let critical = self.power_iteration(None)?;
+        let critical = self.power_iteration(None)? / self.effects_amplification().sqrt();
         self.dt_critical = Some(critical);
         Ok(critical)
+    }
+
+    /// The product of the effects' [`Effect::force_amplification`](crate::effect::Effect::force_amplification)
+    /// (local damping: `1 + α`), which divides `ω_max²`'s step.
+    fn effects_amplification(&self) -> f64 {
+        self.effects
+            .iter()
+            .map(|e| e.force_amplification())
+            .product()
     }
 
     /// The critical time step with the row-sum lumped mass `m_i = Σ_p m_p phi_i(x_p)`
@@ -48,7 +59,7 @@ where
                 lumped[i] += m * self.evals.phi[s].to_f64();
             }
         }
-        self.power_iteration(Some(&lumped))
+        Ok(self.power_iteration(Some(&lumped))? / self.effects_amplification().sqrt())
     }
 
     /// `2 / √λ_max(M⁻¹K)` by power iteration, `M` the strategy's system (`None`) or

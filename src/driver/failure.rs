@@ -184,7 +184,8 @@ where
         }
         if let Some(critical) = self.dt_critical {
             let dt = self.dt.to_f64();
-            let cause = if self.material.is_objective(particle) {
+            // In 1D nothing rotates: objectivity is not a cause there.
+            let cause = if self.material.is_objective(particle) || D == 1 {
                 "the deformation there is large, with a stiffer response than at the start (compression, an impact): lower `time.courant` or `time.dt`"
             } else {
                 "its law, `linear-elastic`, is not objective and builds spurious stress where the body rotates: use `neo-hookean` or `corotational`, or a smaller `time.dt`"
@@ -193,8 +194,13 @@ where
                 "the element around it inverted (speed {speed:.3e}) although Δt = {dt:.3e} is below the critical step {critical:.3e} estimated at the start: {cause}"
             );
         }
+        let rotation = if D == 1 {
+            ""
+        } else {
+            "; if the body rotates, a law that is not objective (`linear-elastic`) also builds spurious stress"
+        };
         format!(
-            "the element around it inverted (speed {speed:.3e}, Δt = {:.3e}): the time step is likely above the critical one for this material and mesh, lower `time.dt` or `time.courant`; if the body rotates, a law that is not objective (`linear-elastic`) also builds spurious stress",
+            "the element around it inverted (speed {speed:.3e}, Δt = {:.3e}): the time step is likely above the critical one for this material and mesh, lower `time.dt` or `time.courant`{rotation}",
             self.dt.to_f64()
         )
     }

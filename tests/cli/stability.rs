@@ -192,3 +192,33 @@ fn unknown_cases_and_strategies_are_input_errors() {
         assert!(stderr.starts_with(message), "{stderr}");
     }
 }
+
+/// A strategy that deactivates the functions carrying a sliding block leaves it
+/// standing still with its energy bounded: the slide error (1.00, the block did not
+/// move) makes the cell not stable, with the reason, while the default slides.
+#[test]
+fn a_block_that_does_not_slide_is_not_stable() {
+    let cells = json(&[
+        "stability",
+        "--cases",
+        "free-incline",
+        "--mass",
+        "deactivate:0.01,default",
+        "--format",
+        "json",
+    ]);
+    let cells = cells.as_array().unwrap();
+    let (frozen, default) = (&cells[0], &cells[1]);
+    assert_eq!(frozen["measure"], "slide");
+    assert!(frozen["error"].as_f64().unwrap() > 0.9, "{frozen}");
+    assert_eq!(frozen["stable"], false, "{frozen}");
+    assert!(
+        frozen["reason"]
+            .as_str()
+            .unwrap()
+            .contains("above the bound 0.05: the body did not slide"),
+        "{frozen}"
+    );
+    assert_eq!(default["stable"], true, "{default}");
+    assert!(default["error"].as_f64().unwrap() < 1e-3, "{default}");
+}
