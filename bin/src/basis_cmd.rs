@@ -20,7 +20,7 @@ pub enum BasisCommand {
     /// Draw a mesh with its PS refinement and control triangles, or (with
     /// --function K) basis function K as a shaded plot, as SVG.
     ///
-    /// The mesh is the block grid of --blocks on the unit square (default 2x2), the
+    /// The mesh is the block grid of --blocks, unit blocks on [0, NX] × [0, NY] (default 2x2), the
     /// mesh of a scene (--scene NAME or FILE.toml), or a Gmsh file (--mesh FILE.msh).
     Plot(PlotArgs),
 }
@@ -28,7 +28,7 @@ pub enum BasisCommand {
 /// Arguments of `mpm-cli basis plot`.
 #[derive(Debug, clap::Args)]
 pub struct PlotArgs {
-    /// Block grid NXxNY of the unit square (4 triangles per block).
+    /// Block grid NXxNY of unit blocks, on [0, NX] × [0, NY] (4 triangles per block).
     #[arg(long, value_name = "NXxNY", conflicts_with_all = ["scene", "mesh"])]
     blocks: Option<String>,
     /// Use the mesh of this scene (built-in name or FILE.toml).
