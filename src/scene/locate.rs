@@ -35,17 +35,21 @@ fn key_line_after(text: &str, from: usize, key: &str) -> Option<usize> {
     None
 }
 
-/// Byte offset of the first value at or after `from` (in a `key = value` line, before
-/// the next table header but one) that contains `value`.
+/// Byte offset of the first value at or after `from` (in a `key = value` line of the
+/// table whose header is the first at or after `from`, or of the tables of the same
+/// array `[[T]]` that follow it) that contains `value`.
 fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
     let mut offset = 0;
-    let mut headers = 0;
+    let mut header: Option<&str> = None;
     for line in text.split_inclusive('\n') {
         if offset >= from {
-            if line.trim_start().starts_with('[') {
-                headers += 1;
-                if headers > 1 {
-                    return None;
+            let trimmed = line.trim();
+            if trimmed.starts_with('[') {
+                // The first header, or the next element of the same array.
+                match header {
+                    None => header = Some(trimmed),
+                    Some(h) if h == trimmed && h.starts_with("[[") => {}
+                    Some(_) => return None,
                 }
             } else if let Some(eq) = line.find('=') {
                 if let Some(i) = line[eq..].find(value) {
@@ -241,12 +245,15 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
         .iter()
         .any(|m| message.starts_with(m))
     {
-        // A value error inside a tagged table is reported at its header: find
-        // the value the message quotes.
-        if let Some(value) = message.split('`').nth(1) {
-            if let Some(offset) = value_after(text, at, value) {
-                at = offset;
-            }
+        // A value error inside a tagged table is reported at the header of the
+        // first table of its kind: find the value the message quotes (`…`, or a
+        // string "…" with its quotes, as written).
+        let quoted = message.split('`').nth(1).map(str::to_string).or_else(|| {
+            let rest = message.split_once("string \"")?.1;
+            rest.rfind('"').map(|end| format!("\"{}\"", &rest[..end]))
+        });
+        if let Some(offset) = quoted.and_then(|value| value_after(text, at, &value)) {
+            at = offset;
         }
     }
     // A missing field, or an array of the wrong length, inside a table is reported

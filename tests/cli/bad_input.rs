@@ -474,6 +474,18 @@ fn type_cases() -> Vec<Case> {
         case("three-block-counts", BAR)
             .edit("blocks = [4, 1]", "@@blocks = [4, 1, 1]")
             .expect("mesh.blocks: invalid length 3, expected 2 elements in sequence"),
+        // Inside an array of tagged tables the parser reports a value error at
+        // the first table's header: the message names the element and its field,
+        // at the value.
+        case("string-in-the-second-effect", COLUMN)
+            .edit("alpha = 0.1", "alpha = @@\"0.1\"")
+            .expect("effect[1].alpha: invalid type: string \"0.1\", expected f64"),
+        case("string-in-an-effect-array", COLUMN)
+            .edit("g = [0.0, -9.81]", "g = [0.0, @@\"-9.81\"]")
+            .expect("effect[0].g: invalid type: string \"-9.81\", expected f64"),
+        case("string-in-the-third-effect", COLUMN)
+            .edit("traction = [0.0, -1.0]", "traction = [0.0, @@\"down\"]")
+            .expect("effect[2].traction: invalid type: string \"down\", expected f64"),
         case("huge-integer", BAR)
             .edit("blocks = [4, 1]", "blocks = [@@99999999999999999999, 1]")
             .expect("mesh.blocks: the integer `99999999999999999999` is out of range (integers in a scene file are 64-bit)"),
