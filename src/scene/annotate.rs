@@ -149,7 +149,10 @@ mod tests {
         let text = "[[effect]]\nkind = \"damping\"\nalpha = 0.1\n\n[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n";
         let shown = annotate(text);
         assert!(shown.contains("alpha = 0.1"), "{shown}");
-        assert!(shown.contains("# damping factor; 0 ≤ α < 1"), "{shown}");
+        assert!(
+            shown.contains("# damping factor; it makes the critical step √(1 + α) times shorter, and the estimate includes that; 0 ≤ α < 1"),
+            "{shown}"
+        );
         assert!(
             shown.contains("# acceleration; finite [length / time²]"),
             "{shown}"
