@@ -38,10 +38,10 @@ pub struct Overrides {
     #[arg(long)]
     pub layout: Option<String>,
     /// Time step (replaces the scene's dt or Courant number).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
     /// End time.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub t_end: Option<f64>,
     /// Run with a time step above the critical step estimated at the start (an error
     /// otherwise): to see what an unstable step does.
@@ -309,18 +309,38 @@ const COLUMNS: [&str; 10] = [
     "condition",
 ];
 
+/// Columns of `--format csv`: the table's, with the work of the effects (so that
+/// `total = kinetic + strain + potential − work` can be checked from the rows).
+const CSV_COLUMNS: [&str; 11] = [
+    "step",
+    "time",
+    "kinetic",
+    "strain",
+    "potential",
+    "work",
+    "total",
+    "max_speed",
+    "active",
+    "lumped",
+    "condition",
+];
+
+/// A row of `--format csv`: floats in Rust's shortest round-trip `{:e}` form, as in
+/// `diagnostics.csv`.
 fn row_csv(r: &StepReport) -> String {
+    let float = |x: f64| format!("{x:e}");
     out::csv_record(&[
         r.step.to_string(),
-        r.time.to_string(),
-        r.kinetic.to_string(),
-        r.strain.to_string(),
-        r.potential.to_string(),
-        r.total_energy().to_string(),
-        r.max_speed.to_string(),
+        float(r.time),
+        float(r.kinetic),
+        float(r.strain),
+        float(r.potential),
+        float(r.work),
+        float(r.total_energy()),
+        float(r.max_speed),
         r.mass_report.active.to_string(),
         r.mass_report.lumped_rows.to_string(),
-        r.condition.map_or_else(String::new, |c| c.to_string()),
+        r.condition.map_or_else(String::new, float),
     ])
 }
 
@@ -518,7 +538,7 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
                 Format::Json => stdout.line(&row_json(r).to_string()),
                 Format::Csv => {
                     if std::mem::take(&mut csv_header) {
-                        stdout.line(&out::csv_record(&COLUMNS));
+                        stdout.line(&out::csv_record(&CSV_COLUMNS));
                     }
                     stdout.line(&row_csv(r));
                 }
@@ -730,7 +750,14 @@ pub fn summary_text(summary: &Summary) -> String {
     };
     out += &format!(
         "{error} · {} · energy {} → {} (drift {:.2e}) · max condition {} · lumped rows ≤ {}\n",
-        if summary.stable { "stable" } else { "UNSTABLE" },
+        if summary.failure.is_some() {
+            // Stopped: the line after says why; no energy verdict is made.
+            "FAILED"
+        } else if summary.stable {
+            "stable"
+        } else {
+            "UNSTABLE"
+        },
         sci(summary.energy_initial),
         sci(summary.energy_final),
         summary.energy_drift,

@@ -221,6 +221,17 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
     if let Some((head, _)) = message.split_once("expected internally tagged enum") {
         message = format!("{head}expected a table with a `kind` key");
     }
+    // Rust's type names in the scene's words.
+    for (rust, words) in [
+        ("expected usize", "expected a whole number, 0 or more"),
+        ("expected u64", "expected a whole number, 0 or more"),
+        ("expected u32", "expected a whole number, 0 or more"),
+        ("expected f64", "expected a number"),
+    ] {
+        if let Some(head) = message.strip_suffix(rust) {
+            message = format!("{head}{words}");
+        }
+    }
     // Errors of a value in a buffered (tagged) table that quote no value: at
     // their key.
     let key = (message == super::MESH_HOLE_AS_CORNERS).then_some("holes");
