@@ -28,7 +28,8 @@
 //!   tracked particle; the plot shows the displacement against time (computed as
 //!   markers, or as a line without a reference; the reference as a line) and below
 //!   it the velocity in the same style, on the same time axis.
-//! - `energy.svg`: kinetic, strain, potential and total energy against time.
+//! - `energy.svg`: kinetic, strain, potential and total energy against time, and the
+//!   work of the effects when they do some (`total = K + S + P − W`).
 //! - `particles.svg`: the particles at the first frame, the step nearest half the
 //!   run and the last step, coloured by `--picture FIELD` (default `displacement`,
 //!   `|u|`) on one colour scale, over the mesh (2D); in 1D the field against the
@@ -156,7 +157,7 @@ pub struct Recorder {
     diagnostics: Option<csv::Writer<File>>,
     diagnostics_path: PathBuf,
     /// `(time, kinetic, strain, potential, total)` of the initial state and every step.
-    energy: Vec<[f64; 5]>,
+    energy: Vec<[f64; 6]>,
     /// Step of the last frame written, and the last step seen.
     last_frame: Option<usize>,
     last_step: usize,
@@ -262,8 +263,14 @@ impl Recorder {
     }
 
     fn record(&mut self, r: &StepReport, particles: ParticlesRef<'_>) -> Result<(), CliError> {
-        self.energy
-            .push([r.time, r.kinetic, r.strain, r.potential, r.total_energy()]);
+        self.energy.push([
+            r.time,
+            r.kinetic,
+            r.strain,
+            r.potential,
+            r.work,
+            r.total_energy(),
+        ]);
         if r.step == 1 && r.time > 0.0 {
             // The library's step count: t_end / dt, rounded (dt = the first step's time).
             // (The scene's own count is 1 for Courant-number scenes.)
@@ -580,10 +587,23 @@ impl Recorder {
             "time",
             format!("energy per unit {per}"),
         );
-        for (k, name) in ["kinetic", "strain", "potential", "total"]
-            .iter()
-            .enumerate()
+        // The work of the effects (traction, body forces, damping) only where there
+        // is some: `total = kinetic + strain + potential − work` then reads as the
+        // balance it is.
+        let works = self.energy.iter().any(|e| e[4] != 0.0);
+        for (k, name) in [
+            "kinetic",
+            "strain",
+            "potential",
+            "work of the effects",
+            "total",
+        ]
+        .iter()
+        .enumerate()
         {
+            if k == 3 && !works {
+                continue;
+            }
             let points = self.energy.iter().map(|e| (e[0], e[k + 1])).collect();
             plot = plot.with_series(Series::line(*name, thin(points, MAX_PLOT_POINTS)));
         }
