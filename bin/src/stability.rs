@@ -602,8 +602,9 @@ pub fn print(cells: &[Cell], format: Format, jobs: usize) {
             print!("{}", table.render());
             let stable = cells.iter().filter(|c| c.stable).count();
             println!(
-                "{} cells, {stable} stable; NO: the run stopped, NO*: it completed but broke a bound of the verdict; the error of a stopped run is the one where it stopped; wall times measured side by side on {jobs} threads",
-                cells.len()
+                "{} cells, {stable} stable; NO: the run stopped, NO*: it completed but broke a bound of the verdict; the error of a stopped run is the one where it stopped; wall times measured side by side on {jobs} {}",
+                cells.len(),
+                if jobs == 1 { "thread" } else { "threads" }
             );
             for c in cells {
                 if let Some(r) = &c.reason {
