@@ -78,7 +78,11 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
                     return Err(SceneError::new(
                         format!("body[{b}].max"),
                         ErrorKind::Conflict,
-                        format!("the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h}"),
+                        if body.per_block.is_some() {
+                            format!("the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h} (the mesh's block size along that axis over `per_block`): make the extent a multiple of it, choose `blocks` (or `--blocks`) so that it is, or give `count` instead of `per_block`")
+                        } else {
+                            format!("the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h} (`spacing`): make the extent a multiple of it, or give `count` instead")
+                        },
                     )
                     .into());
                 }

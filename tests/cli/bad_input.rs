@@ -745,7 +745,7 @@ fn inconsistent_cases() -> Vec<Case> {
             .at(22, 1).at(24, 7).expect("body[0].max: the particle at [0.125, 1.125] lies outside the mesh; the body must lie inside the meshed domain"),
         case("body-not-a-whole-number-of-cells", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 0.9]")
-            .at(24, 7).expect("body[0].max: the body's extent 0.9 along axis 1 is not a whole number of lattice cells of size 0.25"),
+            .at(24, 7).expect("body[0].max: the body's extent 0.9 along axis 1 is not a whole number of lattice cells of size 0.25 (the mesh's block size along that axis over `per_block`): make the extent a multiple of it, choose `blocks` (or `--blocks`) so that it is, or give `count` instead of `per_block`"),
         case("traction-box-selects-nothing", COLUMN)
             .edit("min = [0.0, 3.5]\nmax = [1.0, 4.0]", "min = [5.0, 5.0]\nmax = [6.0, 6.0]")
             .at(36, 7).expect("effect[2].min: the traction box selects no particle"),
