@@ -256,7 +256,11 @@ impl<T: Scalar> Extended<T> {
             let d = values[pattern.diagonal_position(i)];
             if d <= T::zero() {
                 let live = context.live.get(i).copied().unwrap_or(false);
-                self.role[i] = if live && !self.support.coefficients.is_empty() {
+                // A wall's function stays at zero: a value given to it would have
+                // to satisfy the wall's constraints, which the projection imposes
+                // on the functions with mass.
+                let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
+                self.role[i] = if live && !on_wall && !self.support.coefficients.is_empty() {
                     Role::Ghost
                 } else {
                     Role::Inactive
