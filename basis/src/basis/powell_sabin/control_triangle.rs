@@ -181,7 +181,7 @@ pub const CORNER_AREA_RATIO: f64 = 4.0;
 ///
 /// Where the PS points are mirror-symmetric about the vertical line through
 /// `vertex` (else about the horizontal one), only candidates with that symmetry
-/// compete, when there is one: see [`Mirror`].
+/// compete, when there is one (the private `Mirror` says why).
 ///
 /// Ties between candidates of equal area go to the first one found (hull lines in
 /// counter-clockwise order from the lowest-leftmost point), so the choice is
