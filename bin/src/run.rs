@@ -258,7 +258,24 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
         }
         Ok(s)
     } else {
-        Scene::builtin(name).map_err(CliError::Input)
+        Scene::builtin(name).map_err(|unknown| {
+            // A path that is not a `.toml` file: say so rather than list the
+            // built-in scenes only.
+            let path = std::path::Path::new(name);
+            if path.is_dir() {
+                CliError::Input(format!(
+                    "{}: is a directory; give a scene file FILE.toml or a built-in scene",
+                    psmpm::scene::limits::echo(name)
+                ))
+            } else if path.exists() {
+                CliError::Input(format!(
+                    "{}: a scene file must end in `.toml`",
+                    psmpm::scene::limits::echo(name)
+                ))
+            } else {
+                CliError::Input(unknown)
+            }
+        })
     }
 }
 

@@ -470,3 +470,23 @@ fn a_tracked_point_outside_every_body_is_warned_about() {
     assert!(!stderr.contains("output.tracked[2]"), "{stderr}");
     std::fs::remove_dir_all(path.parent().unwrap()).ok();
 }
+
+/// A directory, or a file that is not `.toml`, given as the scene says what it is,
+/// not only that no built-in scene has that name.
+#[test]
+fn a_directory_or_a_file_without_toml_is_named_as_such() {
+    let dir = std::env::temp_dir().join(format!("psmpm-scene-dir-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = dir.join("scene.txt");
+    std::fs::write(&text, "name = \"x\"\n").unwrap();
+    for (path, message) in [
+        (dir.clone(), "is a directory; give a scene file FILE.toml"),
+        (text, "a scene file must end in `.toml`"),
+    ] {
+        let out = cli().arg("run").arg(&path).output().unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(message), "{stderr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
