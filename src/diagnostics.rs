@@ -86,6 +86,18 @@ impl StepReport {
     pub fn total_energy(&self) -> f64 {
         self.kinetic + self.strain + self.potential - self.work
     }
+
+    /// `[time, kinetic, strain, potential, work, total]`: the energy history's row.
+    pub fn energy_row(&self) -> [f64; 6] {
+        [
+            self.time,
+            self.kinetic,
+            self.strain,
+            self.potential,
+            self.work,
+            self.total_energy(),
+        ]
+    }
 }
 
 /// Energies and momentum of the particles.

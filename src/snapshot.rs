@@ -89,16 +89,7 @@ pub fn snapshot(scene: &Scene, options: &SnapshotOptions) -> Result<Value, Snaps
     // Every step's energies are seen; the sampled ones are chosen at the end, when
     // the number of steps taken is known (Courant-number scenes know it only then).
     let mut energies: Vec<[f64; 6]> = Vec::new();
-    let mut record = |r: &crate::driver::StepReport| {
-        energies.push([
-            r.time,
-            r.kinetic,
-            r.strain,
-            r.potential,
-            r.work,
-            r.total_energy(),
-        ])
-    };
+    let mut record = |r: &crate::driver::StepReport| energies.push(r.energy_row());
     let mut observer = |r: &crate::driver::StepReport, _: simulation::ParticlesRef<'_>| record(r);
     let (summary, tracked) = if scene.dim == 1 {
         let o = simulation::observe_1d(scene, &mut observer)?;

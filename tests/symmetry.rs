@@ -15,6 +15,7 @@
 //! falls and broke the symmetry of the fall. The default gives such functions
 //! their extension rows (`Role::Ghost` in `mass::extended`).
 
+use nalgebra::Vector2;
 use psmpm::scene::Scene;
 use psmpm::simulation::{self, ParticlesRef};
 
@@ -31,17 +32,87 @@ fn dropped_block(basis: &str, mass: &str) -> Scene {
     Scene::from_toml(&text, "falling-block.toml").unwrap()
 }
 
-/// Largest distance between a particle's end position and the mirror image (about
-/// `x = 2`) of its mirror partner's, the partners paired by initial position.
-fn asymmetry(scene: &Scene) -> f64 {
-    let mut worst = f64::NAN;
-    let mut observer = |_: &psmpm::diagnostics::StepReport, p: ParticlesRef<'_>| {
-        let ParticlesRef::Two(p) = p else { return };
-        worst = mirror_error(&p.x0, &p.x, 2.0);
+/// A house-shaped body of 20 × 20 lattice particles (some lie on the grid's
+/// diagonals at its roof) falling at 1 from the middle of a box symmetric about
+/// x = 1.5, on `layout`; with `walls`, onto a no-slip floor between a slip wall and
+/// a wall holding x.
+fn house(basis: &str, mass: &str, layout: &str, walls: bool, t_end: f64) -> Scene {
+    let walls = if walls {
+        "[[boundary]]\ntag = \"bottom\"\nfix = [\"x\", \"y\"]\n[[boundary]]\ntag = \"left\"\nfix = [\"normal\"]\n[[boundary]]\ntag = \"right\"\nfix = [\"x\"]"
+    } else {
+        ""
+    };
+    let text = format!(
+        r#"
+name = "house"
+dim = 2
+basis = "{basis}"
+mass = "{mass}"
+[mesh]
+kind = "blocks"
+x = [0.0, 3.0]
+y = [0.0, 3.0]
+blocks = [12, 12]
+layout = "{layout}"
+[material]
+model = "corotational"
+young = 2e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+shape = "polygon"
+outline = [[1.0, 1.0], [2.0, 1.0], [2.0, 1.6], [1.5, 2.0], [1.0, 1.6]]
+count = [20, 20]
+[initial_velocity]
+kind = "uniform"
+value = [0.0, -1.0]
+{walls}
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.4
+t_end = {t_end}
+"#
+    );
+    Scene::from_toml(&text, "house.toml").unwrap()
+}
+
+/// What a run of a scene symmetric about `x = axis` measured.
+struct Symmetry {
+    /// Largest distance between a particle's end position and the mirror image of
+    /// its mirror partner's, the partners paired by initial position.
+    mirror_error: f64,
+    /// Largest strain and kinetic energies over the run.
+    strain: f64,
+    kinetic: f64,
+}
+
+/// Runs `scene` (which must not fail) and measures its [`Symmetry`].
+fn symmetry(scene: &Scene, axis: f64) -> Symmetry {
+    let (mut strain, mut kinetic) = (0.0f64, 0.0f64);
+    let mut observer = |r: &psmpm::diagnostics::StepReport, _: ParticlesRef<'_>| {
+        strain = strain.max(r.strain);
+        kinetic = kinetic.max(r.kinetic);
     };
     let out = simulation::observe_2d(scene, &mut observer).unwrap();
     assert!(out.summary.failure.is_none(), "{:?}", out.summary.failure);
-    worst
+    let (x0, x) = (&out.particles.x0, &out.particles.x);
+    let mirror = |p: &Vector2<f64>| Vector2::new(2.0 * axis - p.x, p.y);
+    let mirror_error = (0..x.len())
+        .map(|i| {
+            let image = mirror(&x0[i]);
+            let j = (0..x.len())
+                .min_by(|&a, &b| (x0[a] - image).norm().total_cmp(&(x0[b] - image).norm()))
+                .unwrap();
+            (x[i] - mirror(&x[j])).norm()
+        })
+        .fold(0.0, f64::max);
+    Symmetry {
+        mirror_error,
+        strain,
+        kinetic,
+    }
 }
 
 #[test]
@@ -53,7 +124,7 @@ fn a_block_dropped_onto_the_middle_of_a_floor_bounces_without_turning() {
         ("ps", "extended-hybrid-apic"),
         ("pl", "default"),
     ] {
-        let worst = asymmetry(&dropped_block(basis, mass));
+        let worst = symmetry(&dropped_block(basis, mass), 2.0).mirror_error;
         // The block is 1 wide and falls 2: round-off grown over ~2 000 steps and
         // three impacts, against the 0.1–1 of a turning block.
         assert!(
@@ -63,137 +134,35 @@ fn a_block_dropped_onto_the_middle_of_a_floor_bounces_without_turning() {
     }
 }
 
-/// A house-shaped body (20 × 20 lattice particles, so some lie on the grid's
-/// diagonals at its roof) falling freely in a box symmetric about x = 1.5, PL with
-/// the default mass: no strain at all in free fall, and every particle at the
-/// mirror image of its partner at the end.
+/// The house falling freely with PL and the default mass: no strain at all in
+/// free fall, and every particle at the mirror image of its partner at the end.
 #[test]
 fn a_body_with_particles_on_element_edges_falls_without_strain_and_symmetric() {
-    let text = r#"
-name = "falling-house"
-dim = 2
-basis = "pl"
-[mesh]
-kind = "blocks"
-x = [0.0, 3.0]
-y = [0.0, 3.0]
-blocks = [12, 12]
-[material]
-model = "corotational"
-young = 2e5
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "polygon"
-outline = [[1.0, 1.0], [2.0, 1.0], [2.0, 1.6], [1.5, 2.0], [1.0, 1.6]]
-count = [20, 20]
-[initial_velocity]
-kind = "uniform"
-value = [0.0, -1.0]
-[[effect]]
-kind = "gravity"
-g = [0.0, -9.81]
-[time]
-courant = 0.4
-t_end = 0.2
-"#;
-    let scene = Scene::from_toml(text, "falling-house.toml").unwrap();
-    let (mut strain, mut kinetic) = (0.0f64, 0.0f64);
-    let mut worst = f64::NAN;
-    let mut observer = |r: &psmpm::diagnostics::StepReport, p: ParticlesRef<'_>| {
-        strain = strain.max(r.strain);
-        kinetic = kinetic.max(r.kinetic);
-        let ParticlesRef::Two(p) = p else { return };
-        worst = mirror_error(&p.x0, &p.x, 1.5);
-    };
-    let out = simulation::observe_2d(&scene, &mut observer).unwrap();
-    assert!(out.summary.failure.is_none(), "{:?}", out.summary.failure);
+    let run = symmetry(&house("pl", "default", "four-triangles", false, 0.2), 1.5);
     // Before: strain energy 2.2e-2 from the first step (kinetic 4e2), mirror
     // error 2.6e-2 by t = 1.
     assert!(
-        strain < 1e-20 * kinetic,
-        "strain energy {strain:e} in free fall"
+        run.strain < 1e-20 * run.kinetic,
+        "strain energy {:e} in free fall",
+        run.strain
     );
     assert!(
-        worst < 1e-10,
-        "a particle ends {worst:e} off its partner's mirror image"
+        run.mirror_error < 1e-10,
+        "a particle ends {:e} off its partner's mirror image",
+        run.mirror_error
     );
 }
 
-/// Largest distance between a particle's position and the mirror image (about
-/// `x = axis`) of its mirror partner's, the partners paired by initial position.
-fn mirror_error(x0: &[nalgebra::Vector2<f64>], x: &[nalgebra::Vector2<f64>], axis: f64) -> f64 {
-    let mirror = |p: &nalgebra::Vector2<f64>| nalgebra::Vector2::new(2.0 * axis - p.x, p.y);
-    (0..x.len())
-        .map(|i| {
-            let image = mirror(&x0[i]);
-            let j = (0..x.len())
-                .min_by(|&a, &b| (x0[a] - image).norm().total_cmp(&(x0[b] - image).norm()))
-                .unwrap();
-            (x[i] - mirror(&x[j])).norm()
-        })
-        .fold(0.0, f64::max)
-}
-
-/// The same house dropped onto a no-slip floor between two walls, on the
-/// `delaunay` grid (mirror-symmetric, of cocircular block corners and centres),
-/// with PS: every particle ends at the mirror image of its partner. The extension
-/// bounds its weights by 2, and on this grid weights land on that bound: until the
-/// bound had a relative slack, round-off decided for a function and its mirror
-/// image differently (mirror errors 2.45e-3 with the default, 3.9e-2 with
-/// `extended`).
+/// The house landing on the floor between its walls on the `delaunay` grid
+/// (mirror-symmetric, of cocircular block corners and centres), with PS: every
+/// particle ends at the mirror image of its partner. The extension bounds its
+/// weights by 2, and on this grid weights land on that bound: until the bound had a
+/// relative slack, round-off decided for a function and its mirror image
+/// differently (mirror errors 2.45e-3 with the default, 3.9e-2 with `extended`).
 #[test]
 fn a_body_landing_on_a_symmetric_delaunay_grid_stays_symmetric() {
     for mass in ["default", "extended"] {
-        let text = format!(
-            r#"
-name = "landing-house"
-dim = 2
-basis = "ps"
-mass = "{mass}"
-[mesh]
-kind = "blocks"
-x = [0.0, 3.0]
-y = [0.0, 3.0]
-blocks = [12, 12]
-layout = "delaunay"
-[material]
-model = "corotational"
-young = 2e5
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "polygon"
-outline = [[1.0, 1.0], [2.0, 1.0], [2.0, 1.6], [1.5, 2.0], [1.0, 1.6]]
-count = [20, 20]
-[initial_velocity]
-kind = "uniform"
-value = [0.0, -1.0]
-[[boundary]]
-tag = "bottom"
-fix = ["x", "y"]
-[[boundary]]
-tag = "left"
-fix = ["normal"]
-[[boundary]]
-tag = "right"
-fix = ["x"]
-[[effect]]
-kind = "gravity"
-g = [0.0, -9.81]
-[time]
-courant = 0.4
-t_end = 1.0
-"#
-        );
-        let scene = Scene::from_toml(&text, "landing-house.toml").unwrap();
-        let mut worst = f64::NAN;
-        let mut observer = |_: &psmpm::diagnostics::StepReport, p: ParticlesRef<'_>| {
-            let ParticlesRef::Two(p) = p else { return };
-            worst = mirror_error(&p.x0, &p.x, 1.5);
-        };
-        let out = simulation::observe_2d(&scene, &mut observer).unwrap();
-        assert!(out.summary.failure.is_none(), "{:?}", out.summary.failure);
+        let worst = symmetry(&house("ps", mass, "delaunay", true, 1.0), 1.5).mirror_error;
         assert!(
             worst < 1e-9,
             "{mass}: a particle ends {worst:e} off its partner's mirror image"

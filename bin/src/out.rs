@@ -50,6 +50,30 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// A row of `diagnostics.csv` (and of `run --format csv`): floats in Rust's
+/// shortest round-trip `{:e}` form.
+pub fn diagnostics_record(r: &StepReport) -> [String; 15] {
+    let float = |x: f64| format!("{x:e}");
+    [
+        r.step.to_string(),
+        float(r.time),
+        float(r.kinetic),
+        float(r.strain),
+        float(r.potential),
+        float(r.work),
+        float(r.total_energy()),
+        float(r.mass),
+        float(r.momentum()[0]),
+        // (0 in 1D: the file has the same columns for every scene)
+        float(r.momentum().get(1).copied().unwrap_or(0.0)),
+        float(r.max_speed),
+        r.mass_report.active.to_string(),
+        r.mass_report.lumped_rows.to_string(),
+        r.mass_report.deactivated.to_string(),
+        r.condition.map_or_else(String::new, float),
+    ]
+}
+
 /// Columns of `diagnostics.csv`.
 pub const DIAGNOSTICS_COLUMNS: [&str; 15] = [
     "step",
@@ -263,14 +287,7 @@ impl Recorder {
     }
 
     fn record(&mut self, r: &StepReport, particles: ParticlesRef<'_>) -> Result<(), CliError> {
-        self.energy.push([
-            r.time,
-            r.kinetic,
-            r.strain,
-            r.potential,
-            r.work,
-            r.total_energy(),
-        ]);
+        self.energy.push(r.energy_row());
         if r.step == 1 && r.time > 0.0 {
             // The library's step count: t_end / dt, rounded (dt = the first step's time).
             // (The scene's own count is 1 for Courant-number scenes.)
@@ -312,25 +329,7 @@ impl Recorder {
         let Some(w) = self.diagnostics.as_mut() else {
             return Ok(());
         };
-        let float = |x: f64| format!("{x:e}");
-        let record = [
-            r.step.to_string(),
-            float(r.time),
-            float(r.kinetic),
-            float(r.strain),
-            float(r.potential),
-            float(r.work),
-            float(r.total_energy()),
-            float(r.mass),
-            float(r.momentum()[0]),
-            // (0 in 1D: the file has the same columns for every scene)
-            float(r.momentum().get(1).copied().unwrap_or(0.0)),
-            float(r.max_speed),
-            r.mass_report.active.to_string(),
-            r.mass_report.lumped_rows.to_string(),
-            r.mass_report.deactivated.to_string(),
-            r.condition.map_or_else(String::new, float),
-        ];
+        let record = diagnostics_record(r);
         w.write_record(&record)
             .map_err(|e| write_error(path, e.into()))
     }

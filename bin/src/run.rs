@@ -326,41 +326,6 @@ const COLUMNS: [&str; 10] = [
     "condition",
 ];
 
-/// Columns of `--format csv`: the table's, with the work of the effects (so that
-/// `total = kinetic + strain + potential − work` can be checked from the rows).
-const CSV_COLUMNS: [&str; 11] = [
-    "step",
-    "time",
-    "kinetic",
-    "strain",
-    "potential",
-    "work",
-    "total",
-    "max_speed",
-    "active",
-    "lumped",
-    "condition",
-];
-
-/// A row of `--format csv`: floats in Rust's shortest round-trip `{:e}` form, as in
-/// `diagnostics.csv`.
-fn row_csv(r: &StepReport) -> String {
-    let float = |x: f64| format!("{x:e}");
-    out::csv_record(&[
-        r.step.to_string(),
-        float(r.time),
-        float(r.kinetic),
-        float(r.strain),
-        float(r.potential),
-        float(r.work),
-        float(r.total_energy()),
-        float(r.max_speed),
-        r.mass_report.active.to_string(),
-        r.mass_report.lumped_rows.to_string(),
-        r.condition.map_or_else(String::new, float),
-    ])
-}
-
 fn row_cells(r: &StepReport) -> Vec<String> {
     vec![
         r.step.to_string(),
@@ -555,9 +520,9 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
                 Format::Json => stdout.line(&row_json(r).to_string()),
                 Format::Csv => {
                     if std::mem::take(&mut csv_header) {
-                        stdout.line(&out::csv_record(&CSV_COLUMNS));
+                        stdout.line(&out::csv_record(&out::DIAGNOSTICS_COLUMNS));
                     }
-                    stdout.line(&row_csv(r));
+                    stdout.line(&out::csv_record(&out::diagnostics_record(r)));
                 }
                 Format::Table => table.push(row_cells(r)),
             }

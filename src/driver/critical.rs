@@ -30,13 +30,13 @@ where
         self.locate_and_evaluate()?;
         self.assemble_mass();
         self.factorize()?;
-        let critical = self.power_iteration(None)? / self.effects_amplification().sqrt();
+        let critical = self.power_iteration(None)?;
         self.dt_critical = Some(critical);
         Ok(critical)
     }
 
     /// The product of the effects' [`Effect::force_amplification`](crate::effect::Effect::force_amplification)
-    /// (local damping: `1 + α`), which divides `ω_max²`'s step.
+    /// (local damping: `1 + α`): it scales `ω_max²`.
     fn effects_amplification(&self) -> f64 {
         self.effects
             .iter()
@@ -59,12 +59,12 @@ where
                 lumped[i] += m * self.evals.phi[s].to_f64();
             }
         }
-        Ok(self.power_iteration(Some(&lumped))? / self.effects_amplification().sqrt())
+        self.power_iteration(Some(&lumped))
     }
 
-    /// `2 / √λ_max(M⁻¹K)` by power iteration, `M` the strategy's system (`None`) or
-    /// the diagonal `lumped` (its zero entries, functions without particles, left
-    /// out).
+    /// `2 / √(a λ_max(M⁻¹K))` by power iteration, `M` the strategy's system
+    /// (`None`) or the diagonal `lumped` (its zero entries, functions without
+    /// particles, left out), `a` the effects' amplification of the forces.
     fn power_iteration(&mut self, lumped: Option<&[f64]>) -> Result<f64, StepError> {
         let n = self.basis.num_functions();
         // Start: a fixed, non-smooth field (excites the highest modes).
@@ -127,7 +127,7 @@ where
             std::mem::swap(&mut v, &mut f);
         }
         Ok(if estimate > 0.0 {
-            2.0 / estimate.sqrt()
+            2.0 / (estimate * self.effects_amplification()).sqrt()
         } else {
             f64::INFINITY
         })

@@ -310,9 +310,7 @@ impl<T: Scalar> Extended<T> {
         self.ext_ptr[n] = self.ext_idx.len();
         report
     }
-}
 
-impl<T: Scalar> Extended<T> {
     /// The reduced system `Eᵀ M E` of component `k`: its factorisation, else the
     /// conjugate gradients.
     fn solve_reduced(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
