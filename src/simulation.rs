@@ -321,6 +321,48 @@ struct Tally {
     max_rotation_non_objective: f64,
     /// Particles per occupied element at the start.
     sampling: f64,
+    /// The total energy after the last completed step (the initial one before any).
+    last_energy: f64,
+}
+
+/// The strain `ρ |g| H / E` of a body's own weight (H its height along `g`) above
+/// which a run warns: far beyond the small strains the elastic laws model, and most
+/// often a unit slip (`young` in MPa or kPa instead of Pa).
+pub const SELF_WEIGHT_STRAIN: f64 = 0.5;
+
+/// The warning for particles whose weight would strain the bodies by more than
+/// [`SELF_WEIGHT_STRAIN`]: the largest `ρ_p |g| H / E_p` over the particles, `H`
+/// the extent of all particles along `g`, `ρ_p` and `E_p` each particle's.
+pub fn self_weight_warning<const D: usize>(
+    gravity: Option<&[f64]>,
+    particles: &Particles<f64, D>,
+    material: &impl crate::materials::ParticleMaterials<f64, D>,
+) -> Option<String> {
+    let g = gravity?;
+    let g_norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if !(g_norm > 0.0) || particles.is_empty() {
+        return None;
+    }
+    let along = |p: usize| (0..D).map(|k| particles.x0[p][k] * g[k]).sum::<f64>() / g_norm;
+    let (low, high) = (0..particles.len())
+        .map(along)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), s| {
+            (l.min(s), h.max(s))
+        });
+    let height = high - low;
+    let (strain, p) = (0..particles.len())
+        .map(|p| {
+            let e = material.elastic(p);
+            (e.density * g_norm * height / e.young, p)
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))?;
+    (strain > SELF_WEIGHT_STRAIN).then(|| {
+        let e = material.elastic(p);
+        format!(
+            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {g_norm}, H = {height:.4} along g, E = {}), far beyond the small strains the elastic laws model: check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
+            e.density, e.young
+        )
+    })
 }
 
 /// Particles per occupied element at the start below which a run warns that its
@@ -423,6 +465,7 @@ where
     // `observe_2d`/`observe_1d` pass only steps > 0 on.
     on_step(&start, driver.particles.view());
     let mut verdict = Verdict::new(&start);
+    let mut last_energy = start.total_energy();
     let (mut lumped, mut deactivated, mut extended) = (0usize, 0usize, 0usize);
     let mut phases = PhaseTimes::default();
     let mut rms = exact::RmsPositionError::default();
@@ -476,6 +519,7 @@ where
         }
         on_step(&r, driver.particles.view());
         verdict.observe(&r);
+        last_energy = r.total_energy();
         lumped = lumped.max(r.mass_report.lumped_rows);
         deactivated = deactivated.max(r.mass_report.deactivated);
         extended = extended.max(r.mass_report.extended);
@@ -498,6 +542,7 @@ where
         max_rotation,
         max_rotation_non_objective,
         sampling,
+        last_energy,
     }
 }
 
@@ -625,6 +670,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .max_rotation_of_non_objective(&driver.particles.f, now),
         ),
     );
+    let self_weight = self_weight_warning(
+        scene.gravity().as_deref(),
+        &driver.particles,
+        driver.material(),
+    );
     Outcome {
         summary: Summary {
             scene: scene.name.clone(),
@@ -643,15 +693,25 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             dt_critical: run.dt_critical,
             max_condition,
             energy_initial: tally.verdict.initial_energy(),
-            energy_final: end.total_energy(),
+            // A failed step leaves the particles half updated: the energy is that
+            // of the last completed step, which the verdict saw.
+            energy_final: if failure.is_some() {
+                tally.last_energy
+            } else {
+                end.total_energy()
+            },
             energy_drift,
             energy_growth,
             stable,
             energy_growth_hint,
-            failure: failure.as_ref().map(|e| e.to_string()),
+            failure: failure.as_ref().map(|e| match &self_weight {
+                Some(w) => format!("{e}. Before anything else: {w}"),
+                None => e.to_string(),
+            }),
             max_rotation,
             warnings: warnings
                 .into_iter()
+                .chain(self_weight.clone())
                 .chain(sparse_sampling_warning(tally.sampling))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .collect(),

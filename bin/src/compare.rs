@@ -139,11 +139,12 @@ pub fn run_all(scenes: &[Scene], jobs: usize, pool: &ThreadPool) -> Vec<Result<S
         .collect()
 }
 
-const COLUMNS: [&str; 11] = [
+const COLUMNS: [&str; 12] = [
     "basis",
     "mass",
     "functions",
     "particles",
+    "dt",
     "steps",
     "error",
     "max_condition",
@@ -198,6 +199,7 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     s.mass.clone(),
                     s.functions.to_string(),
                     s.particles.to_string(),
+                    s.dt.to_string(),
                     s.steps.to_string(),
                     opt(s.error),
                     opt(s.max_condition),
@@ -217,12 +219,18 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     s.mass.clone(),
                     s.functions.to_string(),
                     s.particles.to_string(),
+                    sci(s.dt),
                     s.steps.to_string(),
                     s.error.map_or_else(|| "-".into(), sci),
                     s.max_condition.map_or_else(|| "-".into(), sci),
                     s.max_lumped_rows.to_string(),
                     sci(s.energy_drift),
-                    if s.stable { "yes" } else { "NO" }.to_string(),
+                    match (s.stable, s.failure.is_some()) {
+                        (_, true) => "stopped",
+                        (true, false) => "yes",
+                        (false, false) => "NO",
+                    }
+                    .to_string(),
                     format!("{:.2}", s.seconds),
                 ]);
             }
@@ -240,6 +248,22 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     s.scene,
                     (t_end * 1e9).round() / 1e9
                 );
+                let steps: Vec<f64> = summaries.iter().map(|s| s.dt).collect();
+                if steps.iter().any(|&dt| dt != steps[0]) {
+                    println!(
+                        "the variants run at different time steps (`courant` sets each one's \
+                         from its own critical step): give --dt to compare them at one step"
+                    );
+                }
+                if summaries.iter().any(|s| s.max_condition.is_none()) {
+                    println!(
+                        "stable: completed with energy growth under {} of the energy scale; the \
+                         condition of the solved system enters the verdict only where it was \
+                         measured (--condition: below {})",
+                        simulation::STABLE_ENERGY_GROWTH,
+                        sci(simulation::STABLE_CONDITION)
+                    );
+                }
             }
             for s in summaries {
                 if let Some(reason) = &s.failure {

@@ -12,6 +12,7 @@ use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::output::chart::{line_plot, Axis, LinePlot, Scale, Series, SeriesStyle};
 use psmpm::particles::Particles;
+use psmpm::scene::limits::echo;
 use psmpm::scene::{BodyShape, Scene};
 use psmpm::simulation::{self, RunError, Summary};
 use psmpm::studies::self_convergence::{error_against, FinestField};
@@ -60,12 +61,14 @@ pub struct ConvergeArgs {
 }
 
 /// The columns of the table and of `converge.csv`.
-const COLUMNS: [&str; 9] = [
+const COLUMNS: [&str; 11] = [
     "basis",
     "level",
     "h",
     "functions",
     "particles",
+    "dt",
+    "steps",
     "error",
     "order",
     "seconds",
@@ -85,14 +88,21 @@ pub struct Level {
     pub functions: usize,
     /// Particles.
     pub particles: usize,
-    /// Error against the reference.
+    /// Time step (with `courant`, it shrinks with `h`).
+    pub dt: f64,
+    /// Steps taken (fewer than planned when the run stopped early).
+    pub steps: usize,
+    /// Error against the reference; `None` when the run stopped before its end
+    /// time (an error at another time is not comparable with the other levels').
     pub error: Option<f64>,
-    /// Observed order against the previous level.
+    /// Observed order against the previous level with an error.
     pub order: Option<f64>,
     /// Wall time of the run.
     pub seconds: f64,
     /// Stable verdict.
     pub stable: bool,
+    /// The run stopped before its end time (a failed step).
+    pub stopped: bool,
 }
 
 /// When a basis's error reaches a target error ([`ConvergeArgs::target_error`]).
@@ -255,9 +265,33 @@ impl Finest {
     }
 }
 
-/// Runs `scene` and keeps its final particles when the run reached its end.
-fn run_level(scene: &Scene) -> Result<(Summary, Option<Final>), CliError> {
-    let err = |e: RunError| CliError::Input(e.to_string());
+/// Runs `scene`, level `level` of the study of `args`, and keeps its final particles
+/// when the run reached its end. A set-up error names the scene, the level and the
+/// basis, and the flags that set its field.
+fn run_level(
+    args: &ConvergeArgs,
+    level: usize,
+    scene: &Scene,
+) -> Result<(Summary, Option<Final>), CliError> {
+    let err = |e: RunError| {
+        let e = match e {
+            RunError::Scene(e) => {
+                let flags = args.overrides.flags_of(&e);
+                if flags.is_empty() {
+                    e.to_string()
+                } else {
+                    format!("{} (from {})", e, flags.join(" "))
+                }
+            }
+            other => other.to_string(),
+        };
+        CliError::Input(format!(
+            "{}: level {level} ({}, h = {}): {e}",
+            echo(&args.scene),
+            scene.basis.name(),
+            scene.mesh_size().map_or_else(|| "-".into(), sci),
+        ))
+    };
     let (summary, particles) = if scene.dim == 1 {
         let o = simulation::run_1d(scene, &mut |_| {}).map_err(err)?;
         (o.summary, Final::One(o.particles))
@@ -343,8 +377,8 @@ fn study(
     for variant in scenes {
         let mut levels = Vec::new();
         let mut finals = Vec::new();
-        for s in variant {
-            let (summary, particles) = run_level(&s)?;
+        for (level, s) in variant.into_iter().enumerate() {
+            let (summary, particles) = run_level(args, level, &s)?;
             progress.inc(1);
             levels.push((s, summary));
             finals.push(particles);
@@ -369,7 +403,7 @@ fn study(
             },
         };
         let error_of = |summary: &Summary, particles: &Option<Final>| match against {
-            Against::Exact => summary.error,
+            Against::Exact => particles.as_ref().and(summary.error),
             Against::FinestLevel => match (&finest, particles) {
                 (Some(f), Some(p)) => f.error(p),
                 _ => None,
@@ -387,6 +421,22 @@ fn study(
                 error_of(summary, particles)
             };
             let h = s.mesh_size().unwrap_or(f64::NAN);
+            if let Some(failure) = &summary.failure {
+                notes.push(format!(
+                    "{} level {index}: stopped at t = {:.4} of {}, so it has no error and gives no \
+                     order: {failure}",
+                    summary.basis,
+                    summary.t_end,
+                    s.time.t_end,
+                ));
+            } else if error.is_some() && !summary.stable {
+                notes.push(format!(
+                    "{} level {index}: not stable ({}); its error and order are shown, and \
+                     drawn apart in the plots",
+                    summary.basis,
+                    crate::run::unstable_reason(summary),
+                ));
+            }
             let order = match (previous, error) {
                 (Some((h0, e0)), Some(e)) if e > 0.0 && e0 > 0.0 => {
                     Some((e0 / e).ln() / (h0 / h).ln())
@@ -408,16 +458,19 @@ fn study(
                 h,
                 functions: summary.functions,
                 particles: summary.particles,
+                dt: summary.dt,
+                steps: summary.steps,
                 error,
                 order,
                 seconds: summary.seconds,
                 stable: summary.stable,
+                stopped: summary.failure.is_some(),
             });
         }
         if let Some((index, order)) = falling {
             let error = rows[first + index].error.unwrap_or(f64::NAN);
             let probe = |s: Scene| -> Result<Option<f64>, CliError> {
-                let (summary, particles) = run_level(&s)?;
+                let (summary, particles) = run_level(args, index, &s)?;
                 Ok(error_of(&summary, &particles).map(|e| e / error))
             };
             let s = &levels[index].0;
@@ -538,8 +591,8 @@ fn explanation(study: &Study) -> String {
     let (against, diagnoses, notes) = (study.against, study.diagnoses, study.notes);
     let mut out = String::new();
     if against == Against::FinestLevel {
-        out += "error: E_u against the finest level of the same basis (the scene has no \
-                exact solution), so the finest level has none\n";
+        out += "note: the error is E_u against the finest level of the same basis (the \
+                scene has no exact solution), so the finest level has none\n";
     }
     for n in notes {
         out += &format!("note: {n}\n");
@@ -582,10 +635,17 @@ fn print_levels(study: &Study, format: Format) {
                     sci(r.h),
                     r.functions.to_string(),
                     r.particles.to_string(),
+                    sci(r.dt),
+                    r.steps.to_string(),
                     r.error.map_or_else(|| "-".into(), sci),
                     fixed2(r.order),
                     format!("{:.3}", r.seconds),
-                    if r.stable { "yes" } else { "NO" }.to_string(),
+                    match (r.stable, r.stopped) {
+                        (_, true) => "stopped",
+                        (true, false) => "yes",
+                        (false, false) => "NO",
+                    }
+                    .to_string(),
                 ]);
             }
             print!("{}", table.render());
@@ -605,6 +665,8 @@ fn csv(rows: &[Level]) -> String {
             r.h.to_string(),
             r.functions.to_string(),
             r.particles.to_string(),
+            r.dt.to_string(),
+            r.steps.to_string(),
             opt(r.error),
             opt(r.order),
             r.seconds.to_string(),
@@ -629,20 +691,33 @@ fn write_outputs(dir: &std::path::Path, scene: &str, study: &Study) -> Result<()
     std::fs::write(&path, json).map_err(|e| io(&path, e))?;
     let mut bases: Vec<&str> = rows.iter().map(|r| r.basis).collect();
     bases.dedup();
+    // Per basis, its stable levels as a curve and its unstable ones as markers of a
+    // series of their own (levels that stopped early have no error to draw).
     let curves = |x: &dyn Fn(&Level) -> f64| -> Vec<Series> {
-        bases
-            .iter()
-            .map(|b| Series {
+        let points = |b: &str, stable: bool| -> Vec<(f64, f64)> {
+            rows.iter()
+                .filter(|r| r.basis == b && r.stable == stable)
+                .filter_map(|r| r.error.map(|e| (x(r), e)))
+                .filter(|(x, e)| *x > 0.0 && *e > 0.0)
+                .collect()
+        };
+        let mut series = Vec::new();
+        for b in &bases {
+            series.push(Series {
                 name: b.to_uppercase(),
-                points: rows
-                    .iter()
-                    .filter(|r| r.basis == *b)
-                    .filter_map(|r| r.error.map(|e| (x(r), e)))
-                    .filter(|(x, e)| *x > 0.0 && *e > 0.0)
-                    .collect(),
+                points: points(b, true),
                 style: SeriesStyle::LineAndMarkers,
-            })
-            .collect()
+            });
+            let unstable = points(b, false);
+            if !unstable.is_empty() {
+                series.push(Series {
+                    name: format!("{} (not stable)", b.to_uppercase()),
+                    points: unstable,
+                    style: SeriesStyle::Markers,
+                });
+            }
+        }
+        series
     };
     let plots = [
         (
@@ -694,10 +769,13 @@ mod tests {
             h: 1.0,
             functions: 1,
             particles: 1,
+            dt: 1e-3,
+            steps: 1,
             error: Some(error),
             order: None,
             seconds,
             stable,
+            stopped: false,
         }
     }
 

@@ -48,7 +48,9 @@ pub struct Overrides {
     #[arg(long)]
     pub allow_above_critical: bool,
     /// Estimate the condition number of the solved mass system every step (about 60
-    /// extra solves; 30 products for `extended`).
+    /// extra solves; 30 products for `extended`). The verdict then also requires it
+    /// below 1e8, as in the stability matrix (docs/stability.md); without it the
+    /// verdict judges completion and energy only, and says so.
     #[arg(long)]
     pub condition: bool,
 }
@@ -56,7 +58,6 @@ pub struct Overrides {
 impl Overrides {
     /// Applies the overrides to `s` and validates it.
     pub fn apply(&self, mut s: Scene) -> Result<Scene, CliError> {
-        let input = |e: psmpm::scene::SceneError| CliError::Input(e.to_string());
         let dim = s.dim;
         let one_d = |flag: &str, text: &str, second: usize| {
             if dim == 1 && second != 1 {
@@ -71,7 +72,8 @@ impl Overrides {
         if let Some(b) = &self.blocks {
             let (nx, ny) = pair(b, "--blocks")?;
             one_d("--blocks", b, ny)?;
-            s.set_blocks(nx, ny).map_err(input)?;
+            s.set_blocks(nx, ny)
+                .map_err(|e| CliError::Input(format!("--blocks {}: {e}", echo(b))))?;
         }
         if let Some(p) = &self.particles {
             let (px, py) = pair(p, "--particles")?;
@@ -79,6 +81,12 @@ impl Overrides {
             s.set_particles_per_block([px, py]);
         }
         if let Some(split) = &self.split {
+            if dim == 1 {
+                return Err(CliError::Input(format!(
+                    "--split {}: a 1D scene has no triangles to split",
+                    echo(split)
+                )));
+            }
             s.split = parse_split(split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
         }
         if let Some(layout) = &self.layout {
@@ -92,7 +100,8 @@ impl Overrides {
                     )))
                 }
             };
-            s.set_layout(l).map_err(input)?;
+            s.set_layout(l)
+                .map_err(|e| CliError::Input(format!("--layout {}: {e}", echo(layout))))?;
         }
         if let Some(dt) = self.dt {
             s.set_dt(dt);
@@ -114,6 +123,16 @@ impl Overrides {
     /// A validation error after the overrides, prefixed by the flags (and values)
     /// that set the field.
     fn name_flags(&self, e: &psmpm::scene::SceneError) -> String {
+        let flags = self.flags_of(e);
+        if flags.is_empty() {
+            e.to_string()
+        } else {
+            format!("{}: {e}", flags.join(" "))
+        }
+    }
+
+    /// The flags (and values) of these overrides that set the field of `e`.
+    pub fn flags_of(&self, e: &psmpm::scene::SceneError) -> Vec<String> {
         let field = e.field.as_str();
         let mut flags = Vec::new();
         if field.starts_with("time.") {
@@ -134,11 +153,7 @@ impl Overrides {
                 flags.push(format!("--particles {}", echo(p)));
             }
         }
-        if flags.is_empty() {
-            e.to_string()
-        } else {
-            format!("{}: {e}", flags.join(" "))
-        }
+        flags
     }
 }
 
@@ -230,11 +245,19 @@ pub fn locate(scene: &str, e: &SceneError) -> String {
     }
 }
 
-/// A run that could not be set up, as the user sees it: a scene error located in
-/// the scene file `scene` when it is one.
-pub fn run_error(scene: &str, e: RunError) -> CliError {
+/// A run that could not be set up, as the user sees it: a scene error named by the
+/// command-line flags that set its field, else located in the scene file `scene`
+/// when it is one.
+pub fn run_error(scene: &str, overrides: &Overrides, e: RunError) -> CliError {
     match e {
-        RunError::Scene(e) => CliError::Input(locate(scene, &e)),
+        RunError::Scene(e) => {
+            let flags = overrides.flags_of(&e);
+            if flags.is_empty() {
+                CliError::Input(locate(scene, &e))
+            } else {
+                CliError::Input(format!("{} with {}: {e}", echo(scene), flags.join(" ")))
+            }
+        }
         other => CliError::Input(other.to_string()),
     }
 }
@@ -539,7 +562,7 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     // stays in --out.
     let checked = match (outcome, too_many) {
         (Ok(o), None) => Ok(o),
-        (Err(e), _) => Err(run_error(&args.scene, e)),
+        (Err(e), _) => Err(run_error(&args.scene, &args.overrides, e)),
         (Ok(_), Some(message)) => Err(CliError::Input(message)),
     };
     let (summary, tracked, last) = match checked {
@@ -735,6 +758,8 @@ pub fn summary_text(summary: &Summary) -> String {
         if summary.failure.is_some() {
             // Stopped: the line after says why; no energy verdict is made.
             "FAILED"
+        } else if summary.stable && summary.max_condition.is_none() {
+            "stable (energy; condition not measured, see --condition)"
         } else if summary.stable {
             "stable"
         } else {

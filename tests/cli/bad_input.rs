@@ -1260,7 +1260,9 @@ fn a_run_that_fails_numerically_exits_with_1_and_names_the_step() {
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
-        stderr.starts_with("error: time.dt: the time step 100 is above the critical step 4.32"),
+        stderr.starts_with(
+            "error: vibrating-bar with --dt 100.0 --t-end 1000.0: time.dt: the time step 100 is above the critical step 4.32"
+        ),
         "{stderr}"
     );
     assert!(stderr.contains("--allow-above-critical"), "{stderr}");

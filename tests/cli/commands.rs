@@ -170,6 +170,7 @@ fn compare_ps_and_pl_side_by_side_identically_on_one_and_two_threads() {
             "mass",
             "functions",
             "particles",
+            "dt",
             "steps",
             "error",
             "max_condition",
@@ -645,4 +646,131 @@ fn throughput_prints_rates_memory_and_the_scaling_exponent() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("the throughput scene is 2D"));
+}
+
+/// A student's settling column whose finer PL levels stop before the end time with
+/// the consistent mass (the top functions lose their support).
+const STOPPING_COLUMN: &str = r#"
+name = "stopping-column"
+dim = 1
+basis = "bspline"
+[mesh]
+kind = "interval"
+x = [0.0, 10.0]
+elements = 10
+[material]
+young = 1e4
+density = 2.0
+[[body]]
+min = [0.0]
+max = [10.0]
+per_block = [6]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [-9.81]
+[time]
+courant = 0.4
+t_end = 0.5
+[reference]
+kind = "column-self-weight"
+"#;
+
+#[test]
+fn converge_gives_no_error_and_no_order_for_a_level_that_stopped_early() {
+    let dir = temp_dir("converge-stopped");
+    let scene = dir.join("column.toml");
+    std::fs::write(&scene, STOPPING_COLUMN).unwrap();
+    let out = cli()
+        .args(["converge", scene.to_str().unwrap(), "--levels", "4"])
+        .args([
+            "--basis",
+            "pl1d",
+            "--mass",
+            "consistent",
+            "--format",
+            "json",
+        ])
+        .output()
+        .unwrap();
+    let study: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let levels = study["levels"].as_array().unwrap();
+    let stopped: Vec<&Value> = levels.iter().filter(|l| l["stopped"] == true).collect();
+    assert!(!stopped.is_empty(), "{study}");
+    for l in &stopped {
+        // An error at another time than the other levels' is not comparable.
+        assert!(l["error"].is_null() && l["order"].is_null(), "{l}");
+        assert!(l["steps"].as_u64().unwrap() > 0, "{l}");
+    }
+    // The level after a stopped one takes its order against the last level with
+    // an error, never against the stopped one.
+    let notes: Vec<&str> = study["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    for l in &stopped {
+        let level = l["level"].as_u64().unwrap();
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.starts_with(&format!("pl1d level {level}: stopped at t = "))),
+            "{notes:?}"
+        );
+    }
+    // With `courant` every level has its own step.
+    let dts: Vec<f64> = levels.iter().map(|l| l["dt"].as_f64().unwrap()).collect();
+    assert!(dts.windows(2).all(|w| w[1] < w[0]), "{dts:?}");
+}
+
+#[test]
+fn an_error_of_a_converge_level_names_the_file_the_level_and_the_basis() {
+    let dir = temp_dir("converge-level-error");
+    let scene = dir.join("column.toml");
+    std::fs::write(&scene, STOPPING_COLUMN).unwrap();
+    let out = cli()
+        .args(["converge", scene.to_str().unwrap(), "--levels", "3"])
+        .args(["--basis", "bspline", "--dt", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with(&format!(
+            "error: {}: level 0 (bspline, h = 1.00e0): time.dt: the time step 1 is above",
+            scene.display()
+        )),
+        "{stderr}"
+    );
+    assert!(stderr.contains("(from --dt 1.0)"), "{stderr}");
+}
+
+#[test]
+fn a_body_far_too_soft_for_its_weight_is_named_as_the_cause() {
+    let dir = temp_dir("soft-body");
+    let scene = dir.join("soft.toml");
+    // E typed in MPa: the column's weight would strain it by about 2e3.
+    std::fs::write(
+        &scene,
+        STOPPING_COLUMN
+            .replace("young = 1e4", "young = 1e-2")
+            .replace("courant = 0.4", "dt = 1e-3"),
+    )
+    .unwrap();
+    let out = cli()
+        .args(["run", scene.to_str().unwrap(), "--basis", "bspline"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("own weight would strain them by about ρ |g| H / E = 1.9e4"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("check the units of `young` (Pa)"),
+        "{stderr}"
+    );
 }

@@ -122,7 +122,10 @@ fn table_and_summary_for_a_1d_scene() {
     assert!(text.contains("column-small-1d · pl1d · consistent mass · 17 functions"));
     // Readable at a glance: error, verdict, wall time and time per step.
     assert!(text.contains("error E_u = "), "{text}");
-    assert!(text.contains(" · stable · "), "{text}");
+    assert!(
+        text.contains(" · stable (energy; condition not measured, see --condition) · "),
+        "{text}"
+    );
     assert!(
         text.contains("wall time ") && text.contains("µs/step"),
         "{text}"
