@@ -340,7 +340,7 @@ pub fn self_weight_warning<const D: usize>(
 ) -> Option<String> {
     let g = gravity?;
     let g_norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
-    if !(g_norm > 0.0) || particles.is_empty() {
+    if g_norm.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || particles.is_empty() {
         return None;
     }
     let along = |p: usize| (0..D).map(|k| particles.x0[p][k] * g[k]).sum::<f64>() / g_norm;
