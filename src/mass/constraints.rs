@@ -19,8 +19,15 @@ pub const DEPENDENT_CONSTRAINT: f64 = 1e-10;
 /// once; a constraint whose functions are all inactive (zero pivot) is skipped.
 pub struct Constraints<T: Scalar, const D: usize> {
     pub(crate) rows: Vec<Vec<(usize, usize, T)>>,
-    /// `W[c][k]`: component `k` of `M⁻¹ Cᵀ e_c`.
+    /// `W[c][k]`: component `k` of `M⁻¹ Cᵀ e_c`, allocated when first solved
+    /// (empty before: a wall far from every body costs no memory).
     w: Vec<Vec<Vec<T>>>,
+    /// `W[c][k]` holds this step's solve; otherwise it is zero and not read (the
+    /// constraint touches no function with particles), so a step costs what the
+    /// constraints near the bodies cost, not the size of the mesh times the walls.
+    solved: Vec<[bool; D]>,
+    /// Length of each `W[c][k]` (the number of functions).
+    n: usize,
     /// `S = C W`, then its Cholesky factor (row-major, lower triangle).
     s: Vec<f64>,
     /// Pivot kept (`false` for constraints on inactive functions).
@@ -32,7 +39,9 @@ impl<T: Scalar, const D: usize> Constraints<T, D> {
     pub fn new(rows: Vec<Vec<(usize, usize, T)>>, n: usize) -> Self {
         let m = rows.len();
         Constraints {
-            w: vec![vec![vec![T::zero(); n]; D]; m],
+            w: vec![vec![Vec::new(); D]; m],
+            solved: vec![[false; D]; m],
+            n,
             s: vec![0.0; m * m],
             keep: vec![false; m],
             lambda: vec![0.0; m],
@@ -66,29 +75,38 @@ impl<T: Scalar, const D: usize> Constraints<T, D> {
         }
         for (c, row) in self.rows.iter().enumerate() {
             for k in 0..D {
+                let touched = row.iter().any(|&(kk, i, _)| kk == k && has_particles(i));
+                self.solved[c][k] = touched;
+                if !touched {
+                    continue;
+                }
                 let w = &mut self.w[c][k];
-                w.iter_mut().for_each(|v| *v = T::zero());
-                let mut any = false;
-                let mut touched = false;
+                if w.is_empty() {
+                    w.resize(self.n, T::zero());
+                } else {
+                    w.iter_mut().for_each(|v| *v = T::zero());
+                }
                 for &(kk, i, weight) in row {
                     if kk == k {
                         w[i] += weight;
-                        any = true;
-                        touched |= has_particles(i);
                     }
                 }
-                if any && touched {
-                    mass.solve(k, w)?;
-                } else if any {
-                    w.iter_mut().for_each(|v| *v = T::zero());
-                }
+                mass.solve(k, w)?;
             }
         }
+        // `S = C W`; a `W[d][k]` not solved this step is zero.
+        let (w, solved) = (&self.w, &self.solved);
         for c in 0..m {
             for d in 0..m {
                 self.s[c * m + d] = self.rows[c]
                     .iter()
-                    .map(|&(k, i, weight)| (weight * self.w[d][k][i]).to_f64())
+                    .map(|&(k, i, weight)| {
+                        if solved[d][k] {
+                            (weight * w[d][k][i]).to_f64()
+                        } else {
+                            0.0
+                        }
+                    })
                     .sum();
             }
         }
@@ -165,7 +183,7 @@ impl<T: Scalar, const D: usize> Constraints<T, D> {
             if self.lambda[c] == 0.0 {
                 continue;
             }
-            for k in 0..D {
+            for k in (0..D).filter(|&k| self.solved[c][k]) {
                 for (x, w) in a[k].iter_mut().zip(&self.w[c][k]) {
                     *x -= l * *w;
                 }

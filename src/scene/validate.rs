@@ -4,7 +4,8 @@ use super::limits::{
     MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
 };
 use super::{
-    bad, conflict, Component, EffectSpec, MaterialModel, MeshSpec, Reference, Scene, SceneError,
+    bad, conflict, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference,
+    Scene, SceneError,
 };
 
 impl Scene {
@@ -247,7 +248,10 @@ impl Scene {
             vector(&format!("output.tracked[{i}]"), t)?;
         }
         match self.reference {
-            Some(Reference::VibratingBar { v0 }) => finite("reference.v0", v0)?,
+            Some(Reference::VibratingBar { v0 }) => {
+                finite("reference.v0", v0)?;
+                self.validate_vibrating_bar(v0)?;
+            }
             Some(Reference::ColumnSelfWeight {}) | Some(Reference::ColumnEquilibrium {})
                 if gravity.is_none() =>
             {
@@ -278,6 +282,63 @@ impl Scene {
         }
         if self.steps() == 0 {
             return Err(conflict("time.t_end", "is shorter than one time step"));
+        }
+        Ok(())
+    }
+
+    /// The vibrating-bar reference (thesis eq. (4.2)) is the first mode of a bar fixed
+    /// at both ends: the first body starts in that mode with the reference's `v0`,
+    /// and on a block or interval mesh it spans the mesh along x (whose ends carry
+    /// the walls). Otherwise its error would measure another motion.
+    fn validate_vibrating_bar(&self, v0: f64) -> Result<(), SceneError> {
+        let (field, start) = match &self.bodies[0].initial_velocity {
+            Some(v) => ("body[0].initial_velocity", Some(v)),
+            None => ("initial_velocity", Some(&self.initial_velocity)),
+        };
+        match start {
+            Some(InitialVelocity::Exact {}) => {}
+            Some(InitialVelocity::SineMode { v0: w }) if *w == v0 => {}
+            Some(InitialVelocity::SineMode { v0: w }) => {
+                return Err(conflict(
+                    "reference.v0",
+                    format!(
+                        "is {v0}, but the bar starts in the sine mode with v0 = {w} \
+                         ([{field}]): the reference would be another motion; give both the \
+                         same v0, or `kind = \"exact\"` in [{field}] to start from the \
+                         reference"
+                    ),
+                ));
+            }
+            _ => {
+                return Err(conflict(
+                    "reference.kind",
+                    format!(
+                        "`vibrating-bar` is the first mode of a bar started with \
+                         v_x = v0 sin(π x / L), but the bar starts otherwise: give \
+                         [{field}] `kind = \"exact\"` (or `kind = \"sine-mode\"` with the \
+                         reference's v0)"
+                    ),
+                ));
+            }
+        }
+        let mesh_x = match &self.mesh {
+            MeshSpec::Blocks { x, .. } | MeshSpec::Interval { x, .. } => *x,
+            _ => return Ok(()),
+        };
+        let body = &self.bodies[0];
+        if let (Some(&lo), Some(&hi)) = (body.min.first(), body.max.first()) {
+            let tolerance = 1e-9 * (mesh_x[1] - mesh_x[0]).abs();
+            if (lo - mesh_x[0]).abs() > tolerance || (hi - mesh_x[1]).abs() > tolerance {
+                return Err(conflict(
+                    "body[0].max",
+                    format!(
+                        "the `vibrating-bar` reference is a bar fixed at both ends, but body[0] \
+                         spans [{lo}, {hi}] along x and the mesh, whose ends carry the walls, \
+                         [{}, {}]: make the body span the mesh, or leave out [reference]",
+                        mesh_x[0], mesh_x[1]
+                    ),
+                ));
+            }
         }
         Ok(())
     }

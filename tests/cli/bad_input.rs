@@ -710,6 +710,17 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("model = \"neo-hookean\"", "model = \"linear-elastic\"")
             .edit("kind = \"axis-aligned\"", "kind = @@\"axis-aligned\"")
             .expect("reference.kind: `axis-aligned` is a 2D neo-Hookean solution"),
+        case("vibrating-bar-reference-against-another-sine-mode", BAR)
+            .edit("kind = \"exact\"", "kind = \"sine-mode\"\nv0 = 0.2")
+            .edit("kind = \"vibrating-bar\"\nv0 = 0.1", "kind = \"vibrating-bar\"\nv0 = @@0.1")
+            .expect("reference.v0: is 0.1, but the bar starts in the sine mode with v0 = 0.2 ([initial_velocity]): the reference would be another motion; give both the same v0, or `kind = \"exact\"` in [initial_velocity] to start from the reference"),
+        case("vibrating-bar-reference-from-rest", BAR)
+            .edit("[initial_velocity]\nkind = \"exact\"\n", "")
+            .edit("kind = \"vibrating-bar\"", "kind = @@\"vibrating-bar\"")
+            .expect("reference.kind: `vibrating-bar` is the first mode of a bar started with v_x = v0 sin(π x / L), but the bar starts otherwise: give [initial_velocity] `kind = \"exact\"` (or `kind = \"sine-mode\"` with the reference's v0)"),
+        case("vibrating-bar-reference-on-a-shorter-body", BAR)
+            .edit("max = [4.0, 1.0]", "max = @@[3.0, 1.0]")
+            .expect("body[0].max: the `vibrating-bar` reference is a bar fixed at both ends, but body[0] spans [0, 3] along x and the mesh, whose ends carry the walls, [0, 4]: make the body span the mesh, or leave out [reference]"),
         case("exact-velocity-without-reference", BAR)
             .edit("[reference]\nkind = \"vibrating-bar\"\nv0 = 0.1\n", "")
             .edit("kind = \"exact\"", "kind = @@\"exact\"")

@@ -279,6 +279,8 @@ impl<T: Scalar> Direct<T> {
         for q in 0..m {
             x[self.free[q]] = self.b[q];
         }
-        op.expand_all(x, rhs);
+        // `E x` is zero off the active functions: a fill, then the active rows.
+        rhs.iter_mut().for_each(|v| *v = T::zero());
+        op.expand(x, rhs);
     }
 }

@@ -329,7 +329,8 @@ impl<T: Scalar> Extended<T> {
             let op = self.reduced(s);
             op.restrict(rhs, &mut b);
             let result = conjugate_gradients(&op, &self.precond[s], &b, &mut scratch);
-            op.expand_all(&scratch.x, rhs);
+            rhs.iter_mut().for_each(|v| *v = T::zero());
+            op.expand(&scratch.x, rhs);
             result
         };
         self.rhs = b;

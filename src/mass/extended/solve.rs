@@ -47,12 +47,6 @@ impl<T: Scalar> Reduced<'_, T> {
             u[i] = self.expanded(x, i);
         }
     }
-    /// `u = E x` on every function.
-    pub(super) fn expand_all(&self, x: &[T], u: &mut [T]) {
-        for i in 0..u.len() {
-            u[i] = self.expanded(x, i);
-        }
-    }
     /// `y = Eᵀ w`, zero off the free functions (written on the active ones).
     pub(super) fn restrict(&self, w: &[T], y: &mut [T]) {
         for &i in self.active {
