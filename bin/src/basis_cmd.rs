@@ -83,8 +83,11 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
     let kind =
         BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
     let mesh = mesh(&args)?;
-    let plot_error = |e: psmpm::output::chart::PlotError| {
-        CliError::Input(format!("{}: {e}", args.out.display()))
+    let plot_error = |e: psmpm::output::chart::PlotError| match e {
+        psmpm::output::chart::PlotError::FunctionIndex { .. } => {
+            CliError::Input(format!("--function: {e}"))
+        }
+        e => CliError::Input(format!("{}: {e}", args.out.display())),
     };
     let functions = match (args.function, kind) {
         (None, BasisKind::Ps) => {

@@ -430,7 +430,11 @@ impl Recorder {
                     .collect();
                 points.sort_by(|a, b| a.0.total_cmp(&b.0));
                 plot = plot.with_series(Series::line(
-                    format!("t = {}", crate::table::short(f.time)),
+                    // Four significant digits: a legend, not a record.
+                    format!(
+                        "t = {}",
+                        format!("{:.3e}", f.time).parse::<f64>().unwrap_or(f.time)
+                    ),
                     thin(points, MAX_PLOT_POINTS),
                 ));
             }

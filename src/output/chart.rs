@@ -95,7 +95,7 @@ pub enum PlotError {
         reason: &'static str,
     },
     /// A basis function index not in `0..count`.
-    #[error("basis function index {index} is out of range: the basis has functions 0..{count}")]
+    #[error("basis function index {index} is out of range: the basis has {count} functions (indices below {count})")]
     FunctionIndex {
         /// The requested index.
         index: usize,

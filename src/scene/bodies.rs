@@ -295,7 +295,10 @@ impl Scene {
                 if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
                     return Err(bad(
                         field("per_block"),
-                        format!("needs {d} counts in 1..=1000, got {p:?}"),
+                        format!(
+                            "needs {d} {} in 1..=1000, got {p:?}",
+                            if d == 1 { "count" } else { "counts" }
+                        ),
                     ));
                 }
                 if !matches!(
@@ -312,7 +315,10 @@ impl Scene {
                 if c.len() != d || c.iter().any(|&n| n == 0 || n > 100_000) {
                     return Err(bad(
                         field("count"),
-                        format!("needs {d} counts in 1..=100000, got {c:?}"),
+                        format!(
+                            "needs {d} {} in 1..=100000, got {c:?}",
+                            if d == 1 { "count" } else { "counts" }
+                        ),
                     ));
                 }
             }

@@ -395,7 +395,10 @@ impl Scene {
                 if p.len() != d || p.iter().any(|&n| n == 0 || n > 1000) {
                     return Err(bad(
                         field("per_block"),
-                        format!("needs {d} counts in 1..=1000, got {p:?}"),
+                        format!(
+                            "needs {d} {} in 1..=1000, got {p:?}",
+                            if d == 1 { "count" } else { "counts" }
+                        ),
                     ));
                 }
                 if self.blocks().is_none() {

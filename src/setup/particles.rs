@@ -75,6 +75,9 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
             let n = if body.per_block.is_some() || body.spacing.is_some() {
                 let n = extent / h;
                 if (n - n.round()).abs() > WHOLE_CELLS * n.max(1.0) || n.round() < 1.0 {
+                    // Ten significant digits: 0.8, not 0.7999999999999999.
+                    let shown = |x: f64| format!("{x:.9e}").parse::<f64>().unwrap_or(x);
+                    let (extent, h) = (shown(extent), shown(h));
                     return Err(SceneError::new(
                         format!("body[{b}].max"),
                         ErrorKind::Conflict,

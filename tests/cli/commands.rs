@@ -468,7 +468,12 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("0..39"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("error: --function: basis function index 39 is out of range")
+            && stderr.contains("the basis has 39 functions (indices below 39)"),
+        "{stderr}"
+    );
 }
 
 /// `reproduce` chooses the UL-FEM cache directory from the environment (the library
