@@ -237,3 +237,64 @@ fn local_damping_shortens_the_critical_step_by_the_root_of_one_plus_alpha() {
     let ratio = plain.dt_critical.unwrap() / damped.dt_critical.unwrap();
     assert!((ratio - 1.6f64.sqrt()).abs() < 1e-12, "ratio {ratio}");
 }
+
+/// A soft block (ρ = 1000) resting on a stiff one (ρ = 2000) under a geostatic
+/// initial stress: the vertical stress of each particle is the weight of what lies
+/// above it (the soft block's too), not its own density times the depth.
+#[test]
+fn a_layered_geostatic_stress_is_the_weight_above() {
+    let text = r#"
+name = "layers"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 1.0]
+y = [0.0, 2.5]
+blocks = [2, 5]
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+per_block = [2, 2]
+[body.material]
+young = 1e8
+poisson = 0.3
+density = 2000.0
+[[body]]
+min = [0.0, 1.0]
+max = [1.0, 2.0]
+per_block = [2, 2]
+[body.material]
+young = 1e6
+poisson = 0.3
+density = 1000.0
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -10.0]
+[[effect]]
+kind = "geostatic-stress"
+surface = 2.0
+[time]
+dt = 1e-5
+t_end = 1e-5
+"#;
+    let scene = Scene::from_toml(text, "layers.toml").unwrap();
+    let outcome = psmpm::simulation::run_2d(&scene, &mut |_| {}).unwrap();
+    let p = &outcome.particles;
+    for q in 0..p.len() {
+        let y = p.x0[q][1];
+        let weight = if y < 1.0 {
+            1000.0 * 10.0 + 2000.0 * 10.0 * (1.0 - y)
+        } else {
+            1000.0 * 10.0 * (2.0 - y)
+        };
+        let sigma = p.sigma0[q][(1, 1)];
+        assert!(
+            (sigma + weight).abs() < 1e-3 * weight,
+            "particle at y = {y}: σ_yy⁰ = {sigma}, weight above {weight}"
+        );
+    }
+}

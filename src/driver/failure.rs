@@ -8,6 +8,11 @@ use super::{phases, to_f64_point, Driver, UNDER_SUPPORTED_COVERAGE};
 /// mass matrix is nearly singular (an invertible particle mass matrix stays within
 /// a factor of about 2–4 of its row sums' step).
 pub const NEARLY_SINGULAR: f64 = 10.0;
+
+/// A polynomial piece whose longest edge is this many times its height on it is a
+/// sliver, named as the cause of an inversion in it (the six PS pieces of a
+/// well-shaped triangle stay below about 4).
+pub const SLIVER_ASPECT: f64 = 20.0;
 use crate::mass::{MassError, MassStrategy, SupportFacts};
 use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
@@ -121,6 +126,10 @@ where
                 self.mass.spec()
             ));
         }
+        if self.mass.spec().starts_with("extended") {
+            // Already the strategy that treats such functions.
+            return None;
+        }
         self.untreated_under_supported().map(|(_, _, why)| {
             format!("{why}; use the default mass strategy (`extended-hybrid`: remove `mass`, or `--mass default`), which expresses such functions through their neighbours")
         })
@@ -147,9 +156,11 @@ where
             .map(|&i| i as usize)
             .map(|i| (i, coverage[i].unwrap_or(0.0)))
             .min_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((i, c)) =
-            worst.filter(|&(_, c)| c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0)
-        {
+        // The default strategy is the fix only where it is not already in use.
+        let extends = self.mass.spec().starts_with("extended");
+        if let Some((i, c)) = worst.filter(|&(_, c)| {
+            c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0 && !extends
+        }) {
             return format!(
                 "the particle sits in the support of function {i} at {}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
                 point(&to_f64_point(&self.basis.function_point(i))),
@@ -158,7 +169,7 @@ where
             );
         }
         if let Some((i, c)) = self.last_report.worst_coverage {
-            if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 {
+            if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 && !extends {
                 return format!(
                     "function {i} at {} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended-hybrid`)",
                     point(&to_f64_point(&self.basis.function_point(i))),
@@ -172,6 +183,11 @@ where
             self.bins.particles(element).len(),
             self.basis.element_functions(element).len(),
         );
+        if let Some(aspect) = self.sliver_aspect(element) {
+            return format!(
+                "the element around it inverted (speed {speed:.3e}); it is a sliver (its pieces' longest edge is {aspect:.0} times their height), whose stiffness the critical step estimated at the start did not see if the body was not in it yet: lower `time.courant` or `time.dt` by about that factor, or mesh without slivers (Gmsh: `Mesh.OptimizeNetgen`, or a larger smallest edge)"
+            );
+        }
         if inside < functions {
             let held = if inside == 1 {
                 "1 particle".to_string()
@@ -203,6 +219,34 @@ where
             "the element around it inverted (speed {speed:.3e}, Δt = {:.3e}): the time step is likely above the critical one for this material and mesh, lower `time.dt` or `time.courant`{rotation}",
             self.dt.to_f64()
         )
+    }
+
+    /// In 2D, the largest aspect ratio (longest edge over the height on it) of the
+    /// polynomial pieces of `element` when it is at least [`SLIVER_ASPECT`].
+    fn sliver_aspect(&self, element: usize) -> Option<f64> {
+        if D != 2 {
+            return None;
+        }
+        let mut corners = Vec::new();
+        self.basis.polynomial_pieces(element, &mut corners);
+        let aspect = corners
+            .chunks(3)
+            .filter(|t| t.len() == 3)
+            .map(|t| {
+                let (a, b, c) = (t[0], t[1], t[2]);
+                let (u, v) = (b - a, c - a);
+                let area2 = (u[0] * v[1] - u[1] * v[0]).abs();
+                let longest = [(b - a).norm(), (c - b).norm(), (a - c).norm()]
+                    .into_iter()
+                    .fold(0.0, f64::max);
+                if area2 > 0.0 {
+                    longest * longest / area2
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .fold(0.0, f64::max);
+        (aspect >= SLIVER_ASPECT).then_some(aspect)
     }
 
     /// The error of a failed mass solve, with what the strategy reported.

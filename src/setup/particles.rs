@@ -302,24 +302,91 @@ fn initial_velocity(
     }
 }
 
-/// `σ⁰` of every particle from the scene's geostatic stress states, with the density
-/// of the particle's body and `g` of the gravity effect.
+/// Samples of the density between a particle and the surface ([`weight_above`]).
+const LAYER_SAMPLES: usize = 400;
+
+/// `∫_y^surface ρ(s) ds` of a piecewise-constant `density`: sampled at the midpoints
+/// of [`LAYER_SAMPLES`] intervals, and where two samples differ the jump between
+/// them located by bisection (to round-off), so that layers thicker than an
+/// interval are integrated exactly.
+fn weight_above(density: &impl Fn(f64) -> f64, y: f64, surface: f64) -> f64 {
+    let ds = (surface - y) / LAYER_SAMPLES as f64;
+    let mid = |k: usize| y + (k as f64 + 0.5) * ds;
+    let (mut total, mut from, mut rho) = (0.0, y, density(mid(0)));
+    for k in 1..LAYER_SAMPLES {
+        let next = density(mid(k));
+        if next != rho {
+            let (mut lo, mut hi) = (mid(k - 1), mid(k));
+            for _ in 0..60 {
+                let m = 0.5 * (lo + hi);
+                if density(m) == rho {
+                    lo = m;
+                } else {
+                    hi = m;
+                }
+            }
+            total += rho * (hi - from);
+            from = hi;
+            rho = next;
+        }
+    }
+    total + rho * (surface - from)
+}
+
+/// `σ⁰` of every particle from the scene's geostatic stress states, with `g` of the
+/// gravity effect. With one density (every body the same material density) it is
+/// `ρ g (surface − y)`. With bodies of several densities stacked (a stiff layer under
+/// a soft one) the vertical stress is the weight of what lies above the particle,
+/// `g ∫_y^surface ρ(x, s) ds`, `ρ` the density of the body at `(x, s)` (zero
+/// outside every body; [`weight_above`]).
 fn initial_stress<const D: usize>(
     scene: &Scene,
     lattice: &Lattice,
     particles: &mut Particles<f64, D>,
 ) {
+    let densities: Vec<f64> = (0..scene.bodies.len())
+        .map(|b| scene.body_material(b).density)
+        .collect();
+    let layered = densities.iter().any(|&r| r != densities[0]);
+    let regions: Vec<Option<Region>> = scene
+        .bodies
+        .iter()
+        .map(|body| Region::of(body, D))
+        .collect();
+    // The density at a point: of the first body containing it.
+    let density_at = |x: &nalgebra::SVector<f64, D>, height: f64| -> f64 {
+        let mut point = [0.0; 2];
+        for k in 0..D {
+            point[k] = x[k];
+        }
+        point[D - 1] = height;
+        regions
+            .iter()
+            .zip(&densities)
+            .find(|(r, _)| r.as_ref().is_some_and(|r| r.contains(point)))
+            .map_or(0.0, |(_, &rho)| rho)
+    };
     for spec in &scene.effects {
         if let EffectSpec::GeostaticStress { surface, k0 } = spec {
             let g = scene.gravity().map_or(0.0, |g| g[D - 1]);
             for (p, b) in lattice.body_of_particles().into_iter().enumerate() {
+                let x0 = particles.x0[p];
+                let depth = surface - x0[D - 1];
+                // The mean density above the particle (its own body's when all are
+                // one; Gmsh bodies have no region and keep their own).
+                let density = if layered && depth > 0.0 && regions[b].is_some() {
+                    let at = |height: f64| density_at(&x0, height);
+                    weight_above(&at, x0[D - 1], *surface) / depth
+                } else {
+                    densities[b]
+                };
                 let state = Geostatic {
                     surface: *surface,
-                    density: scene.body_material(b).density,
+                    density,
                     gravity: g,
                     k0: *k0,
                 };
-                let s: SMatrix<f64, D, D> = state.sigma0(&particles.x0[p]);
+                let s: SMatrix<f64, D, D> = state.sigma0(&x0);
                 if particles.sigma0.is_empty() {
                     particles.sigma0 = vec![SMatrix::zeros(); particles.len()];
                 }
