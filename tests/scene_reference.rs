@@ -184,12 +184,24 @@ fn documented_keys(heading: &str) -> BTreeSet<String> {
         .lines()
         .position(|l| l.trim_end() == heading)
         .unwrap_or_else(|| panic!("docs/scenes.md has no section `{heading}`"));
-    DOC.lines()
+    // Only the rows of a key table (headed `| key |`): a section may also hold
+    // other tables, such as the columns a run writes.
+    let mut in_key_table = false;
+    let mut keys = BTreeSet::new();
+    for line in DOC
+        .lines()
         .skip(start + 1)
         .take_while(|l| !l.starts_with('#'))
-        .filter(|l| l.starts_with("| `"))
-        .map(|l| l[3..].split('`').next().unwrap().to_string())
-        .collect()
+    {
+        if !line.starts_with('|') {
+            in_key_table = false;
+        } else if line.starts_with("| key |") {
+            in_key_table = true;
+        } else if in_key_table && line.starts_with("| `") {
+            keys.insert(line[3..].split('`').next().unwrap().to_string());
+        }
+    }
+    keys
 }
 
 /// The keys the parser accepts where the probe put `zzz`, read from its error.

@@ -159,6 +159,26 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             "condition"
         ]
     );
+    // docs/scenes.md lists exactly these columns, in this order.
+    let documented: Vec<String> = include_str!("../../docs/scenes.md")
+        .lines()
+        .skip_while(|l| !l.starts_with("| column |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .flat_map(|l| {
+            let first = l.split(" | ").next().unwrap().to_string();
+            first
+                .split('`')
+                .skip(1)
+                .step_by(2)
+                .map(String::from)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert_eq!(
+        documented, header,
+        "docs/scenes.md, `What run --out DIR writes`"
+    );
     assert_eq!(csv.len(), steps);
     for (row, json) in csv.iter().zip(rows) {
         assert_eq!(row.len(), header.len());
