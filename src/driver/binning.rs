@@ -82,6 +82,106 @@ impl Bins {
     }
 }
 
+/// Particles lying on the closure of elements other than their own: on a shared
+/// edge, vertex or node ([`Basis::other_elements_at`]), where location picked one
+/// of the elements around by round-off. Per particle its other elements, per
+/// element its other particles, both in particle order; refilled every step by
+/// the strategies whose decisions depend on which elements hold particles, so
+/// that those decisions count such a particle in every element around it.
+#[derive(Default)]
+pub struct Touching {
+    /// `(particle, element)` pairs of each [`CHUNK`] of particles, in particle
+    /// order: the other elements of a particle.
+    pairs: Vec<Vec<(u32, u32)>>,
+    /// Pairs in all.
+    total: usize,
+    /// CSR by element: its other particles.
+    element_start: Vec<usize>,
+    element_particles: Vec<u32>,
+    cursor: Vec<usize>,
+}
+
+impl Touching {
+    /// Finds the other elements of every particle at `x` in `element`.
+    pub fn fill<T: Scalar, const D: usize, B: Basis<T, D>>(
+        &mut self,
+        basis: &B,
+        x: &[SVector<T, D>],
+        element: &[usize],
+    ) {
+        let n = x.len();
+        self.pairs.resize_with(chunks(n), Vec::new);
+        self.pairs
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(c, pairs)| {
+                pairs.clear();
+                let range = c * CHUNK..((c + 1) * CHUNK).min(n);
+                for p in range {
+                    basis.other_elements_at(element[p], &x[p], &mut |e| {
+                        pairs.push((p as u32, e as u32))
+                    });
+                }
+            });
+        self.total = self.pairs.iter().map(Vec::len).sum();
+        // By element: a stable counting sort.
+        let ne = basis.num_elements();
+        self.element_start.clear();
+        self.element_start.resize(ne + 1, 0);
+        if self.total == 0 {
+            return;
+        }
+        for &(_, e) in self.pairs.iter().flatten() {
+            self.element_start[e as usize + 1] += 1;
+        }
+        for e in 0..ne {
+            self.element_start[e + 1] += self.element_start[e];
+        }
+        self.element_particles.clear();
+        self.element_particles.resize(self.total, 0);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.element_start[..ne]);
+        for &(p, e) in self.pairs.iter().flatten() {
+            self.element_particles[self.cursor[e as usize]] = p;
+            self.cursor[e as usize] += 1;
+        }
+    }
+
+    /// No particle lies on another element's closure (or not filled).
+    pub fn is_empty(&self) -> bool {
+        self.total == 0
+    }
+
+    /// The elements other than its own whose closure holds particle `p`.
+    #[inline]
+    pub fn elements_of(&self, p: usize) -> impl Iterator<Item = usize> + '_ {
+        let pairs = match self.total {
+            0 => &[][..],
+            _ => &self.pairs[p / CHUNK][..],
+        };
+        let start = pairs.partition_point(|&(q, _)| (q as usize) < p);
+        pairs[start..]
+            .iter()
+            .take_while(move |&&(q, _)| q as usize == p)
+            .map(|&(_, e)| e as usize)
+    }
+
+    /// The particles of other elements that lie on the closure of element `e`.
+    #[inline]
+    pub fn particles_on(&self, e: usize) -> &[u32] {
+        if self.total == 0 {
+            return &[];
+        }
+        &self.element_particles[self.element_start[e]..self.element_start[e + 1]]
+    }
+
+    /// Element `e` holds a particle of `bins` or one lies on its closure.
+    #[inline]
+    pub fn occupied(&self, bins: &Bins, e: usize) -> bool {
+        bins.occupied(e) || !self.particles_on(e).is_empty()
+    }
+}
+
 /// Entries of an element's local matrix block of `stride` functions: its upper
 /// triangle, row by row (the blocks are symmetric).
 #[inline]

@@ -72,6 +72,43 @@ struct StrategyInputs {
     /// general constraint's term); sized with the coverage.
     on_wall: Vec<bool>,
     support: Option<std::sync::Arc<SupportFacts>>,
+    /// Particles on the edges and vertices of elements other than their own,
+    /// when a decision depends on which elements hold particles (empty elements,
+    /// live functions, the affine-preserving lumping); refilled every step.
+    touching: Option<phases::Touching>,
+    /// `live[i]`: an element holding a particle, or with one on its closure, has
+    /// function `i` (with `touching`; else the gather's live functions serve).
+    live: Vec<bool>,
+    /// Scratch of [`phases::add_affine_lumping`], one per element.
+    element_affine: Vec<bool>,
+}
+
+impl StrategyInputs {
+    /// Fills `touching` and `live` for the particles binned in `bins`.
+    fn mark_touching<T: Scalar, const D: usize, B: Basis<T, D>>(
+        &mut self,
+        basis: &B,
+        particles: &Particles<T, D>,
+        bins: &Bins,
+        gather: &Gather,
+    ) {
+        let Some(touching) = self.touching.as_mut() else {
+            return;
+        };
+        touching.fill(basis, &particles.x, &particles.element);
+        self.live.clear();
+        self.live.extend_from_slice(gather.live());
+        if touching.is_empty() {
+            return;
+        }
+        for e in 0..basis.num_elements() {
+            if !bins.occupied(e) && touching.occupied(bins, e) {
+                for &i in basis.element_functions(e) {
+                    self.live[i] = true;
+                }
+            }
+        }
+    }
 }
 
 /// The MPM driver.
@@ -245,6 +282,16 @@ where
                 Vec::new()
             },
             support,
+            touching: (needs.empty_elements
+                || needs.coverage
+                || needs.correction == Correction::InMass)
+                .then(phases::Touching::default),
+            live: Vec::new(),
+            element_affine: if needs.correction == Correction::InMass {
+                vec![false; basis.num_elements()]
+            } else {
+                Vec::new()
+            },
         };
         let np = particles.len();
         let stride = basis.max_functions_per_element();
@@ -400,7 +447,11 @@ where
             &mut self.scratch,
             &mut self.evals,
         )
-        .inspect(|_| self.gather.mark_live(&self.basis, &self.bins))
+        .inspect(|_| {
+            self.gather.mark_live(&self.basis, &self.bins);
+            self.inputs
+                .mark_touching(&self.basis, &self.particles, &self.bins, &self.gather);
+        })
         .map_err(|o| {
             let p = o.particle;
             let speed = self.particles.v[p].norm().to_f64();
@@ -434,7 +485,15 @@ where
             &mut self.rhs,
         );
         if self.inputs.needs.empty_elements {
-            phases::mark_empty_elements(&self.basis, &self.bins, &mut self.inputs.touches_empty);
+            phases::mark_empty_elements(
+                &self.basis,
+                &self.bins,
+                self.inputs
+                    .touching
+                    .as_ref()
+                    .unwrap_or(&phases::Touching::default()),
+                &mut self.inputs.touches_empty,
+            );
         }
         if self.inputs.needs.coverage {
             let inputs = &mut self.inputs;
@@ -475,13 +534,19 @@ where
                 particle_volume: &self.inputs.particle_volume,
                 particle_count: &self.inputs.particle_count,
                 on_wall: &self.inputs.on_wall,
-                live: self.gather.live(),
+                live: if self.inputs.touching.is_some() {
+                    &self.inputs.live
+                } else {
+                    self.gather.live()
+                },
                 diagonal_only: self.inputs.needs.row_sums_only,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
                 phases::add_affine_lumping(
                     &self.evals,
                     &self.bins,
+                    self.inputs.touching.as_ref().unwrap(),
+                    &mut self.inputs.element_affine,
                     &self.gather,
                     &mut self.local,
                     &self.particles.mass,

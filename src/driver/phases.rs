@@ -28,7 +28,7 @@ use nalgebra::{SMatrix, SVector};
 use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 
-pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local};
+pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local, Touching};
 use super::binning::{packed, ENTRY_CHUNK};
 
 /// Particles per parallel task of the per-particle phases: fixed, so that the
@@ -379,7 +379,11 @@ pub enum MassMatrix {
 /// (`g = e_i − e_j`). An element passes when the mass-weighted covariance `S` of
 /// its particle positions has `det S ≥ (α s_e)^D`, with `s_e` the mean variance
 /// per axis of its functions' points `ξ` (`element_scale`, [`element_scales`])
-/// and `α =` [`AFFINE_SPREAD`].
+/// and `α =` [`AFFINE_SPREAD`], counting the particles on its edges and
+/// vertices ([`Touching`]); a particle on an edge or vertex keeps the whole
+/// correction only where every element around it passes, so that the choice
+/// location made among them does not matter (`element_affine`: scratch, one per
+/// element).
 ///
 /// A basis whose functions are affine on every element (PL, `functions_affine`)
 /// spans exactly the affine fields there: `grad phi_k · (ξ_i − ξ_j) = δ_ki − δ_kj`,
@@ -400,6 +404,8 @@ pub enum MassMatrix {
 pub fn add_affine_lumping<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
     bins: &Bins,
+    touching: &Touching,
+    element_affine: &mut [bool],
     gather: &Gather,
     local: &mut Local<T, D>,
     mass: &[T],
@@ -413,17 +419,32 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     let stride = local.stride;
     let theta = T::of(PLAIN_SHARE);
     let touches_lumped = |p: usize| evals.functions(p).iter().any(|&i| lumped[i as usize]);
+    if !functions_affine {
+        element_affine
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(e, affine)| {
+                let (inside, on) = (bins.particles(e), touching.particles_on(e));
+                *affine = (!inside.is_empty() || !on.is_empty())
+                    && determines_affine(inside.iter().chain(on), mass, x, element_scale[e]);
+            });
+    }
+    let element_affine = &*element_affine;
     local.par_elements(bins).for_each(|(e, (lm, g))| {
         let inside = bins.particles(e);
         if !inside.iter().any(|&p| touches_lumped(p as usize)) {
             return;
         }
-        let affine = !functions_affine && determines_affine(inside, mass, x, element_scale[e]);
         for &p in inside {
             let p = p as usize;
             if !touches_lumped(p) {
                 continue;
             }
+            // A particle on an edge or vertex: affine only if every element
+            // around it is (whichever of them location picked).
+            let affine = !functions_affine
+                && element_affine[e]
+                && touching.elements_of(p).all(|f| element_affine[f]);
             let range = evals.range(p);
             let (base, m) = (range.start, range.len());
             let index = evals.functions(p);
@@ -490,17 +511,17 @@ pub const PLAIN_SHARE: f64 = 0.1;
 
 /// Whether the particles `inside` one element determine an affine field
 /// ([`add_affine_lumping`]).
-fn determines_affine<T: Scalar, const D: usize>(
-    inside: &[u32],
+fn determines_affine<'a, T: Scalar, const D: usize>(
+    inside: impl Iterator<Item = &'a u32> + Clone,
     mass: &[T],
     x: &[SVector<T, D>],
     scale: T,
 ) -> bool {
-    if inside.len() < D + 1 {
+    if inside.clone().count() < D + 1 {
         return false;
     }
     let (mut total, mut mean) = (T::zero(), SVector::<T, D>::zeros());
-    for &p in inside {
+    for &p in inside.clone() {
         let p = p as usize;
         total += mass[p];
         mean += x[p] * mass[p];
@@ -801,15 +822,17 @@ impl UpdateFailure {
 }
 
 /// `touches_empty[i]`: the support of function `i` contains an element without
-/// particles (the seeds' partial-lumping rule).
+/// particles (the seeds' partial-lumping rule). A particle on an edge or vertex
+/// counts in every element around it ([`Touching`]).
 pub fn mark_empty_elements<T: Scalar, const D: usize, B: Basis<T, D>>(
     basis: &B,
     bins: &Bins,
+    touching: &Touching,
     touches_empty: &mut [bool],
 ) {
     touches_empty.iter_mut().for_each(|t| *t = false);
     for e in 0..basis.num_elements() {
-        if !bins.occupied(e) {
+        if !touching.occupied(bins, e) {
             for &i in basis.element_functions(e) {
                 touches_empty[i] = true;
             }

@@ -73,6 +73,11 @@ impl<T: Real> Basis<T, 1> for QuadraticBSpline<T> {
     fn locate(&self, x: &Point<T, 1>, hint: Option<usize>) -> Option<usize> {
         self.mesh.locate(x.x.to_f64(), hint)
     }
+    fn other_elements_at(&self, element: usize, x: &Point<T, 1>, visit: &mut dyn FnMut(usize)) {
+        if let Some(e) = self.mesh.other_element_at(element, x.x.to_f64()) {
+            visit(e)
+        }
+    }
     /// Cox–de Boor on knot span `i = e + 2` (The NURBS Book, A2.2), with
     /// `N'_{k,2} = 2/(t_{k+2} − t_k) N_{k,1} − 2/(t_{k+3} − t_{k+1}) N_{k+1,1}`.
     #[inline]

@@ -78,6 +78,10 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
         self.mesh
             .locate(Vec2::new(x.x.to_f64(), x.y.to_f64()), hint)
     }
+    fn other_elements_at(&self, element: usize, x: &Point<T, 2>, visit: &mut dyn FnMut(usize)) {
+        self.mesh
+            .other_triangles_at(element, Vec2::new(x.x.to_f64(), x.y.to_f64()), visit)
+    }
     #[inline]
     fn eval(&self, element: usize, x: &Point<T, 2>, out: &mut BasisEval<T, 2>) {
         let tri = &self.mesh.triangles()[element];

@@ -52,6 +52,11 @@ impl<T: Real> Basis<T, 1> for Linear1d<T> {
     fn locate(&self, x: &Point<T, 1>, hint: Option<usize>) -> Option<usize> {
         self.mesh.locate(x.x.to_f64(), hint)
     }
+    fn other_elements_at(&self, element: usize, x: &Point<T, 1>, visit: &mut dyn FnMut(usize)) {
+        if let Some(e) = self.mesh.other_element_at(element, x.x.to_f64()) {
+            visit(e)
+        }
+    }
     #[inline]
     fn eval(&self, element: usize, x: &Point<T, 1>, out: &mut BasisEval<T, 1>) {
         let (a, b) = (self.nodes[element], self.nodes[element + 1]);

@@ -133,6 +133,14 @@ pub trait Basis<T: Real, const D: usize>: Sync {
     /// The element containing `x`, starting the search at `hint` (e.g. a particle's
     /// previous element). `None` when `x` lies outside the mesh.
     fn locate(&self, x: &Point<T, D>, hint: Option<usize>) -> Option<usize>;
+    /// Calls `visit` with every element other than `element` whose closure holds
+    /// `x` (which lies in `element`) up to round-off: a point on a shared edge,
+    /// vertex or node lies in every element around it, and
+    /// [`locate`](Basis::locate) picks one of them by round-off. Decisions that
+    /// depend on which elements hold particles (empty elements, the particles that
+    /// pin an affine field) count the point in all of them, so that they do not
+    /// depend on that choice (a mirror-symmetric scene stays symmetric on any grid).
+    fn other_elements_at(&self, element: usize, x: &Point<T, D>, visit: &mut dyn FnMut(usize));
     /// Writes index, value and gradient of every function non-zero on `element`
     /// at `x` (which must lie in the element, up to round-off) into `out`.
     fn eval(&self, element: usize, x: &Point<T, D>, out: &mut BasisEval<T, D>);

@@ -29,6 +29,14 @@ use super::{TriMesh, Vec2};
 /// outside it.
 pub const INSIDE_TOLERANCE: f64 = 1e-12;
 
+/// Barycentric tolerance of "on an edge or vertex" for
+/// [`TriMesh::other_triangles_at`]: `p` lies on the edge opposite vertex `k` when
+/// `λ_k ≤ TOUCH_TOLERANCE`, about `1e-9` heights. Well above the round-off of
+/// locating a point that lies on an edge in exact arithmetic (a lattice point on a
+/// grid diagonal, computed in floating point), and far below any spacing of
+/// particles.
+pub const TOUCH_TOLERANCE: f64 = 1e-9;
+
 /// Longest walk (in triangles) before falling back to the global search; caps
 /// cycling walks in non-Delaunay meshes.
 pub const MAX_WALK_STEPS: usize = 64;
@@ -256,6 +264,66 @@ mod tests {
         Vec2::new(f64::NAN, 0.5),
         Vec2::new(0.5, f64::INFINITY),
     ];
+
+    /// Every triangle whose closure holds `p` up to the touch tolerance, by brute force.
+    fn closure_triangles(mesh: &TriMesh, p: Vec2) -> Vec<usize> {
+        (0..mesh.num_triangles())
+            .filter(|&t| {
+                mesh.barycentric(t, p)
+                    .iter()
+                    .all(|&l| l >= -TOUCH_TOLERANCE)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_point_on_an_edge_or_vertex_touches_every_triangle_around_it() {
+        // h = 1/3: lattice points on the diagonals and the block corners are on
+        // edges and vertices only up to round-off.
+        let mesh = generators::block_grid(0.0, 4.0, 0.0, 4.0, 12, 12).unwrap();
+        let h = 4.0 / 12.0;
+        let mut seen = [0usize; 4];
+        for i in 0..36 {
+            for j in 0..36 {
+                // Per-block lattices of 3 × 3 (on the diagonals and the centres) and
+                // points on the block edges and corners.
+                for p in [
+                    Vec2::new(
+                        1.0 + (i as f64 + 0.5) * h / 3.0,
+                        0.5 + (j as f64 + 0.5) * h / 3.0,
+                    ),
+                    Vec2::new((i as f64) * h / 3.0, (j as f64) * h / 3.0),
+                ] {
+                    if p.x > 4.0 || p.y > 4.0 {
+                        continue;
+                    }
+                    let t = mesh.locate(p, None).unwrap();
+                    let mut all = vec![t];
+                    mesh.other_triangles_at(t, p, &mut |n| all.push(n));
+                    all.sort_unstable();
+                    assert_eq!(all, closure_triangles(&mesh, p), "at {p:?}");
+                    seen[(all.len() - 1).min(3)] += 1;
+                }
+            }
+        }
+        // Interior points, edge points, vertex points all occurred.
+        assert!(seen[0] > 0 && seen[1] > 0 && seen[3] > 0, "{seen:?}");
+    }
+
+    #[test]
+    fn a_point_on_a_node_touches_both_intervals() {
+        let mesh = crate::mesh::Mesh1d::uniform(0.0, 1.0, 10).unwrap();
+        for (x, other) in [
+            (0.3, Some(2)),
+            (0.35, None),
+            (0.0, None),
+            (1.0, None),
+            (0.7 + 1e-13, Some(6)),
+        ] {
+            let e = mesh.locate(x, None).unwrap();
+            assert_eq!(mesh.other_element_at(e, x), other, "at {x}");
+        }
+    }
 
     #[test]
     fn locates_on_every_generator() {

@@ -84,6 +84,21 @@ impl Mesh1d {
         let k = self.nodes.partition_point(|&v| v <= x);
         Some((k - 1).min(n - 1))
     }
+
+    /// The element other than `e` whose closure holds `x` (which lies in `e`) up
+    /// to `1e-9` element lengths: the neighbour beyond the node `x` lies on, if any
+    /// (the 1D [`TriMesh::other_triangles_at`](super::TriMesh::other_triangles_at)).
+    pub fn other_element_at(&self, e: usize, x: f64) -> Option<usize> {
+        let (a, b) = self.element(e);
+        let tol = super::locate::TOUCH_TOLERANCE * (b - a);
+        if x - a <= tol && e > 0 {
+            Some(e - 1)
+        } else if b - x <= tol && e + 1 < self.num_elements() {
+            Some(e + 1)
+        } else {
+            None
+        }
+    }
 }
 
 #[cfg(test)]

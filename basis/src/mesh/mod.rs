@@ -442,6 +442,34 @@ impl TriMesh {
     pub fn locate(&self, p: Vec2, hint: Option<usize>) -> Option<usize> {
         self.locator.locate(self, p, hint)
     }
+    /// Calls `visit` with every triangle other than `t` whose closure holds `p`
+    /// (which lies in `t`) up to [`locate::TOUCH_TOLERANCE`]: the neighbour across
+    /// the edge `p` lies on, or every other triangle around the vertex it lies on.
+    /// A point on a shared edge or vertex lies in all of them, and
+    /// [`locate`](Self::locate) picks one by round-off; decisions that depend on
+    /// which triangles hold a point use these as well, so that they do not.
+    pub fn other_triangles_at(&self, t: usize, p: Vec2, visit: &mut dyn FnMut(usize)) {
+        let l = self.barycentric(t, p);
+        let on: [bool; 3] = std::array::from_fn(|k| l[k] <= locate::TOUCH_TOLERANCE);
+        match on.iter().filter(|&&o| o).count() {
+            1 => {
+                // The edge opposite vertex m is local edge m + 1 (edge k joins k, k + 1).
+                let m = on.iter().position(|&o| o).unwrap();
+                if let Some(n) = self.neighbours[t][(m + 1) % 3] {
+                    visit(n);
+                }
+            }
+            2 => {
+                let c = on.iter().position(|&o| !o).unwrap();
+                for &n in self.vertex_triangles(self.triangles[t][c]) {
+                    if n != t {
+                        visit(n);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
     /// Barycentric coordinates of `p` in triangle `t` (they sum to one).
     pub fn barycentric(&self, t: usize, p: Vec2) -> [f64; 3] {
         let [a, b, c] = self.triangle_points(t);

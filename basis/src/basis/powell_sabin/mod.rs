@@ -470,6 +470,10 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
         self.mesh
             .locate(Vec2::new(x.x.to_f64(), x.y.to_f64()), hint)
     }
+    fn other_elements_at(&self, element: usize, x: &Point<T, 2>, visit: &mut dyn FnMut(usize)) {
+        self.mesh
+            .other_triangles_at(element, Vec2::new(x.x.to_f64(), x.y.to_f64()), visit)
+    }
     /// Locates the sub-triangle ([`Refinement::sub_triangle_of`]) and evaluates its
     /// polynomial ([`PowellSabin::eval_piece`]).
     #[inline]
