@@ -173,6 +173,26 @@ fn law<const D: usize>(m: &MaterialSpec) -> Result<AnyMaterial, MaterialError> {
     })
 }
 
+/// The bounding box of the mesh of `basis`, for messages: `[x0, x1] × [y0, y1]`.
+fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> String {
+    let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
+    let mut pieces = Vec::new();
+    for e in 0..basis.num_elements() {
+        pieces.clear();
+        basis.polynomial_pieces(e, &mut pieces);
+        for p in &pieces {
+            for k in 0..D {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+    }
+    (0..D)
+        .map(|k| format!("[{}, {}]", lo[k], hi[k]))
+        .collect::<Vec<_>>()
+        .join(" × ")
+}
+
 /// The one place a scene's driver is built: fixes from the boundary conditions,
 /// the scene's mass strategy, the condition estimate on request, slip walls. A
 /// particle outside the mesh is reported against its body.
@@ -199,6 +219,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
             })
         })
         .collect();
+    let extent = mesh_extent(&basis);
     let mut driver: SceneDriver<D, B> = Driver::new(
         basis,
         particles,
@@ -226,7 +247,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
             SceneError::new(
                 field,
                 ErrorKind::Conflict,
-                format!("the particle at {position:?} lies outside the mesh; the body must lie inside the meshed domain"),
+                format!("the particle at {position:?} lies outside the mesh, which spans {extent}; the body must lie inside the meshed domain (not in a hole)"),
             )
         }
         SetupError::Boundary { tag, message } => SceneError::new(
