@@ -232,6 +232,27 @@ pub fn energies_from_terms<T: Scalar, const D: usize>(
     }
 }
 
+/// The elastic energy stored in the particles' initial stresses,
+/// `Σ_p V⁰_p ½ σ⁰_p : ε⁰_p` with `ε⁰ = C⁻¹ σ⁰` the small strain of each particle's
+/// law that carries `σ⁰` (`σ = λ tr(ε) I + 2μ ε`, plane strain in 2D): the strain
+/// energy a stress-free body would store once settled into that state. Zero
+/// without initial stresses.
+pub fn initial_stress_energy<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
+    parts: &Particles<T, D>,
+    material: &Mat,
+) -> f64 {
+    (0..parts.sigma0.len())
+        .map(|p| {
+            let sigma = parts.initial_stress(p).map(|v| v.to_f64());
+            let (lambda, mu) = material.elastic(p).lame(D);
+            let trace_strain = sigma.trace() / (D as f64 * lambda + 2.0 * mu);
+            let strain =
+                (sigma - SMatrix::<f64, D, D>::identity() * (lambda * trace_strain)) / (2.0 * mu);
+            parts.volume0[p].to_f64() * 0.5 * sigma.dot(&strain)
+        })
+        .sum()
+}
+
 /// Tracks the energy balance and the condition of a run, and gives the verdict.
 ///
 /// The drift and growth of the total energy `E = K + S + P − W` are measured
@@ -240,9 +261,18 @@ pub fn energies_from_terms<T: Scalar, const D: usize>(
 /// whichever is largest. Unlike `|E|` or `|P|`, these do not change when the scene
 /// is moved or gravity's zero level is put elsewhere, or when gravity is written as
 /// a body force: the verdict of a run is that of its motion.
+///
+/// A run that starts from an initial stress `σ⁰` (a geostatic column) counts its
+/// strain energy from that state, so `K + S` leaves out the elastic energy the
+/// state stores, which the same column settled from a stress-free start counts
+/// in `S`: [`Verdict::with_initial_stress_energy`] adds it to the scale, so that
+/// a column at rest under its geostatic stress is judged as the settled one is
+/// (its small oscillation about equilibrium is not the scale of the run).
 #[derive(Debug, Clone, Copy)]
 pub struct Verdict {
     e0: f64,
+    /// The elastic energy stored in the initial stress ([`initial_stress_energy`]).
+    stored: f64,
     /// Largest `K + S` seen.
     motion: f64,
     /// Least and largest potential energy seen.
@@ -263,6 +293,7 @@ impl Verdict {
     pub fn new(start: &StepReport) -> Self {
         Verdict {
             e0: start.total_energy(),
+            stored: 0.0,
             motion: start.kinetic + start.strain,
             potential: (start.potential, start.potential),
             work: (start.work, start.work),
@@ -271,6 +302,13 @@ impl Verdict {
             growth_crossed: None,
             max_condition: None,
         }
+    }
+
+    /// The same, with the elastic energy `stored` in the run's initial stress
+    /// ([`initial_stress_energy`]) added to the energy scale.
+    pub fn with_initial_stress_energy(mut self, stored: f64) -> Self {
+        self.stored = stored.max(0.0);
+        self
     }
 
     /// Takes the report of a step.
@@ -297,7 +335,7 @@ impl Verdict {
 
     /// The energy scale (see [`Verdict`]).
     pub fn scale(&self) -> f64 {
-        self.motion
+        (self.motion + self.stored)
             .max(self.potential.1 - self.potential.0)
             .max(self.work.1 - self.work.0)
     }
@@ -395,6 +433,58 @@ mod tests {
         assert_eq!(worked.scale(), base.scale());
         assert_eq!(worked.energy_drift_and_growth(), (drift, growth));
         assert_eq!(worked.growth_crossed, Some((4, 4.0)));
+    }
+
+    /// The stored energy of an initial stress is `½ σ⁰ : C⁻¹ σ⁰` per unit volume
+    /// (1D: `σ² / 2E`; 2D plane strain under a uniaxial `σ_yy`:
+    /// `(1 − ν²) σ² / 2E`), and it widens the scale against which a small
+    /// oscillation about that state is judged.
+    #[test]
+    fn an_initial_stress_stores_energy_that_widens_the_scale() {
+        use crate::material::{Elastic, LinearElastic};
+        let elastic = Elastic::new(1e6, 0.3, 1000.0).unwrap();
+        let (sigma, volume) = (-3e4, 0.5);
+        let mut bar =
+            Particles::<f64, 1>::new(vec![nalgebra::Vector1::new(0.2)], vec![volume], 1.0);
+        bar.sigma0 = vec![SMatrix::<f64, 1, 1>::new(sigma)];
+        let law = LinearElastic::new(elastic, 1);
+        let stored = initial_stress_energy(&bar, &law);
+        let expected = volume * sigma * sigma / (2.0 * 1e6);
+        assert!(
+            (stored - expected).abs() < 1e-12 * expected,
+            "{stored} {expected}"
+        );
+        let mut column =
+            Particles::<f64, 2>::new(vec![SVector::<f64, 2>::new(0.2, 0.3)], vec![volume], 1.0);
+        column.sigma0 = vec![SMatrix::<f64, 2, 2>::new(0.0, 0.0, 0.0, sigma)];
+        let stored = initial_stress_energy(&column, &LinearElastic::new(elastic, 2));
+        let expected = volume * (1.0 - 0.09) * sigma * sigma / (2.0 * 1e6);
+        assert!(
+            (stored - expected).abs() < 1e-12 * expected,
+            "{stored} {expected}"
+        );
+        // Without an initial stress: nothing stored.
+        column.sigma0.clear();
+        assert_eq!(
+            initial_stress_energy(&column, &LinearElastic::new(elastic, 2)),
+            0.0
+        );
+
+        // A start at rest whose total rises to 1.1: UNSTABLE against the motion's
+        // own scale (1.1), stable against a stored energy of 100.
+        let state = |k: f64, s: f64| StepReport {
+            kinetic: k,
+            strain: s,
+            ..StepReport::default()
+        };
+        let history = [state(0.0, 0.0), state(1.0, 0.1), state(0.5, 0.5)];
+        let judge = |stored: f64| {
+            let mut v = Verdict::new(&history[0]).with_initial_stress_energy(stored);
+            history[1..].iter().for_each(|r| v.observe(r));
+            v.stable(false)
+        };
+        assert!(!judge(0.0));
+        assert!(judge(100.0));
     }
 
     /// Nothing moving and nothing changing is no growth, not 0/0.

@@ -464,7 +464,9 @@ where
     // The initial state (step 0); the public entry points other than
     // `observe_2d`/`observe_1d` pass only steps > 0 on.
     on_step(&start, driver.particles.view());
-    let mut verdict = Verdict::new(&start);
+    let mut verdict = Verdict::new(&start).with_initial_stress_energy(
+        crate::diagnostics::initial_stress_energy(&driver.particles, driver.material()),
+    );
     let mut last_energy = start.total_energy();
     let (mut lumped, mut deactivated, mut extended) = (0usize, 0usize, 0usize);
     let mut phases = PhaseTimes::default();
