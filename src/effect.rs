@@ -104,6 +104,9 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     fn does_work(&self) -> bool {
         false
     }
+    /// The run's time step is `dt` (called when the driver is built and whenever
+    /// its step changes), for effects whose forces depend on it.
+    fn set_time_step(&mut self, _dt: f64) {}
 }
 
 /// Uniform gravity `g`: `F^body_{k,i} = Σ_p m_p phi_i(x_p) g_k` (paper eq. (16)),

@@ -60,6 +60,7 @@
 pub use psmpm_basis as basis;
 
 pub mod bases;
+pub mod contact;
 pub mod diagnostics;
 pub mod driver;
 pub mod effect;

@@ -147,6 +147,11 @@ const PROBES: &[(&str, bool, &str)] = &[
         "[[resolution]]\nbasis = \"pl\"\nzzz = 0",
     ),
     ("## `[study]`", false, "[study]\nzzz = 0"),
+    (
+        "### `[[effect]]` with `kind = \"contact-wall\"`",
+        true,
+        "[[effect]]\nkind = \"contact-wall\"\ntag = \"bottom\"\nzzz = 0",
+    ),
 ];
 
 /// The TOML examples of the page, in order.

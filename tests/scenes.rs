@@ -90,9 +90,9 @@ fn only_declared_effects_are_evaluated() {
 
     let none = Particles::<f64, 2>::new(Vec::new(), Vec::new(), 1.0);
     let bar = Scene::builtin("vibrating-bar").unwrap();
-    assert!(build_effects(&bar, &none).unwrap().is_empty());
+    assert!(build_effects(&bar, &none, &[]).unwrap().is_empty());
     let column = Scene::builtin("column-small").unwrap();
-    let effects = build_effects(&column, &none).unwrap();
+    let effects = build_effects(&column, &none, &[]).unwrap();
     let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
     assert_eq!(names, ["gravity"]);
 

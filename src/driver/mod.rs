@@ -198,9 +198,12 @@ where
         material: Mat,
         mut mass: M,
         fixes: &[Fix],
-        effects: Vec<Box<dyn Effect<T, D>>>,
+        mut effects: Vec<Box<dyn Effect<T, D>>>,
         dt: f64,
     ) -> Result<Self, SetupError> {
+        for effect in &mut effects {
+            effect.set_time_step(dt);
+        }
         let n = basis.num_functions();
         // Function indices, pattern positions and local offsets are stored in 32
         // bits: below 2³¹ functions and local entries, the pattern's entries
@@ -393,6 +396,9 @@ where
     /// Changes the time step (e.g. to a fraction of [`Driver::critical_time_step`]).
     pub fn set_dt(&mut self, dt: f64) {
         self.dt = T::of(dt);
+        for effect in &mut self.effects {
+            effect.set_time_step(dt);
+        }
     }
     /// The material.
     pub fn material(&self) -> &Mat {
@@ -456,12 +462,17 @@ where
             let p = o.particle;
             let speed = self.particles.v[p].norm().to_f64();
             let moved = speed * self.dt.to_f64();
+            let contact = if self.effects.iter().any(|e| e.name() == "contact-wall") {
+                "; if it went through a contact wall, the wall's springs were too soft for the load or the speed: raise its `stiffness` (up to 1) or lower the time step (the springs stiffen as 1/Δt²)"
+            } else {
+                ""
+            };
             StepError::ParticleLeftMesh {
                 step: self.step + 1,
                 particle: p,
                 position: to_f64(&self.particles.x[p]),
                 hint: format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column){contact}"
                 ),
             }
         })

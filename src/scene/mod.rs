@@ -575,6 +575,15 @@ pub enum EffectSpec {
     /// The body force that makes the reference solution exact (paper eqs. (42)–(46)
     /// for `axis-aligned`).
     ManufacturedBodyForce {},
+    /// A frictionless contact wall on the boundary tagged `tag`, acting on the
+    /// particles (a penalty; [`crate::contact`]): 2D only.
+    ContactWall {
+        /// The boundary tag of the wall.
+        tag: String,
+        /// `κ`: each particle's spring has frequency `κ / Δt`, in `(0, 1]`.
+        #[serde(default = "default_contact_stiffness")]
+        stiffness: f64,
+    },
     /// Geostatic initial stress: `σ_yy = ρ g (surface − y)`, `σ_xx = k0 σ_yy`, with
     /// the density of the material and `g` of the gravity effect.
     GeostaticStress {
@@ -584,6 +593,10 @@ pub enum EffectSpec {
         #[serde(default)]
         k0: f64,
     },
+}
+
+fn default_contact_stiffness() -> f64 {
+    crate::contact::DEFAULT_STIFFNESS
 }
 
 /// Time stepping: a fixed `dt`, or one from a Courant number.

@@ -199,6 +199,31 @@ impl Scene {
                         ));
                     }
                 }
+                EffectSpec::ContactWall { tag, stiffness } => {
+                    if self.dim != 2 {
+                        return Err(conflict(
+                            field("kind"),
+                            "a contact wall needs a 2D scene (in 1D, fix the end: `[[boundary]]` with `fix = [\"x\"]`)",
+                        ));
+                    }
+                    if !(*stiffness > 0.0 && *stiffness <= 1.0) {
+                        return Err(bad(
+                            field("stiffness"),
+                            format!("must be in (0, 1], got {stiffness}"),
+                        ));
+                    }
+                    if let Some(b) = self.boundaries.iter().position(|bc| &bc.tag == tag) {
+                        if !self.boundaries[b].fix.is_empty() {
+                            return Err(conflict(
+                                field("tag"),
+                                format!(
+                                    "`{}` is also held by boundary[{b}] (`fix`): a contact wall replaces the condition on the functions; remove that `[[boundary]]`",
+                                    crate::scene::limits::echo(tag)
+                                ),
+                            ));
+                        }
+                    }
+                }
                 EffectSpec::GeostaticStress { surface, k0 } => {
                     finite(&field("surface"), *surface)?;
                     finite(&field("k0"), *k0)?;

@@ -1,6 +1,7 @@
 //! The effects a scene declares, built for its particles.
 
 use super::Solution;
+use crate::contact::{ContactWall, WallGeometry};
 use crate::effect::{BodyForce, Effect, Gravity, LocalDamping, Traction};
 use crate::particles::Particles;
 use crate::scene::{EffectSpec, ErrorKind, Scene, SceneError};
@@ -12,8 +13,10 @@ use nalgebra::SVector;
 pub fn build_effects<const D: usize>(
     scene: &Scene,
     particles: &Particles<f64, D>,
+    contacts: &[WallGeometry],
 ) -> Result<Vec<Box<dyn Effect<f64, D>>>, RunError> {
     let solution = Solution::new(scene);
+    let mut contacts = contacts.iter();
     let mut effects: Vec<Box<dyn Effect<f64, D>>> = Vec::new();
     for (i, spec) in scene.effects.iter().enumerate() {
         match spec {
@@ -59,6 +62,26 @@ pub fn build_effects<const D: usize>(
                     .into());
                 };
                 effects.push(Box::new(BodyForce::Manufactured(a)));
+            }
+            EffectSpec::ContactWall { tag, stiffness } => {
+                let geometry = contacts.next().cloned().ok_or_else(|| {
+                    SceneError::new(
+                        format!("effect[{i}].kind"),
+                        ErrorKind::Conflict,
+                        "a contact wall needs a 2D mesh",
+                    )
+                })?;
+                let reach = geometry.reach();
+                let wall = ContactWall::new(geometry, particles, *stiffness).map_err(|d| {
+                    SceneError::new(
+                        format!("effect[{i}].tag"),
+                        ErrorKind::Conflict,
+                        format!(
+                            "the particles near `{tag}` are coarser than the mesh: a contact distance of {d:.4e} (half a particle spacing) exceeds the longest edge {reach:.4e}; use more particles (`per_block`, `count` or `spacing`)"
+                        ),
+                    )
+                })?;
+                effects.push(Box::new(wall));
             }
             // An initial state, not an effect: `particles::apply_initial_states`.
             EffectSpec::GeostaticStress { .. } => {}

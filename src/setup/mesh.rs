@@ -4,7 +4,8 @@
 
 use super::Domain;
 use crate::bases::BasisKind;
-use crate::scene::{BlockLayout, Component, ErrorKind, MeshSpec, Scene, SceneError};
+use crate::contact::WallGeometry;
+use crate::scene::{BlockLayout, Component, EffectSpec, ErrorKind, MeshSpec, Scene, SceneError};
 use crate::simulation::RunError;
 use psmpm_basis::basis::bspline1d::QuadraticBSpline;
 use psmpm_basis::basis::linear::Linear;
@@ -44,6 +45,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let h = smallest_edge(&mesh);
     check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
+    let contacts = contact_walls(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
             PowellSabin::<f64>::new(mesh, scene.split).map_err(|e| conflict("basis", e))?,
@@ -53,7 +55,12 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
             return Err(conflict("basis", format!("`{}` is a 1D basis", one_d.name())).into())
         }
     };
-    Ok(Domain { basis, h, walls })
+    Ok(Domain {
+        basis,
+        h,
+        walls,
+        contacts,
+    })
 }
 
 /// The mesh, basis and walls of a 1D scene (validated here).
@@ -79,7 +86,12 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
             return Err(conflict("basis", format!("`{}` is a 2D basis", two_d.name())).into())
         }
     };
-    Ok(Domain { basis, h, walls })
+    Ok(Domain {
+        basis,
+        h,
+        walls,
+        contacts: Vec::new(),
+    })
 }
 
 /// The mesh of a 2D scene and its smallest edge length.
@@ -188,6 +200,39 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
             )
         })?;
         walls.push((bc.tag.clone(), [n[0], n[1]]));
+    }
+    Ok(walls)
+}
+
+/// The geometry of every contact wall, in the order of the scene's effects: the
+/// wall items are listed for the elements within the mesh's longest edge of them.
+fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Vec<WallGeometry>, RunError> {
+    let longest = mesh
+        .edges()
+        .iter()
+        .map(|e| (mesh.vertices()[e.vertices[0]] - mesh.vertices()[e.vertices[1]]).norm())
+        .fold(0.0, f64::max);
+    let mut walls = Vec::new();
+    for (i, effect) in scene.effects.iter().enumerate() {
+        let EffectSpec::ContactWall { tag, .. } = effect else {
+            continue;
+        };
+        let field = format!("effect[{i}].tag");
+        let id = mesh.tag_id(tag).map_err(|_| {
+            SceneError::new(
+                field.clone(),
+                ErrorKind::Unknown,
+                format!(
+                    "unknown boundary tag `{}`; the mesh has tags {:?}",
+                    crate::scene::limits::echo(tag),
+                    mesh.tags()
+                ),
+            )
+        })?;
+        walls.push(
+            WallGeometry::new(mesh, id, longest)
+                .ok_or_else(|| conflict(field, format!("`{tag}` has no boundary edge")))?,
+        );
     }
     Ok(walls)
 }

@@ -46,6 +46,8 @@ pub(crate) struct Domain<B> {
     pub h: f64,
     /// Tag and unit normal of every slip wall.
     pub walls: Vec<(String, [f64; 2])>,
+    /// The geometry of each contact wall, in the order of the scene's effects.
+    pub contacts: Vec<crate::contact::WallGeometry>,
 }
 
 /// A run ready to step.
@@ -93,12 +95,14 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
     let mut particles = particles::place::<D>(scene, &lattice);
     particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles);
-    let effects = build_effects(scene, &particles)?;
+    let effects = build_effects(scene, &particles, &domain.contacts)?;
     // The lattice's positions and volumes are in `particles` now: free them before
     // the driver allocates (they would otherwise count in the run's peak memory).
     let body_sizes = std::mem::take(&mut lattice.body_sizes);
     drop(lattice);
-    let Domain { basis, h, walls } = domain;
+    let Domain {
+        basis, h, walls, ..
+    } = domain;
     let functions = basis.num_functions();
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
     // one (a mesh-based guess) only sets the driver up.

@@ -1,0 +1,298 @@
+//! Frictionless contact walls that act on the particles (a penalty), for the
+//! boundaries a body slides, rolls or bounces along.
+//!
+//! A slip wall (`fix = ["normal"]`) holds the normal velocity of the basis
+//! functions on the wall, and their supports reach an element into the body: a
+//! body that spins or rolls against it is braked (`docs/stability.md`, "A slip wall
+//! brakes a body that spins"). A contact wall leaves the functions free and pushes
+//! each particle that comes within its contact distance `d_p` of the wall back,
+//! along the wall's normal, with a linear spring:
+//!
+//! `f_p = k_p g_p n`, `g_p = d_p − dist(x_p, wall)` when positive, potential energy
+//! `Σ_p ½ k_p g_p²` (in the total energy, so the balance still closes),
+//!
+//! with `d_p = ½ √V_p⁰` (half the particle spacing: the body's surface, not its
+//! outermost particles, touches the wall) and `k_p = m_p (κ / Δt)²`: each
+//! particle's spring has frequency `κ / Δt`, so it does not set the time step:
+//! with the elastic modes at `ω Δt = 2C` (Courant number `C`) a particle alone at
+//! the wall is stable while `√(4C² + κ²) < 2`, for the default `κ = 1` up to
+//! `C = 0.85` (a particle among others also moves their grid mass, which gives
+//! more margin); a particle arriving at speed `v` sinks about `v Δt / κ` into
+//! its contact distance.
+//!
+//! The particles are points: a body sampled on a lattice that is not aligned with
+//! the wall touches it with a staircase of particles, and rocks onto the lattice's
+//! facets (a disk on a 30° slope turns by 0.3 rad in 0.4 s, where a slip wall
+//! turns it by 1.4e-2): for a body that slides along a slanted wall without
+//! turning, a slip wall is the better model; for one that rolls or spins, this. The wall is the tagged
+//! boundary's edges, and the boundary's reflex corners (a domain angle above π,
+//! the corners of an obstacle) push radially, so a body can wrap around them.
+
+use crate::effect::Effect;
+use crate::particles::Particles;
+use crate::sparse::Scalar;
+use nalgebra::SVector;
+use psmpm_basis::{TriMesh, Vec2};
+use std::collections::VecDeque;
+
+/// The default `κ`: a particle's spring frequency is `κ / Δt`. With `κ = 1/2`
+/// a disk of soft rubber (E = 5e5, radius 0.3) sank through a slope under its own
+/// weight (the spring of a particle also moves the grid mass around it, so the
+/// face's effective spring is softer than `k_p / m_p`); `κ = 1` holds it
+/// 8e-3 above it (`docs/stability.md`, "Contact walls").
+pub const DEFAULT_STIFFNESS: f64 = 1.0;
+
+/// The wall geometry of one boundary tag, and the wall items near each element.
+#[derive(Debug, Clone)]
+pub struct WallGeometry {
+    /// Edges `(a, b, n)`, `n` the unit normal into the mesh.
+    segments: Vec<(Vec2, Vec2, Vec2)>,
+    /// Reflex corners: the vertex and its two wall edges.
+    corners: Vec<(Vec2, [usize; 2])>,
+    /// Per element, the segments (`i`) and corners (`segments.len() + j`) within
+    /// `reach` of it (CSR).
+    element_start: Vec<usize>,
+    element_items: Vec<u32>,
+    /// Items within this distance of an element are listed for it.
+    reach: f64,
+}
+
+impl WallGeometry {
+    /// The edges tagged `tag` of `mesh` (a tag id), with the items within `reach`
+    /// of each element. `None` when no edge has the tag.
+    pub fn new(mesh: &TriMesh, tag: usize, reach: f64) -> Option<Self> {
+        let v = mesh.vertices();
+        let mut segments = Vec::new();
+        let mut edge_of_segment = Vec::new();
+        for (k, e) in mesh.edges().iter().enumerate() {
+            if e.tag == Some(tag) && e.is_boundary() {
+                let (a, b) = (v[e.vertices[0]], v[e.vertices[1]]);
+                // Counter-clockwise in its triangle: the mesh lies to the left.
+                let d = (b - a).normalize();
+                segments.push((a, b, Vec2::new(-d.y, d.x)));
+                edge_of_segment.push(k);
+            }
+        }
+        if segments.is_empty() {
+            return None;
+        }
+        // Reflex corners: vertices shared by two wall edges where the mesh's angle
+        // exceeds π.
+        let mut corners = Vec::new();
+        for (s, &k) in edge_of_segment.iter().enumerate() {
+            let end = mesh.edges()[k].vertices[1];
+            let Some(next) = edge_of_segment
+                .iter()
+                .position(|&l| mesh.edges()[l].vertices[0] == end)
+            else {
+                continue;
+            };
+            let angle: f64 = mesh
+                .vertex_triangles(end)
+                .iter()
+                .map(|&t| corner_angle(mesh, t, end))
+                .sum();
+            if angle > std::f64::consts::PI + 1e-9 {
+                corners.push((v[end], [s, next]));
+            }
+        }
+        // Items near each element: a walk outwards from the triangles on each item
+        // while their bounding boxes stay within `reach`.
+        let ne = mesh.num_triangles();
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); ne];
+        let mut seen = vec![usize::MAX; ne];
+        let mut queue = VecDeque::new();
+        let items = segments.len() + corners.len();
+        for item in 0..items {
+            let (lo, hi, start) = if item < segments.len() {
+                let (a, b, _) = segments[item];
+                let edge = &mesh.edges()[edge_of_segment[item]];
+                (a.inf(&b), a.sup(&b), edge.triangles.0)
+            } else {
+                let (c, [s, _]) = corners[item - segments.len()];
+                (c, c, mesh.edges()[edge_of_segment[s]].triangles.0)
+            };
+            queue.clear();
+            queue.push_back(start);
+            seen[start] = item;
+            while let Some(t) = queue.pop_front() {
+                lists[t].push(item as u32);
+                for n in mesh.neighbours()[t].iter().flatten() {
+                    if seen[*n] != item && box_distance(mesh, *n, lo, hi) <= reach {
+                        seen[*n] = item;
+                        queue.push_back(*n);
+                    }
+                }
+            }
+        }
+        let mut element_start = vec![0];
+        let mut element_items = Vec::new();
+        for list in lists {
+            element_items.extend(list);
+            element_start.push(element_items.len());
+        }
+        Some(WallGeometry {
+            segments,
+            corners,
+            element_start,
+            element_items,
+            reach,
+        })
+    }
+
+    /// Items are listed for the elements within this distance.
+    pub fn reach(&self) -> f64 {
+        self.reach
+    }
+
+    /// Calls `contact(g, n)` for each wall item within `d` of `x` (in `element`):
+    /// `g` how far inside the distance, `n` the unit direction from the wall to `x`.
+    #[inline]
+    fn contacts(&self, element: usize, x: Vec2, d: f64, mut contact: impl FnMut(f64, Vec2)) {
+        let Some(range) = self
+            .element_start
+            .get(element)
+            .zip(self.element_start.get(element + 1))
+        else {
+            return;
+        };
+        let along = |s: usize| {
+            let (a, b, _) = self.segments[s];
+            let ab = b - a;
+            (x - a).dot(&ab) / ab.norm_squared()
+        };
+        for &item in &self.element_items[*range.0..*range.1] {
+            let item = item as usize;
+            if item < self.segments.len() {
+                let (a, _, n) = self.segments[item];
+                let t = along(item);
+                if (0.0..=1.0).contains(&t) {
+                    let g = d - (x - a).dot(&n);
+                    if g > 0.0 {
+                        contact(g, n);
+                    }
+                }
+            } else {
+                let (c, [s0, s1]) = self.corners[item - self.segments.len()];
+                let outside = |t: f64| !(0.0..=1.0).contains(&t);
+                if outside(along(s0)) && outside(along(s1)) {
+                    let r = x - c;
+                    let dist = r.norm();
+                    if dist < d && dist > 0.0 {
+                        contact(d - dist, r / dist);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The angle of triangle `t` at vertex `v`.
+fn corner_angle(mesh: &TriMesh, t: usize, v: usize) -> f64 {
+    let tri = mesh.triangles()[t];
+    let k = tri.iter().position(|&w| w == v).unwrap_or(0);
+    let p = mesh.vertices();
+    let (a, b, c) = (p[tri[k]], p[tri[(k + 1) % 3]], p[tri[(k + 2) % 3]]);
+    let (u, w) = (b - a, c - a);
+    (u.x * w.y - u.y * w.x).atan2(u.dot(&w)).abs()
+}
+
+/// Distance between the bounding box of triangle `t` and the box `[lo, hi]`.
+fn box_distance(mesh: &TriMesh, t: usize, lo: Vec2, hi: Vec2) -> f64 {
+    let p = mesh.triangle_points(t);
+    let (tlo, thi) = (p[0].inf(&p[1]).inf(&p[2]), p[0].sup(&p[1]).sup(&p[2]));
+    let gap = |a0: f64, a1: f64, b0: f64, b1: f64| (b0 - a1).max(a0 - b1).max(0.0);
+    Vec2::new(gap(tlo.x, thi.x, lo.x, hi.x), gap(tlo.y, thi.y, lo.y, hi.y)).norm()
+}
+
+/// A frictionless contact wall (see the module doc): per particle, the contact
+/// distance `d_p` and mass `m_p`; `κ` and the run's `Δt` give the stiffness.
+#[derive(Debug, Clone)]
+pub struct ContactWall {
+    /// The wall.
+    pub geometry: WallGeometry,
+    /// `d_p = ½ √V_p⁰`.
+    distance: Vec<f64>,
+    mass: Vec<f64>,
+    /// `κ`.
+    stiffness: f64,
+    /// `(κ / Δt)²`, set by [`Effect::set_time_step`].
+    rate: f64,
+}
+
+impl ContactWall {
+    /// The wall `geometry` for `particles`, with spring frequency `stiffness / Δt`.
+    /// `Err` with the largest contact distance when it exceeds the geometry's
+    /// reach (particles much coarser than the elements).
+    pub fn new<T: Scalar, const D: usize>(
+        geometry: WallGeometry,
+        particles: &Particles<T, D>,
+        stiffness: f64,
+    ) -> Result<Self, f64> {
+        let distance: Vec<f64> = particles
+            .volume0
+            .iter()
+            .map(|v| 0.5 * v.to_f64().powf(1.0 / D as f64))
+            .collect();
+        let largest = distance.iter().copied().fold(0.0, f64::max);
+        if largest > geometry.reach {
+            return Err(largest);
+        }
+        Ok(ContactWall {
+            geometry,
+            distance,
+            mass: particles.mass.iter().map(|m| m.to_f64()).collect(),
+            stiffness,
+            rate: 0.0,
+        })
+    }
+
+    fn position<T: Scalar, const D: usize>(x: &SVector<T, D>) -> Vec2 {
+        Vec2::new(x[0].to_f64(), if D > 1 { x[1].to_f64() } else { 0.0 })
+    }
+}
+
+impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
+    fn name(&self) -> &'static str {
+        "contact-wall"
+    }
+    fn set_time_step(&mut self, dt: f64) {
+        self.rate = (self.stiffness / dt).powi(2);
+    }
+    fn particle_force(
+        &self,
+        particles: &Particles<T, D>,
+        p: usize,
+        _time: f64,
+    ) -> Option<SVector<T, D>> {
+        let mut f = Vec2::zeros();
+        let k = self.mass[p] * self.rate;
+        self.geometry.contacts(
+            particles.element[p],
+            Self::position(&particles.x[p]),
+            self.distance[p],
+            |g, n| f += n * (k * g),
+        );
+        Some(SVector::from_fn(|i, _| {
+            T::of(if i < 2 { f[i] } else { 0.0 })
+        }))
+    }
+    fn acts_per_particle(&self) -> bool {
+        true
+    }
+    fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
+        (0..particles.len())
+            .map(|p| {
+                let mut energy = 0.0;
+                let k = self.mass[p] * self.rate;
+                self.geometry.contacts(
+                    particles.element[p],
+                    Self::position(&particles.x[p]),
+                    self.distance[p],
+                    |g, _| energy += 0.5 * k * g * g,
+                );
+                energy
+            })
+            .sum()
+    }
+}
