@@ -514,7 +514,7 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("mesh.kind: unknown variant `grid`, expected one of `blocks`, `polygon`, `gmsh`, `interval`"),
         case("unknown-effect-kind", COLUMN)
             .edit("kind = \"damping\"", "kind = @@\"magnetism\"")
-            .expect("effect[1].kind: unknown variant `magnetism`, expected one of `gravity`, `damping`, `traction`, `body-force`, `manufactured-body-force`, `geostatic-stress`"),
+            .expect("effect[1].kind: unknown variant `magnetism`, expected one of `gravity`, `damping`, `traction`, `body-force`, `manufactured-body-force`, `contact-wall`, `geostatic-stress`"),
         case("unknown-reference-kind", BAR)
             .edit("kind = \"vibrating-bar\"", "kind = @@\"pendulum\"")
             .expect("reference.kind: unknown variant `pendulum`, expected one of `vibrating-bar`, `column-self-weight`, `axis-aligned`, `column-equilibrium`"),
