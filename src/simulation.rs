@@ -269,35 +269,10 @@ fn run_2d_observed(
     on_step: &mut Observer,
     stop: Option<&AtomicBool>,
 ) -> Result<Outcome<2>, RunError> {
-    let Domain {
-        basis,
-        h,
-        walls,
-        contacts,
-    } = setup::domain_2d(scene)?;
+    let (basis, domain) = setup::domain_2d(scene)?.take_basis();
     match basis {
-        Basis2d::Ps(basis) => run_with(
-            scene,
-            Domain {
-                basis,
-                h,
-                walls,
-                contacts: contacts.clone(),
-            },
-            on_step,
-            stop,
-        ),
-        Basis2d::Linear(basis) => run_with(
-            scene,
-            Domain {
-                basis,
-                h,
-                walls,
-                contacts: contacts.clone(),
-            },
-            on_step,
-            stop,
-        ),
+        Basis2d::Ps(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
+        Basis2d::Linear(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
     }
 }
 
@@ -306,35 +281,10 @@ fn run_1d_observed(
     on_step: &mut Observer,
     stop: Option<&AtomicBool>,
 ) -> Result<Outcome<1>, RunError> {
-    let Domain {
-        basis,
-        h,
-        walls,
-        contacts,
-    } = setup::domain_1d(scene)?;
+    let (basis, domain) = setup::domain_1d(scene)?.take_basis();
     match basis {
-        Basis1d::Bspline(basis) => run_with(
-            scene,
-            Domain {
-                basis,
-                h,
-                walls,
-                contacts: contacts.clone(),
-            },
-            on_step,
-            stop,
-        ),
-        Basis1d::Linear(basis) => run_with(
-            scene,
-            Domain {
-                basis,
-                h,
-                walls,
-                contacts: contacts.clone(),
-            },
-            on_step,
-            stop,
-        ),
+        Basis1d::Bspline(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
+        Basis1d::Linear(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
     }
 }
 

@@ -50,6 +50,41 @@ pub(crate) struct Domain<B> {
     pub contacts: Vec<crate::contact::WallGeometry>,
 }
 
+impl<B> Domain<B> {
+    /// The basis, and the rest of the domain to give another basis
+    /// ([`Domain::with_basis`]): a scene's basis is chosen at run time, its type
+    /// per branch.
+    pub fn take_basis(self) -> (B, Domain<()>) {
+        let Domain {
+            basis,
+            h,
+            walls,
+            contacts,
+        } = self;
+        (
+            basis,
+            Domain {
+                basis: (),
+                h,
+                walls,
+                contacts,
+            },
+        )
+    }
+}
+
+impl Domain<()> {
+    /// This domain with `basis`.
+    pub fn with_basis<C>(self, basis: C) -> Domain<C> {
+        Domain {
+            basis,
+            h: self.h,
+            walls: self.walls,
+            contacts: self.contacts,
+        }
+    }
+}
+
 /// A run ready to step.
 pub(crate) struct Prepared<const D: usize, B: Basis<f64, D>> {
     /// The driver, with particles, effects, fixes and walls.
