@@ -594,12 +594,16 @@ impl Recorder {
         // is some: `total = kinetic + strain + potential − work` then reads as the
         // balance it is.
         let works = self.energy.iter().any(|e| e[4] != 0.0);
+        // The potential and the total from their values at the start: their zero is
+        // where gravity's potential is zero, which can put them far above the
+        // motion's energies (and flatten those).
+        let start = self.energy.first().copied().unwrap_or_default();
         for (k, name) in [
             "kinetic",
             "strain",
-            "potential",
+            "potential − P(0)",
             "work of the effects",
-            "total",
+            "total − E(0)",
         ]
         .iter()
         .enumerate()
@@ -607,7 +611,12 @@ impl Recorder {
             if k == 3 && !works {
                 continue;
             }
-            let points = self.energy.iter().map(|e| (e[0], e[k + 1])).collect();
+            let from = if k == 2 || k == 4 { start[k + 1] } else { 0.0 };
+            let points = self
+                .energy
+                .iter()
+                .map(|e| (e[0], e[k + 1] - from))
+                .collect();
             plot = plot.with_series(Series::line(*name, thin(points, MAX_PLOT_POINTS)));
         }
         plot

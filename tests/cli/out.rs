@@ -322,7 +322,7 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
 
     check_plot(
         &json["svg"][key(&files[4])],
-        &["kinetic", "strain", "potential", "total"],
+        &["kinetic", "strain", "potential − P(0)", "total − E(0)"],
         &[1; 4],
         0,
     );
@@ -421,7 +421,7 @@ fn a_1d_run_writes_about_50_frames_and_no_mesh() {
     assert_eq!(entries[50][0], "1.0");
     check_plot(
         &json["svg"][key(&energy)],
-        &["kinetic", "strain", "potential", "total"],
+        &["kinetic", "strain", "potential − P(0)", "total − E(0)"],
         &[1; 4],
         0,
     );
