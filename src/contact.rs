@@ -12,21 +12,26 @@
 //! `Σ_p ½ k_p g_p²` (in the total energy, so the balance still closes),
 //!
 //! with `d_p = ½ √V_p⁰` (half the particle spacing: the body's surface, not its
-//! outermost particles, touches the wall) and `k_p = m_p (κ / Δt)²`: each
-//! particle's spring has frequency `κ / Δt`, so it does not set the time step:
-//! with the elastic modes at `ω Δt = 2C` (Courant number `C`) a particle alone at
-//! the wall is stable while `√(4C² + κ²) < 2`, for the default `κ = 1` up to
-//! `C = 0.85` (a particle among others also moves their grid mass, which gives
-//! more margin); a particle arriving at speed `v` sinks about `v Δt / κ` into
-//! its contact distance.
+//! outermost particles, touches the wall; a particle placed closer keeps its
+//! starting distance, so a body starts at rest where it is placed) and
+//! `k_p = m̃_p (κ / Δt)²`, `m̃_p = 1 / Σ_i φ_i(x_p)² / m_i` the grid mass the
+//! particle's force moves (`m_i` the lumped mass of function `i`). A particle's
+//! force accelerates the functions around it, not the particle alone: a spring
+//! sized on `m_p` softens as the particles get finer at a fixed mesh (a disk of
+//! 1 792 particles sank through a slope that held it with 448), this one keeps the
+//! grid's contact modes near the frequency `κ / Δt` at any particle count, so it
+//! does not set the time step (the default `κ = 1/2`; with 1 the slope runs grew
+//! unstable), and a body arriving at speed `v` sinks about `v Δt / κ`.
 //!
 //! The particles are points: a body sampled on a lattice that is not aligned with
-//! the wall touches it with a staircase of particles, and rocks onto the lattice's
-//! facets (a disk on a 30° slope turns by 0.3 rad in 0.4 s, where a slip wall
-//! turns it by 1.4e-2): for a body that slides along a slanted wall without
-//! turning, a slip wall is the better model; for one that rolls or spins, this. The wall is the tagged
-//! boundary's edges, and the boundary's reflex corners (a domain angle above π,
-//! the corners of an obstacle) push radially, so a body can wrap around them.
+//! the wall touches it with a staircase of particles whose springs' resultant
+//! passes up to half a spacing beside the centre of mass, a torque of about
+//! `W s / 2` for a weight `W`; a disk on a 30° slope turns by 0.21 rad in 0.4 s
+//! (0.08 with half the spacing), where a slip wall turns it by 1.4e-2: for a body
+//! that slides along a slanted wall without turning, a slip wall is the better
+//! model; for one that rolls or spins, this. The wall is the tagged boundary's
+//! edges, and the boundary's reflex corners (a domain angle above π, the corners
+//! of an obstacle) push radially, so a body can wrap around them.
 
 use crate::effect::Effect;
 use crate::particles::Particles;
@@ -34,13 +39,13 @@ use crate::sparse::Scalar;
 use nalgebra::SVector;
 use psmpm_basis::{TriMesh, Vec2};
 use std::collections::VecDeque;
+use std::sync::Mutex;
 
-/// The default `κ`: a particle's spring frequency is `κ / Δt`. With `κ = 1/2`
-/// a disk of soft rubber (E = 5e5, radius 0.3) sank through a slope under its own
-/// weight (the spring of a particle also moves the grid mass around it, so the
-/// face's effective spring is softer than `k_p / m_p`); `κ = 1` holds it
-/// 8e-3 above it (`docs/stability.md`, "Contact walls").
-pub const DEFAULT_STIFFNESS: f64 = 1.0;
+/// The default `κ`: the grid's contact modes have frequency about `κ / Δt`. With
+/// `κ = 1` a rubber disk on a slope (`docs/examples/disk-slope.toml` with a contact
+/// wall) gained 13–64 % of its energy (UNSTABLE); with `κ = 1/2` its drift is
+/// 2e-3 at two particle spacings (`docs/stability.md`, "Contact walls").
+pub const DEFAULT_STIFFNESS: f64 = 0.5;
 
 /// The wall geometry of one boundary tag, and the wall items near each element.
 #[derive(Debug, Clone)]
@@ -206,18 +211,33 @@ fn box_distance(mesh: &TriMesh, t: usize, lo: Vec2, hi: Vec2) -> f64 {
 }
 
 /// A frictionless contact wall (see the module doc): per particle, the contact
-/// distance `d_p` and mass `m_p`; `κ` and the run's `Δt` give the stiffness.
-#[derive(Debug, Clone)]
+/// distance `d_p`, and the spring `k_p` of the last step (for the potential
+/// energy); `κ` and the run's `Δt` give the stiffness.
+#[derive(Debug)]
 pub struct ContactWall {
     /// The wall.
     pub geometry: WallGeometry,
-    /// `d_p = ½ √V_p⁰`.
-    distance: Vec<f64>,
-    mass: Vec<f64>,
+    /// `d_p = ½ √V_p⁰`, or the particle's distance at the start if it was closer
+    /// (the body starts at rest where it was placed, without a spring already
+    /// compressed).
+    distance: Mutex<Vec<f64>>,
     /// `κ`.
     stiffness: f64,
     /// `(κ / Δt)²`, set by [`Effect::set_time_step`].
     rate: f64,
+    /// Scratch and state of [`Effect::add_forces`].
+    state: Mutex<State>,
+}
+
+/// What [`ContactWall`] keeps from step to step.
+#[derive(Debug)]
+struct State {
+    /// The lumped mass `m_i` of each function (scratch).
+    grid_mass: Vec<f64>,
+    /// `k_p` of each particle (`m_p (κ / Δt)²` until the first step).
+    springs: Vec<f64>,
+    /// The contact distances were checked against the particles' first positions.
+    started: bool,
 }
 
 impl ContactWall {
@@ -238,13 +258,38 @@ impl ContactWall {
         if largest > geometry.reach {
             return Err(largest);
         }
+        let mass = particles.mass.iter().map(|m| m.to_f64()).collect();
         Ok(ContactWall {
             geometry,
-            distance,
-            mass: particles.mass.iter().map(|m| m.to_f64()).collect(),
             stiffness,
             rate: 0.0,
+            distance: Mutex::new(distance),
+            state: Mutex::new(State {
+                grid_mass: Vec::new(),
+                springs: mass,
+                started: false,
+            }),
         })
+    }
+
+    /// At the first call (the particles located): a particle closer to the wall
+    /// than its `d_p` takes its distance as its contact distance.
+    fn start<T: Scalar, const D: usize>(&self, state: &mut State, particles: &Particles<T, D>) {
+        if state.started {
+            return;
+        }
+        state.started = true;
+        let mut distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());
+        for (p, d) in distance.iter_mut().enumerate() {
+            let mut deepest = 0.0f64;
+            self.geometry.contacts(
+                particles.element[p],
+                Self::position(&particles.x[p]),
+                *d,
+                |g, _| deepest = deepest.max(g),
+            );
+            *d -= deepest;
+        }
     }
 
     fn position<T: Scalar, const D: usize>(x: &SVector<T, D>) -> Vec2 {
@@ -257,38 +302,84 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
         "contact-wall"
     }
     fn set_time_step(&mut self, dt: f64) {
-        self.rate = (self.stiffness / dt).powi(2);
+        let rate = (self.stiffness / dt).powi(2);
+        // Before the first step the springs are `m_p (κ / Δt)²`.
+        let springs = &mut self
+            .state
+            .get_mut()
+            .unwrap_or_else(|e| e.into_inner())
+            .springs;
+        if self.rate > 0.0 {
+            springs.iter_mut().for_each(|k| *k *= rate / self.rate);
+        } else {
+            springs.iter_mut().for_each(|k| *k *= rate);
+        }
+        self.rate = rate;
     }
-    fn particle_force(
+    /// `f_p = k_p g_p n` with `k_p = m̃_p (κ / Δt)²`, `m̃_p = 1 / Σ_i φ_i(x_p)² / m_i`
+    /// the grid mass the particle's force moves (`m_i = Σ_q φ_i(x_q) m_q`, the
+    /// lumped mass): a particle's force accelerates the functions around it, not the
+    /// particle alone, so a spring sized on `m_p` would soften as the particles get
+    /// finer (a disk of 4 × 448 particles sank through a slope) and this one keeps
+    /// the frequency of the grid's contact modes near `κ / Δt` at any particle
+    /// count. `m̃_p ≥ m_p`. Serial, in particle order.
+    fn add_forces(
         &self,
         particles: &Particles<T, D>,
-        p: usize,
-        _time: f64,
-    ) -> Option<SVector<T, D>> {
-        let mut f = Vec2::zeros();
-        let k = self.mass[p] * self.rate;
-        self.geometry.contacts(
-            particles.element[p],
-            Self::position(&particles.x[p]),
-            self.distance[p],
-            |g, n| f += n * (k * g),
-        );
-        Some(SVector::from_fn(|i, _| {
-            T::of(if i < 2 { f[i] } else { 0.0 })
-        }))
-    }
-    fn acts_per_particle(&self) -> bool {
-        true
+        state: &crate::effect::StepState<T, D>,
+        forces: &mut [Vec<T>],
+    ) {
+        let mut guard = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        self.start(&mut guard, particles);
+        let State {
+            grid_mass, springs, ..
+        } = &mut *guard;
+        let distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());
+        let basis = &state.basis;
+        grid_mass.clear();
+        grid_mass.resize(forces[0].len(), 0.0);
+        for p in 0..particles.len() {
+            let m = particles.mass[p].to_f64();
+            for (i, phi) in basis.functions(p) {
+                grid_mass[i] += phi.to_f64() * m;
+            }
+        }
+        for p in 0..particles.len() {
+            let mut f = Vec2::zeros();
+            let mut touching = false;
+            let x = Self::position(&particles.x[p]);
+            self.geometry
+                .contacts(particles.element[p], x, distance[p], |g, n| {
+                    touching = true;
+                    f += n * g;
+                });
+            if !touching {
+                continue;
+            }
+            let inverse: f64 = basis
+                .functions(p)
+                .filter(|&(i, _)| grid_mass[i] > 0.0)
+                .map(|(i, phi)| phi.to_f64().powi(2) / grid_mass[i])
+                .sum();
+            let k = self.rate / inverse;
+            springs[p] = k;
+            let f = SVector::<T, D>::from_fn(|c, _| T::of(if c < 2 { f[c] * k } else { 0.0 }));
+            basis.scatter(p, &f, forces);
+        }
     }
     fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
+        let mut guard = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        self.start(&mut guard, particles);
+        let springs = &guard.springs;
+        let distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());
         (0..particles.len())
             .map(|p| {
                 let mut energy = 0.0;
-                let k = self.mass[p] * self.rate;
+                let k = springs[p];
                 self.geometry.contacts(
                     particles.element[p],
                     Self::position(&particles.x[p]),
-                    self.distance[p],
+                    distance[p],
                     |g, _| energy += 0.5 * k * g * g,
                 );
                 energy

@@ -463,7 +463,7 @@ where
             let speed = self.particles.v[p].norm().to_f64();
             let moved = speed * self.dt.to_f64();
             let contact = if self.effects.iter().any(|e| e.name() == "contact-wall") {
-                "; if it went through a contact wall, the wall's springs were too soft for the load or the speed: raise its `stiffness` (up to 1) or lower the time step (the springs stiffen as 1/Δt²)"
+                "; if it went through a contact wall, the wall's springs were too soft for the load or the speed: lower the time step (they stiffen as 1/Δt²) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable)"
             } else {
                 ""
             };
