@@ -46,6 +46,10 @@ pub struct StepReport {
     pub max_speed: f64,
     /// What the mass strategy did.
     pub mass_report: MassReport,
+    /// The position of the worst-covered function of
+    /// [`MassReport::worst_coverage`] (its point of linear precision,
+    /// [`psmpm_basis::Basis::function_point`]; `dim` components), when reported.
+    pub worst_coverage_at: Option<[f64; 2]>,
     /// Condition-number estimate of the solved mass system, when requested.
     pub condition: Option<f64>,
     /// Wall time of the phases of the step.

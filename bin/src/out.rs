@@ -8,9 +8,11 @@
 //!
 //! - `diagnostics.csv`: one row per step (not the initial state): `step, time,
 //!   kinetic, strain, potential, work, total, mass, momentum_x, momentum_y,
-//!   max_speed, active, lumped_rows, deactivated, condition` (the values of
-//!   `--format json`; floats in Rust's shortest round-trip `{:e}` form, integers as
-//!   integers, `condition` empty unless `--condition`). All CSV files are written
+//!   max_speed, active, lumped_rows, deactivated, extended, worst_coverage,
+//!   worst_function, worst_x, worst_y, condition` (the values of `--format json`;
+//!   floats in Rust's shortest round-trip `{:e}` form, integers as integers, the
+//!   `worst_*` columns empty when the mass strategy does not measure coverage,
+//!   `worst_y` in 1D, `condition` unless `--condition`). All CSV files are written
 //!   with the `csv` crate (RFC 4180 quoting where needed).
 //! - `summary.json`: the summary of `--format json`, pretty-printed (with
 //!   `"interrupted": true` when SIGINT/SIGTERM or a closed stdout stopped the run;
@@ -52,8 +54,14 @@ use std::path::{Path, PathBuf};
 
 /// A row of `diagnostics.csv` (and of `run --format csv`): floats in Rust's
 /// shortest round-trip `{:e}` form.
-pub fn diagnostics_record(r: &StepReport) -> [String; 15] {
+pub fn diagnostics_record(r: &StepReport) -> [String; 20] {
     let float = |x: f64| format!("{x:e}");
+    let worst = r.mass_report.worst_coverage;
+    let at = |k: usize| {
+        r.worst_coverage_at
+            .filter(|_| k < r.dim)
+            .map_or_else(String::new, |x| float(x[k]))
+    };
     [
         r.step.to_string(),
         float(r.time),
@@ -70,12 +78,17 @@ pub fn diagnostics_record(r: &StepReport) -> [String; 15] {
         r.mass_report.active.to_string(),
         r.mass_report.lumped_rows.to_string(),
         r.mass_report.deactivated.to_string(),
+        r.mass_report.extended.to_string(),
+        worst.map_or_else(String::new, |(_, c)| float(c)),
+        worst.map_or_else(String::new, |(i, _)| i.to_string()),
+        at(0),
+        at(1),
         r.condition.map_or_else(String::new, float),
     ]
 }
 
 /// Columns of `diagnostics.csv`.
-pub const DIAGNOSTICS_COLUMNS: [&str; 15] = [
+pub const DIAGNOSTICS_COLUMNS: [&str; 20] = [
     "step",
     "time",
     "kinetic",
@@ -90,6 +103,11 @@ pub const DIAGNOSTICS_COLUMNS: [&str; 15] = [
     "active",
     "lumped_rows",
     "deactivated",
+    "extended",
+    "worst_coverage",
+    "worst_function",
+    "worst_x",
+    "worst_y",
     "condition",
 ];
 

@@ -331,12 +331,16 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         "deactivated": r.mass_report.deactivated,
         "extended": r.mass_report.extended,
         "treated": r.mass_report.treated(),
-        "worst_coverage": r.mass_report.worst_coverage.map(|(f, c)| json!({"function": f, "coverage": c})),
+        "worst_coverage": r.mass_report.worst_coverage.map(|(f, c)| json!({
+            "function": f,
+            "coverage": c,
+            "position": r.worst_coverage_at.map(|x| x[..r.dim].to_vec()),
+        })),
         "condition": r.condition,
     })
 }
 
-const COLUMNS: [&str; 10] = [
+const COLUMNS: [&str; 12] = [
     "step",
     "time",
     "kinetic",
@@ -346,6 +350,8 @@ const COLUMNS: [&str; 10] = [
     "max_speed",
     "active",
     "lumped",
+    "extended",
+    "min_cover",
     "condition",
 ];
 
@@ -360,6 +366,10 @@ fn row_cells(r: &StepReport) -> Vec<String> {
         sci(r.max_speed),
         r.mass_report.active.to_string(),
         r.mass_report.lumped_rows.to_string(),
+        r.mass_report.extended.to_string(),
+        r.mass_report
+            .worst_coverage
+            .map_or_else(|| "-".into(), |(_, c)| sci(c)),
         r.condition.map_or_else(|| "-".into(), sci),
     ]
 }

@@ -91,6 +91,12 @@ where
             dim: D,
             max_speed: e.max_speed,
             mass_report: self.last_report,
+            worst_coverage_at: self.last_report.worst_coverage.map(|(i, _)| {
+                let x = self.basis.function_point(i);
+                let mut at = [0.0; 2];
+                at[..D].copy_from_slice(&x.as_slice()[..D]);
+                at
+            }),
             condition: self.last_condition,
             phases: self.phases,
         }

@@ -316,8 +316,10 @@ pub struct MassReport {
     pub deactivated: usize,
     /// Functions expressed through their neighbours (extension).
     pub extended: usize,
-    /// The worst-covered active function and its coverage (fraction of its
-    /// support's integral covered by particle volume), when the strategy measures it.
+    /// The worst-covered function the strategy solves for and its coverage
+    /// (fraction of its support's integral covered by particle volume), when the
+    /// strategy measures it; the functions an extension expresses through their
+    /// neighbours are not solved for and are left out.
     pub worst_coverage: Option<(usize, f64)>,
 }
 

@@ -145,8 +145,10 @@ fn extension_keeps_row_sums_where_consistent_fails() {
     );
     let report = m.factorize(&c.pattern, &c.values, context(&c)).unwrap();
     assert!(report.extended > 0, "nothing extended: {report:?}");
+    // The worst-covered function reported is the worst one solved for: every
+    // function below the threshold is extended, out of the system.
     let (_, worst) = report.worst_coverage.unwrap();
-    assert!(worst < DEFAULT_COVERAGE);
+    assert!(worst >= DEFAULT_COVERAGE, "worst solved coverage {worst}");
     assert_keeps_row_sums(&c, &mut m, "extended");
     let condition = m.condition_estimate(&c.pattern);
     assert!((1.0..1e4).contains(&condition), "condition {condition}");

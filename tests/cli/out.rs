@@ -156,6 +156,11 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             "active",
             "lumped_rows",
             "deactivated",
+            "extended",
+            "worst_coverage",
+            "worst_function",
+            "worst_x",
+            "worst_y",
             "condition"
         ]
     );
@@ -186,21 +191,29 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             match name {
                 "momentum_x" => json["momentum"][0].clone(),
                 "momentum_y" => json["momentum"][1].clone(),
+                "worst_coverage" => json["worst_coverage"]["coverage"].clone(),
+                "worst_function" => json["worst_coverage"]["function"].clone(),
+                "worst_x" => json["worst_coverage"]["position"][0].clone(),
+                "worst_y" => json["worst_coverage"]["position"][1].clone(),
                 other => json[other].clone(),
             }
         };
         for (name, field) in header.iter().zip(row) {
             let want = expected(name);
+            if want.is_null() {
+                // Not measured (the condition without --condition, coverage with a
+                // strategy that does not measure it): an empty field.
+                assert!(field.is_empty(), "{name}: {field}");
+                continue;
+            }
             match name.as_str() {
-                "step" | "active" | "lumped_rows" | "deactivated" => {
+                "step" | "active" | "lumped_rows" | "deactivated" | "extended"
+                | "worst_function" => {
                     assert_eq!(
                         field.parse::<u64>().unwrap(),
                         want.as_u64().unwrap(),
                         "{name}"
                     )
-                }
-                "condition" => {
-                    assert!(want.is_null() && field.is_empty(), "{name}: {field}")
                 }
                 _ => assert_eq!(
                     field.parse::<f64>().unwrap().to_bits(),
@@ -657,6 +670,52 @@ fn csv_format_keeps_the_summary_on_stderr() {
         .find_map(|l| l.strip_prefix("# error="))
         .unwrap();
     assert!(error.parse::<f64>().unwrap() > 0.0, "{error}");
+}
+
+/// The default mass strategy reports, every step, how many functions it extended
+/// and the worst-covered function it solves for, with its position: a body in a
+/// mostly empty box, read back from `--format csv`.
+#[test]
+fn the_default_reports_its_worst_covered_solved_function_every_step() {
+    let root = format!("{}/..", env!("CARGO_MANIFEST_DIR"));
+    let out = cli()
+        .args([
+            "run",
+            &format!("{root}/docs/examples/drop-plate.toml"),
+            "--t-end",
+            "0.01",
+            "--diag-every",
+            "1",
+            "--format",
+            "csv",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert!(rows.len() > 10);
+    for row in &rows {
+        let number = |name: &str| row[column(name)].parse::<f64>().unwrap();
+        // Extended below coverage 0.02: what is solved for is covered at least that.
+        assert!(number("extended") > 0.0);
+        let coverage = number("worst_coverage");
+        assert!((0.02..0.75).contains(&coverage), "{coverage}");
+        let function = number("worst_function");
+        assert!(function >= 0.0 && function.fract() == 0.0);
+        // The box is [0, 4] x [0, 3]; the plate starts in [1, 2.6] x [1, 2.4].
+        let (x, y) = (number("worst_x"), number("worst_y"));
+        assert!(
+            (0.5..3.1).contains(&x) && (0.5..2.9).contains(&y),
+            "({x}, {y})"
+        );
+    }
 }
 
 /// `particles.svg`: the particles at the first, middle and last frame, coloured by

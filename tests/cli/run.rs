@@ -117,6 +117,8 @@ fn table_and_summary_for_a_1d_scene() {
         "max_speed",
         "active",
         "lumped",
+        "extended",
+        "min_cover",
         "condition"
     ]));
     assert!(text.contains("column-small-1d · pl1d · consistent mass · 17 functions"));

@@ -271,9 +271,6 @@ impl<T: Scalar> Extended<T> {
             report.active += 1;
             let coverage =
                 SupportFacts::coverage_of(context.particle_volume[i], self.support.volume[i]);
-            if report.worst_coverage.is_none_or(|(_, w)| coverage < w) {
-                report.worst_coverage = Some((i, coverage));
-            }
             // A wall's function extended rather than lumped (`with_walls`).
             let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
             let threshold = if on_wall && self.lump > self.coverage {
@@ -286,6 +283,13 @@ impl<T: Scalar> Extended<T> {
             } else {
                 Role::Solved
             };
+            // The worst-covered function the system solves for (the extended ones
+            // are out of it): what the system's conditioning depends on.
+            if self.role[i] == Role::Solved
+                && report.worst_coverage.is_none_or(|(_, w)| coverage < w)
+            {
+                report.worst_coverage = Some((i, coverage));
+            }
             let sparse = context.particle_count[i] < MIN_PARTICLE_COUNT;
             self.lumped[i] = self.role[i] == Role::Solved
                 && self.lump > self.coverage
