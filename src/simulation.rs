@@ -622,7 +622,7 @@ pub fn energy_growth_hint(
         .map(|c| dt / c);
     let step = match courant {
         Some(c) => format!(
-            "the time step is {c:.2} of the critical step estimated at the start: lower `time.courant` (to {:.2}, say) or `time.dt`",
+            "the time step is {c:.2} of the critical step estimated at the start: lower `time.courant` (to {:.2}, say; `--courant` on the command line) or `time.dt`",
             c / 2.0
         ),
         None => "lower `time.dt`".to_string(),

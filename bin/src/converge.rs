@@ -545,9 +545,9 @@ fn with_double_particles(scene: &Scene) -> Option<Scene> {
 fn verdict(scene: &Scene, half_dt: Option<f64>, double_particles: Option<f64>) -> String {
     let lowers = |r: Option<f64>| r.is_some_and(|r| r < 1.0 - LIMITING_GAIN);
     let time = if scene.time.courant.is_some() {
-        "a smaller `courant` (or --dt)"
+        "a smaller `courant` (--courant, or --dt)"
     } else {
-        "a smaller `dt` (--dt), or `courant` so that the step shrinks with h"
+        "a smaller `dt` (--dt), or `courant` (--courant) so that the step shrinks with h"
     };
     let particles = "more particles per element as h shrinks (`per_block` or `count`, \
                      --particles)";

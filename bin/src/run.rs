@@ -38,8 +38,12 @@ pub struct Overrides {
     #[arg(long)]
     pub layout: Option<String>,
     /// Time step (replaces the scene's dt or Courant number).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "courant")]
     pub dt: Option<f64>,
+    /// Time step as a fraction C of the critical step estimated at the start,
+    /// Δt = C Δt_crit (replaces the scene's dt or Courant number; below 1).
+    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    pub courant: Option<f64>,
     /// End time.
     #[arg(long, allow_negative_numbers = true)]
     pub t_end: Option<f64>,
@@ -106,6 +110,9 @@ impl Overrides {
         if let Some(dt) = self.dt {
             s.set_dt(dt);
         }
+        if let Some(c) = self.courant {
+            s.set_courant(c);
+        }
         if self.allow_above_critical {
             s.time.allow_above_critical = true;
         }
@@ -138,6 +145,9 @@ impl Overrides {
         if field.starts_with("time.") {
             if let Some(dt) = self.dt {
                 flags.push(format!("--dt {dt:?}"));
+            }
+            if let Some(c) = self.courant {
+                flags.push(format!("--courant {c:?}"));
             }
             if let Some(t) = self.t_end {
                 flags.push(format!("--t-end {t:?}"));

@@ -62,6 +62,13 @@ impl Scene {
         self.time.courant = None;
     }
 
+    /// Sets the time step to the fraction `courant` of the critical step estimated
+    /// at the start ([`TimeSpec::courant`](super::TimeSpec::courant)).
+    pub fn set_courant(&mut self, courant: f64) {
+        self.time.courant = Some(courant);
+        self.time.dt = None;
+    }
+
     /// The scene for `basis`, with the resolution the scene gives that basis (see
     /// [`Scene::resolutions`]), validated.
     pub fn with_basis(&self, basis: BasisKind) -> Result<Scene, SceneError> {

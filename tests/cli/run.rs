@@ -385,7 +385,7 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
         "the run is UNSTABLE: energy growth",
         "it reached the bound at t = 0.78",
         "the time step is 0.50 of the critical step",
-        "lower `time.courant` (to 0.25, say)",
+        "lower `time.courant` (to 0.25, say; `--courant` on the command line)",
         "per occupied element for the 9 functions of each",
     ] {
         assert!(stderr.contains(part), "`{part}` not in: {stderr}");
@@ -395,7 +395,8 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
     assert!(
         stdout.contains("ps extended-hybrid: UNSTABLE: energy growth")
-            && stdout.contains("lower `time.courant` (to 0.25, say)"),
+            && stdout
+                .contains("lower `time.courant` (to 0.25, say; `--courant` on the command line)"),
         "{stdout}"
     );
     std::fs::remove_dir_all(&dir).ok();
@@ -494,4 +495,52 @@ fn a_directory_or_a_file_without_toml_is_named_as_such() {
         assert!(stderr.contains(message), "{stderr}");
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `--courant C` replaces the scene's step by `C Δt_crit` (the scene here has a
+/// fixed `dt`), and conflicts with `--dt`.
+#[test]
+fn courant_on_the_command_line_sets_the_step_from_the_critical_one() {
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--courant",
+            "0.3",
+            "--t-end",
+            "0.5",
+            "--diag-every",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(out.status.success(), "{stdout}");
+    let first = stdout.lines().next().unwrap();
+    // Shortened so that a whole number of steps ends at t_end: at most 0.3.
+    let courant: f64 = first
+        .rsplit("Courant number ")
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    assert!((0.28..=0.3).contains(&courant), "{first}");
+    let out = cli()
+        .args(["run", "vibrating-bar", "--courant", "0.3", "--dt", "1e-5"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--courant") && stderr.contains("--dt"),
+        "{stderr}"
+    );
+    let out = cli()
+        .args(["run", "vibrating-bar", "--courant", "1.5"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("below 1"), "{stderr}");
 }
