@@ -14,14 +14,19 @@
 //! with `d_p = ½ √V_p⁰` (half the particle spacing: the body's surface, not its
 //! outermost particles, touches the wall; a particle placed closer keeps its
 //! starting distance, so a body starts at rest where it is placed) and
-//! `k_p = m̃_p (κ / Δt)²`, `m̃_p = 1 / Σ_i φ_i(x_p)² / m_i` the grid mass the
-//! particle's force moves (`m_i` the lumped mass of function `i`). A particle's
-//! force accelerates the functions around it, not the particle alone: a spring
-//! sized on `m_p` softens as the particles get finer at a fixed mesh (a disk of
-//! 1 792 particles sank through a slope that held it with 448), this one keeps the
-//! grid's contact modes near the frequency `κ / Δt` at any particle count, so it
-//! does not set the time step (the default `κ = 1/2`; with 1 the slope runs grew
-//! unstable), and a body arriving at speed `v` sinks about `v Δt / κ`.
+//! `k_p = m_p (κ / Δt)² / c_p`, `c_p` the largest share of a function's lumped mass
+//! carried by particles in contact, over the functions around `p`. A particle's
+//! force accelerates the functions around it, not the particle alone, and every
+//! particle in contact pushes the same functions: this choice bounds the rows of the
+//! contact stiffness by `(κ / Δt)²` times the functions' masses, so the grid's
+//! contact modes stay at or below the frequency `κ / Δt` at any particle count
+//! (Gershgorin), and reach it when a layer of particles touches. It does not set the
+//! time step (the default `κ = 1/2`; with 1 the slope runs grew unstable), and a
+//! body arriving at speed `v` sinks about `v Δt / κ`. A spring sized on `m_p`
+//! alone is too soft (a disk of 1 792 particles sank through a slope), one sized on
+//! the grid mass around each particle too stiff once several particles share a
+//! function (a block striking a wall gained 16 % energy at 9 particles per triangle,
+//! 1.9 % with this one; `docs/stability.md`, "Contact walls").
 //!
 //! The particles are points: a body sampled on a lattice that is not aligned with
 //! the wall touches it with a staircase of particles whose springs' resultant
@@ -41,10 +46,11 @@ use psmpm_basis::{TriMesh, Vec2};
 use std::collections::VecDeque;
 use std::sync::Mutex;
 
-/// The default `κ`: the grid's contact modes have frequency about `κ / Δt`. With
-/// `κ = 1` a rubber disk on a slope (`docs/examples/disk-slope.toml` with a contact
-/// wall) gained 13–64 % of its energy (UNSTABLE); with `κ = 1/2` its drift is
-/// 2e-3 at two particle spacings (`docs/stability.md`, "Contact walls").
+/// The default `κ`: the grid's contact modes have frequency at most `κ / Δt`. With
+/// `κ = 1` a block striking a wall at 9 particles per triangle gained 11 % of its
+/// energy (UNSTABLE); with `κ = 1/2` 1.9 %, and a rubber disk on a slope
+/// (`docs/examples/disk-slope.toml` with a contact wall) drifts by 2.5e-3 to 7.8e-3
+/// at two particle spacings (`docs/stability.md`, "Contact walls").
 pub const DEFAULT_STIFFNESS: f64 = 0.5;
 
 /// The wall geometry of one boundary tag, and the wall items near each element.
@@ -223,7 +229,7 @@ pub struct ContactWall {
     distance: Mutex<Vec<f64>>,
     /// `κ`.
     stiffness: f64,
-    /// `(κ / Δt)²`, set by [`Effect::set_time_step`].
+    /// `ω_c² = (κ / Δt)²`, set by [`Effect::set_time_step`].
     rate: f64,
     /// Scratch and state of [`Effect::add_forces`].
     state: Mutex<State>,
@@ -234,6 +240,10 @@ pub struct ContactWall {
 struct State {
     /// The lumped mass `m_i` of each function (scratch).
     grid_mass: Vec<f64>,
+    /// The part of `m_i` carried by particles in contact (scratch).
+    contact_mass: Vec<f64>,
+    /// The particles in contact and their summed `g n` (scratch).
+    touching: Vec<(usize, Vec2)>,
     /// `k_p` of each particle (`m_p (κ / Δt)²` until the first step).
     springs: Vec<f64>,
     /// The contact distances were checked against the particles' first positions.
@@ -266,6 +276,8 @@ impl ContactWall {
             distance: Mutex::new(distance),
             state: Mutex::new(State {
                 grid_mass: Vec::new(),
+                contact_mass: Vec::new(),
+                touching: Vec::new(),
                 springs: mass,
                 started: false,
             }),
@@ -303,26 +315,29 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
     }
     fn set_time_step(&mut self, dt: f64) {
         let rate = (self.stiffness / dt).powi(2);
-        // Before the first step the springs are `m_p (κ / Δt)²`.
+        // Before the first step the springs are `m_p (κ / Δt)²`; after, those of
+        // the last step follow the new rate.
+        let scale = if self.rate > 0.0 {
+            rate / self.rate
+        } else {
+            rate
+        };
         let springs = &mut self
             .state
             .get_mut()
             .unwrap_or_else(|e| e.into_inner())
             .springs;
-        if self.rate > 0.0 {
-            springs.iter_mut().for_each(|k| *k *= rate / self.rate);
-        } else {
-            springs.iter_mut().for_each(|k| *k *= rate);
-        }
+        springs.iter_mut().for_each(|k| *k *= scale);
         self.rate = rate;
     }
-    /// `f_p = k_p g_p n` with `k_p = m̃_p (κ / Δt)²`, `m̃_p = 1 / Σ_i φ_i(x_p)² / m_i`
-    /// the grid mass the particle's force moves (`m_i = Σ_q φ_i(x_q) m_q`, the
-    /// lumped mass): a particle's force accelerates the functions around it, not the
-    /// particle alone, so a spring sized on `m_p` would soften as the particles get
-    /// finer (a disk of 4 × 448 particles sank through a slope) and this one keeps
-    /// the frequency of the grid's contact modes near `κ / Δt` at any particle
-    /// count. `m̃_p ≥ m_p`. Serial, in particle order.
+    /// `f_p = k_p g_p n` with `k_p = m_p (κ / Δt)² / c_p`, `c_p = max_i c_i` over
+    /// the functions around the particle, `c_i = Σ_{q in contact} φ_i(x_q) m_q / m_i`
+    /// the share of function `i`'s lumped mass `m_i` that is in contact. Row `i` of
+    /// the contact stiffness `K_c = Σ_p k_p (φ(x_p) n)(φ(x_p) n)ᵀ` then sums to at
+    /// most `(κ / Δt)² m_i` (the functions are a non-negative partition of unity),
+    /// so by Gershgorin the contact modes' frequency is at most `κ / Δt` whatever the
+    /// particle count, and at about that bound when a layer of particles touches.
+    /// Serial, in particle order.
     fn add_forces(
         &self,
         particles: &Particles<T, D>,
@@ -332,36 +347,54 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
         let mut guard = self.state.lock().unwrap_or_else(|e| e.into_inner());
         self.start(&mut guard, particles);
         let State {
-            grid_mass, springs, ..
+            grid_mass,
+            contact_mass,
+            touching,
+            springs,
+            ..
         } = &mut *guard;
         let distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());
         let basis = &state.basis;
+        touching.clear();
+        for p in 0..particles.len() {
+            let mut f = Vec2::zeros();
+            let mut touches = false;
+            let x = Self::position(&particles.x[p]);
+            self.geometry
+                .contacts(particles.element[p], x, distance[p], |g, n| {
+                    touches = true;
+                    f += n * g;
+                });
+            if touches {
+                touching.push((p, f));
+            }
+        }
+        if touching.is_empty() {
+            return;
+        }
         grid_mass.clear();
         grid_mass.resize(forces[0].len(), 0.0);
+        contact_mass.clear();
+        contact_mass.resize(forces[0].len(), 0.0);
         for p in 0..particles.len() {
             let m = particles.mass[p].to_f64();
             for (i, phi) in basis.functions(p) {
                 grid_mass[i] += phi.to_f64() * m;
             }
         }
-        for p in 0..particles.len() {
-            let mut f = Vec2::zeros();
-            let mut touching = false;
-            let x = Self::position(&particles.x[p]);
-            self.geometry
-                .contacts(particles.element[p], x, distance[p], |g, n| {
-                    touching = true;
-                    f += n * g;
-                });
-            if !touching {
-                continue;
+        for &(p, _) in touching.iter() {
+            let m = particles.mass[p].to_f64();
+            for (i, phi) in basis.functions(p) {
+                contact_mass[i] += phi.to_f64() * m;
             }
-            let inverse: f64 = basis
+        }
+        for &(p, f) in touching.iter() {
+            let share = basis
                 .functions(p)
-                .filter(|&(i, _)| grid_mass[i] > 0.0)
-                .map(|(i, phi)| phi.to_f64().powi(2) / grid_mass[i])
-                .sum();
-            let k = self.rate / inverse;
+                .filter(|&(i, phi)| grid_mass[i] > 0.0 && phi.to_f64() > 0.0)
+                .map(|(i, _)| contact_mass[i] / grid_mass[i])
+                .fold(0.0, f64::max);
+            let k = self.rate * particles.mass[p].to_f64() / share;
             springs[p] = k;
             let f = SVector::<T, D>::from_fn(|c, _| T::of(if c < 2 { f[c] * k } else { 0.0 }));
             basis.scatter(p, &f, forces);

@@ -212,6 +212,17 @@ impl Scene {
                             format!("must be in (0, 1], got {stiffness}"),
                         ));
                     }
+                    if let Some(j) = self.effects[..i].iter().position(
+                        |e| matches!(e, EffectSpec::ContactWall { tag: t, .. } if t == tag),
+                    ) {
+                        return Err(conflict(
+                            field("tag"),
+                            format!(
+                                "`{}` already has a contact wall (effect[{j}]): a second one would double its springs; keep one",
+                                crate::scene::limits::echo(tag)
+                            ),
+                        ));
+                    }
                     if let Some(b) = self.boundaries.iter().position(|bc| &bc.tag == tag) {
                         if !self.boundaries[b].fix.is_empty() {
                             return Err(conflict(
