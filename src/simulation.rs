@@ -379,6 +379,24 @@ pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
     })
 }
 
+/// Particles per occupied triangle at the start below which a PS run warns that its
+/// error can grow with refinement.
+pub const PS_SAMPLING: f64 = 3.0;
+
+/// The warning for a PS body sampled by `sampling` particles per occupied triangle,
+/// if that is below [`PS_SAMPLING`] (and not already below [`SPARSE_SAMPLING`]).
+/// Measured on `scenes/column-large.toml` (default mass, `--courant 0.5`), 3 × 3
+/// particles per block (2.25 per triangle) on 1 × 10, 2 × 20, 4 × 40 blocks:
+/// UNSTABLE, then det F failures at steps 2441 and 3057; 6 × 6 per block: stable,
+/// E_u 2.7e-4, 1.2e-4, 1.1e-4.
+pub fn ps_sampling_warning(sampling: f64) -> Option<String> {
+    (SPARSE_SAMPLING..PS_SAMPLING).contains(&sampling).then(|| {
+        format!(
+            "the bodies are sampled by {sampling:.2} particles per occupied triangle at the start, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle (`per_block` 4 × 4 on block meshes, `count` or `spacing`; `--particles`)"
+        )
+    })
+}
+
 /// The tracked particles: the particle nearest each of the scene's tracked points.
 fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>) -> Vec<Tracked> {
     // The initial positions: the particles' reference positions.
@@ -649,6 +667,25 @@ pub fn energy_growth_hint(
     )
 }
 
+/// What a condition estimate above [`STABLE_CONDITION`] says about the system the
+/// mass strategy `mass` (a [`Summary::mass`] name) solves, and what to do about it.
+/// On `docs/examples/drop-plate.toml` to t = 0.3: `lumped` 3.7e19, `partial`
+/// 2.7e21, the default 1.9e2.
+pub fn condition_hint(mass: &str) -> String {
+    let fix = "the default mass strategy (remove `mass`, or `--mass default`) expresses such functions through their neighbours and keeps them out of the system";
+    if mass == "lumped" {
+        format!(
+            "the lumped mass solves exactly, but its condition (the largest function mass over the smallest) says that some function's support holds almost no particle: that function's velocity is the ratio of two tiny numbers, which a particle's round-off or noise can blow up; {fix}"
+        )
+    } else if mass.starts_with("extended") {
+        "the system is nearly singular even after the extension: some solved function's coverage lies just above the threshold below which it is extended (the table's `min_cover`, `worst_coverage` in `--out`'s diagnostics.csv, name it and where it is); raise that threshold (`--mass extended-hybrid:0.05:0.75`, say)".to_string()
+    } else {
+        format!(
+            "the mass system `{mass}` solves is nearly singular: some function's support holds almost no particle (or too few for the functions the elements hold); {fix}"
+        )
+    }
+}
+
 /// The summary and outcome of a run: error, energy drift and growth, the verdict.
 fn summarise<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
@@ -727,6 +764,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .into_iter()
                 .chain(self_weight.clone())
                 .chain(sparse_sampling_warning(tally.sampling))
+                .chain(
+                    (scene.basis == crate::bases::BasisKind::Ps)
+                        .then(|| ps_sampling_warning(tally.sampling))
+                        .flatten(),
+                )
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .collect(),
             interrupted: tally.interrupted,

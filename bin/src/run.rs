@@ -665,9 +665,10 @@ pub fn time_step_line(r: &StepReport) -> String {
 pub fn unstable_reason(summary: &Summary) -> String {
     match summary.max_condition {
         Some(c) if c >= simulation::STABLE_CONDITION => format!(
-            "condition estimate {} ≥ {}",
+            "condition estimate {} ≥ {}: {}",
             sci(c),
-            sci(simulation::STABLE_CONDITION)
+            sci(simulation::STABLE_CONDITION),
+            simulation::condition_hint(&summary.mass)
         ),
         _ => {
             let mut reason = format!(

@@ -213,7 +213,7 @@ fn law<const D: usize>(m: &MaterialSpec) -> Result<AnyMaterial, MaterialError> {
 }
 
 /// The bounding box of the mesh of `basis`, for messages: `[x0, x1] × [y0, y1]`.
-fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> String {
+fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> ([f64; D], [f64; D]) {
     let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
     let mut pieces = Vec::new();
     for e in 0..basis.num_elements() {
@@ -226,10 +226,22 @@ fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> String {
             }
         }
     }
-    (0..D)
+    (lo, hi)
+}
+
+/// Why a particle at `position` is in no element of a mesh whose bounding box is
+/// `(lo, hi)`: in a hole or notch when it lies inside the box, outside otherwise.
+fn outside_the_mesh<const D: usize>(position: &[f64], (lo, hi): ([f64; D], [f64; D])) -> String {
+    let span = (0..D)
         .map(|k| format!("[{}, {}]", lo[k], hi[k]))
         .collect::<Vec<_>>()
-        .join(" × ")
+        .join(" × ");
+    let inside_box = (0..D).all(|k| position.get(k).is_some_and(|&x| lo[k] <= x && x <= hi[k]));
+    if inside_box {
+        format!("the particle at {position:?} lies in a hole or notch of the mesh (inside its bounding box {span}, but in no element); the body must not overlap the mesh's holes (`[[mesh.holes]]`) or the parts of its outline cut away")
+    } else {
+        format!("the particle at {position:?} lies outside the mesh, which spans {span}; the body must lie inside the meshed domain")
+    }
 }
 
 /// The one place a scene's driver is built: fixes from the boundary conditions,
@@ -286,7 +298,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
             SceneError::new(
                 field,
                 ErrorKind::Conflict,
-                format!("the particle at {position:?} lies outside the mesh, which spans {extent}; the body must lie inside the meshed domain (not in a hole)"),
+                outside_the_mesh(&position, extent),
             )
         }
         SetupError::Boundary { tag, message } => SceneError::new(

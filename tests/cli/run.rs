@@ -419,8 +419,10 @@ fn scenes_md_example(name: &str, edit: impl Fn(&str) -> String) -> std::path::Pa
 /// A body sampled by about one particle per element or fewer can come apart while
 /// its energy stays bounded, so the run warns at the start's sampling (the
 /// `docs/scenes.md` example with one particle per block of four triangles: 1.00
-/// particles per occupied element), and says nothing with the example's own 3 × 3
-/// per block.
+/// particles per occupied element). A PS body with fewer than 3 particles per
+/// triangle (3 × 3 per block: 2.25) is warned about too, since its error can grow
+/// with refinement; the example's own 4 × 4 per block gets neither warning, nor
+/// does PL at 3 × 3.
 #[test]
 fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
     let path = scenes_md_example("sparse", str::to_string);
@@ -442,8 +444,17 @@ fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
         ) && sparse.contains("use 3 or more particles per element"),
         "{sparse}"
     );
+    let thin = run(&["--particles", "3x3"]);
+    assert!(
+        thin.contains(
+            "warning: the bodies are sampled by 2.25 particles per occupied triangle at the start, fewer than the 3 a PS triangle needs"
+        ) && !thin.contains("per occupied element"),
+        "{thin}"
+    );
+    let pl = run(&["--particles", "3x3", "--basis", "pl"]);
+    assert!(!pl.contains("particles per occupied"), "{pl}");
     let fine = run(&[]);
-    assert!(!fine.contains("particles per occupied element"), "{fine}");
+    assert!(!fine.contains("particles per occupied"), "{fine}");
     std::fs::remove_dir_all(path.parent().unwrap()).ok();
 }
 
@@ -543,4 +554,47 @@ fn courant_on_the_command_line_sets_the_step_from_the_critical_one() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("below 1"), "{stderr}");
+}
+
+/// A condition estimate above 1e8 makes the verdict UNSTABLE; the message says what
+/// it means for the strategy in use and names the fix: `lumped` on the mostly
+/// empty box of `docs/examples/drop-plate.toml` (3.7e19 by t = 0.3) points to the
+/// default, which keeps the near-empty functions out of the system (1.9e2).
+#[test]
+fn an_ill_conditioned_mass_names_its_cause_and_fix() {
+    let plate = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/examples/drop-plate.toml"
+    );
+    let run = |mass: &str| {
+        cli()
+            .args([
+                "run",
+                plate,
+                "--condition",
+                "--t-end",
+                "0.05",
+                "--diag-every",
+                "0",
+            ])
+            .args(["--mass", mass])
+            .output()
+            .unwrap()
+    };
+    let lumped = run("lumped");
+    let stderr = String::from_utf8_lossy(&lumped.stderr);
+    assert_eq!(lumped.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("the run is UNSTABLE: condition estimate")
+            && stderr.contains("some function's support holds almost no particle")
+            && stderr.contains("`--mass default`"),
+        "{stderr}"
+    );
+    let default = run("default");
+    assert_eq!(
+        default.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&default.stderr)
+    );
 }
