@@ -258,7 +258,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
     walls: &[(String, [f64; 2])],
     body_sizes: &[usize],
 ) -> Result<SceneDriver<D, B>, RunError> {
-    let fixes: Vec<Fix> = scene
+    let mut fixes: Vec<Fix> = scene
         .boundaries
         .iter()
         .flat_map(|bc| {
@@ -270,6 +270,23 @@ fn driver<const D: usize, B: Basis<f64, D>>(
             })
         })
         .collect();
+    // A slip wall along an axis fixes one component of its functions: that is a
+    // fixed set, eliminated from the system, not a general constraint projected
+    // after the solve. Both give the same constrained minimiser, but the projection
+    // of a reduced (extended) system, whose functions' values follow their
+    // neighbours, pumped energy into a block bouncing on a slip floor (`docs/stability.md`,
+    // "Slip walls along an axis").
+    let mut oblique = Vec::new();
+    for (tag, normal) in walls {
+        let along: Vec<usize> = (0..D).filter(|&k| normal[k] != 0.0).collect();
+        match along[..] {
+            [component] => fixes.push(Fix {
+                tag: tag.clone(),
+                component,
+            }),
+            _ => oblique.push((tag, normal)),
+        }
+    }
     let extent = mesh_extent(&basis);
     let mut driver: SceneDriver<D, B> = Driver::new(
         basis,
@@ -315,7 +332,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
         }
     })?;
     driver.estimate_condition = scene.output.condition;
-    for (tag, normal) in walls {
+    for (tag, normal) in oblique {
         let n = SVector::<f64, D>::from_fn(|k, _| normal[k]);
         driver.add_slip_wall(tag, &n).map_err(|e| {
             SceneError::new(
