@@ -7,7 +7,7 @@
 //! the tool never removes a file it does not write, nor mixes a run with it.
 //!
 //! - `diagnostics.csv`: one row per step (not the initial state): `step, time,
-//!   kinetic, strain, potential, work, total, mass, momentum_x, momentum_y,
+//!   kinetic, strain, potential, work, total, total_centred, mass, momentum_x, momentum_y,
 //!   max_speed, active, lumped_rows, deactivated, extended, worst_coverage,
 //!   worst_function, worst_x, worst_y, condition` (the values of `--format json`;
 //!   floats in Rust's shortest round-trip `{:e}` form, integers as integers, the
@@ -54,7 +54,7 @@ use std::path::{Path, PathBuf};
 
 /// A row of `diagnostics.csv` (and of `run --format csv`): floats in Rust's
 /// shortest round-trip `{:e}` form.
-pub fn diagnostics_record(r: &StepReport) -> [String; 20] {
+pub fn diagnostics_record(r: &StepReport) -> [String; 21] {
     let float = |x: f64| format!("{x:e}");
     let worst = r.mass_report.worst_coverage;
     let at = |k: usize| {
@@ -70,6 +70,7 @@ pub fn diagnostics_record(r: &StepReport) -> [String; 20] {
         float(r.potential),
         float(r.work),
         float(r.total_energy()),
+        float(r.total_centred),
         float(r.mass),
         float(r.momentum()[0]),
         // (0 in 1D: the file has the same columns for every scene)
@@ -88,7 +89,7 @@ pub fn diagnostics_record(r: &StepReport) -> [String; 20] {
 }
 
 /// Columns of `diagnostics.csv`.
-pub const DIAGNOSTICS_COLUMNS: [&str; 20] = [
+pub const DIAGNOSTICS_COLUMNS: [&str; 21] = [
     "step",
     "time",
     "kinetic",
@@ -96,6 +97,7 @@ pub const DIAGNOSTICS_COLUMNS: [&str; 20] = [
     "potential",
     "work",
     "total",
+    "total_centred",
     "mass",
     "momentum_x",
     "momentum_y",

@@ -333,6 +333,7 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         "potential": r.potential,
         "work": r.work,
         "total": r.total_energy(),
+        "total_centred": r.total_centred,
         "mass": r.mass,
         "momentum": r.momentum(),
         "max_speed": r.max_speed,

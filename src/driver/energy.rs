@@ -98,6 +98,8 @@ where
                 at
             }),
             condition: self.last_condition,
+            // The initial state's; a step's report replaces it with the centred total.
+            total_centred: e.kinetic + e.strain + e.potential - self.work,
             phases: self.phases,
         }
     }

@@ -611,6 +611,9 @@ pub struct Affine<'a, T: Scalar, const D: usize> {
 /// Phases 4–5: particle velocities `v_p += Δt Σ_i a_i phi_i(x_p)` (eq. (18)) and
 /// the momentum `P_i = Σ_p m_p phi_i(x_p) v_p` (eq. (21)) into `momentum`, which
 /// holds `v̂ⁿ` on entry; with `affine`, corrected for the lumped rows ([`Affine`]).
+/// `centred[c]` receives `Σ_p m_p vⁿ_p · Δv_p` over the particles of chunk `c`, in
+/// particle order (the time-centred kinetic energy of
+/// [`crate::diagnostics::StepReport::total_centred`]).
 #[allow(clippy::too_many_arguments)]
 pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
@@ -623,6 +626,7 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     v: &mut [SVector<T, D>],
     momentum: &mut [Vec<T>],
     affine: Option<Affine<'_, T, D>>,
+    centred: &mut [f64],
 ) {
     let increment = |p: usize| {
         let mut a = SVector::<T, D>::zeros();
@@ -640,11 +644,18 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
         rigid,
     }) = affine
     else {
-        v.par_chunks_mut(CHUNK).enumerate().for_each(|(c, v)| {
-            for (q, v) in v.iter_mut().enumerate() {
-                *v += increment(c * CHUNK + q);
-            }
-        });
+        (v.par_chunks_mut(CHUNK), centred.par_iter_mut())
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (v, centred))| {
+                *centred = 0.0;
+                for (q, v) in v.iter_mut().enumerate() {
+                    let p = c * CHUNK + q;
+                    let dv = increment(p);
+                    *centred += mass[p].to_f64() * v.dot(&dv).to_f64();
+                    *v += dv;
+                }
+            });
         zero(momentum);
         let v = &*v;
         scatter_by_elements(bins, evals, gather, local, momentum, |p, s| {
@@ -655,13 +666,20 @@ pub fn update_velocities_and_momentum<T: Scalar, const D: usize>(
     };
     let old = &*momentum;
 
-    (v.par_chunks_mut(CHUNK), gradient.par_chunks_mut(CHUNK))
+    (
+        v.par_chunks_mut(CHUNK),
+        gradient.par_chunks_mut(CHUNK),
+        centred.par_iter_mut(),
+    )
         .into_par_iter()
         .enumerate()
-        .for_each(|(c, (v, gradient))| {
+        .for_each(|(c, (v, gradient, centred))| {
+            *centred = 0.0;
             for (q, (v, g)) in v.iter_mut().zip(gradient.iter_mut()).enumerate() {
                 let p = c * CHUNK + q;
-                *v += increment(p);
+                let dv = increment(p);
+                *centred += mass[p].to_f64() * v.dot(&dv).to_f64();
+                *v += dv;
                 *g = SMatrix::zeros();
                 for (s, i) in evals.entries(p) {
                     for k in 0..D {

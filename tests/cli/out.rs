@@ -149,6 +149,7 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             "potential",
             "work",
             "total",
+            "total_centred",
             "mass",
             "momentum_x",
             "momentum_y",
