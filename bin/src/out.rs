@@ -30,8 +30,9 @@
 //!   tracked particle; the plot shows the displacement against time (computed as
 //!   markers, or as a line without a reference; the reference as a line) and below
 //!   it the velocity in the same style, on the same time axis.
-//! - `energy.svg`: kinetic, strain, potential and total energy against time, and the
-//!   work of the effects when they do some (`total = K + S + P − W`).
+//! - `energy.svg`: kinetic, strain, potential and total energy against time, the
+//!   work of the effects when they do some (`total = K + S + P − W`), and the
+//!   time-centred total (`total_centred`), which does not swing with the step.
 //! - `particles.svg`: the particles at the first frame, the step nearest half the
 //!   run and the last step, coloured by `--picture FIELD` (default `displacement`,
 //!   `|u|`) on one colour scale, over the mesh (2D); in 1D the field against the
@@ -202,6 +203,8 @@ pub struct Recorder {
     diagnostics_path: PathBuf,
     /// `(time, kinetic, strain, potential, total)` of the initial state and every step.
     energy: Vec<[f64; 6]>,
+    /// `(time, total_centred)`: the time-centred total, at the start of each step.
+    centred: Vec<(f64, f64)>,
     /// Step of the last frame written, and the last step seen.
     last_frame: Option<usize>,
     last_step: usize,
@@ -268,6 +271,7 @@ impl Recorder {
             diagnostics: Some(w),
             diagnostics_path: path,
             energy: Vec::new(),
+            centred: Vec::new(),
             last_frame: None,
             last_step: 0,
             mesh,
@@ -308,6 +312,9 @@ impl Recorder {
 
     fn record(&mut self, r: &StepReport, particles: ParticlesRef<'_>) -> Result<(), CliError> {
         self.energy.push(r.energy_row());
+        // A step's centred total is that of the state at its start.
+        let at = if r.step == 0 { r.time } else { r.time - r.dt };
+        self.centred.push((at, r.total_centred));
         if r.step == 1 && r.time > 0.0 {
             // The library's step count: t_end / dt, rounded (dt = the first step's time).
             // (The scene's own count is 1 for Courant-number scenes.)
@@ -639,7 +646,17 @@ impl Recorder {
                 .collect();
             plot = plot.with_series(Series::line(*name, thin(points, MAX_PLOT_POINTS)));
         }
-        plot
+        // The time-centred total, which does not swing with the step after an
+        // impact: where it stays flat, the total's swing is the step's oscillation.
+        let points = self
+            .centred
+            .iter()
+            .map(|&(t, e)| (t, e - start[5]))
+            .collect();
+        plot.with_series(Series::line(
+            "centred total − E(0)",
+            thin(points, MAX_PLOT_POINTS),
+        ))
     }
 
     /// Draws `plots` (one below the other) into `file` without their non-finite

@@ -336,8 +336,14 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
 
     check_plot(
         &json["svg"][key(&files[4])],
-        &["kinetic", "strain", "potential − P(0)", "total − E(0)"],
-        &[1; 4],
+        &[
+            "kinetic",
+            "strain",
+            "potential − P(0)",
+            "total − E(0)",
+            "centred total − E(0)",
+        ],
+        &[1; 5],
         0,
     );
     let names: Vec<String> = [p0, p1]
@@ -435,8 +441,14 @@ fn a_1d_run_writes_about_50_frames_and_no_mesh() {
     assert_eq!(entries[50][0], "1.0");
     check_plot(
         &json["svg"][key(&energy)],
-        &["kinetic", "strain", "potential − P(0)", "total − E(0)"],
-        &[1; 4],
+        &[
+            "kinetic",
+            "strain",
+            "potential − P(0)",
+            "total − E(0)",
+            "centred total − E(0)",
+        ],
+        &[1; 5],
         0,
     );
 }
