@@ -41,6 +41,15 @@ fn series_stroke(k: usize) -> String {
 /// Checks an SVG line plot: the legend names in order, `lines[k]` `<polyline>`s in
 /// the colour of series `k` (one per panel it is drawn as a line in), and `markers`
 /// circles at least.
+/// The series of `energy.svg` for a run whose effects do no work.
+const ENERGY_LEGENDS: &[&str] = &[
+    "kinetic",
+    "strain",
+    "potential − P(0)",
+    "total − E(0)",
+    "centred total − E(0)",
+];
+
 fn check_plot(svg: &Value, names: &[&str], lines: &[usize], markers: usize) {
     let texts: Vec<&str> = svg["texts"]
         .as_array()
@@ -334,18 +343,7 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
         assert_eq!(file, expected);
     }
 
-    check_plot(
-        &json["svg"][key(&files[4])],
-        &[
-            "kinetic",
-            "strain",
-            "potential − P(0)",
-            "total − E(0)",
-            "centred total − E(0)",
-        ],
-        &[1; 5],
-        0,
-    );
+    check_plot(&json["svg"][key(&files[4])], ENERGY_LEGENDS, &[1; 5], 0);
     let names: Vec<String> = [p0, p1]
         .iter()
         .flat_map(|p| {
@@ -439,18 +437,7 @@ fn a_1d_run_writes_about_50_frames_and_no_mesh() {
     let entries = json["pvd"][key(&pvd)].as_array().unwrap();
     assert_eq!(entries.len(), 51);
     assert_eq!(entries[50][0], "1.0");
-    check_plot(
-        &json["svg"][key(&energy)],
-        &[
-            "kinetic",
-            "strain",
-            "potential − P(0)",
-            "total − E(0)",
-            "centred total − E(0)",
-        ],
-        &[1; 5],
-        0,
-    );
+    check_plot(&json["svg"][key(&energy)], ENERGY_LEGENDS, &[1; 5], 0);
 }
 
 fn input_error(args: &[&str]) -> String {
