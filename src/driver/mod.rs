@@ -368,6 +368,11 @@ where
     /// vanishes on the boundary tagged `tag` (for an oblique straight wall, its
     /// normal). The constraints couple the components of each coefficient and are
     /// imposed exactly by projection in the mass-matrix norm (see [`Constraints`]).
+    /// A wall whose normal lies along an axis is better given to [`Driver::new`] as a
+    /// [`Fix`] of that component, as the scene set-up does: the same constrained
+    /// solution, eliminated from the system instead of projected, and the
+    /// projection onto the extension's reduced system gained energy at impacts
+    /// (`docs/stability.md`, "Slip walls along an axis").
     pub fn add_slip_wall(&mut self, tag: &str, normal: &SVector<T, D>) -> Result<(), SetupError> {
         let constraints = self.basis.dirichlet(tag, normal)?;
         let mut general = std::mem::take(&mut self.constraints.rows);
