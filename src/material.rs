@@ -272,6 +272,46 @@ pub fn max_rotation<T: Scalar, const D: usize>(fs: &[SMatrix<T, D, D>]) -> f64 {
     fs.iter().map(rotation_angle).fold(0.0, f64::max)
 }
 
+/// The smallest `det F` over the deformation gradients `fs` and its index
+/// (`(∞, 0)` for none).
+pub fn min_jacobian<T: Scalar, const D: usize>(fs: &[SMatrix<T, D, D>]) -> (f64, usize) {
+    fs.iter()
+        .enumerate()
+        .map(|(p, f)| (det(f).to_f64(), p))
+        .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+}
+
+/// The `det F` below which a run's body is judged collapsed: compressed to under
+/// 5 % of its volume, where none of the elastic laws here is a model of a solid
+/// (the linear and co-rotational stresses stay bounded as `det F → 0`).
+pub const COLLAPSED_JACOBIAN: f64 = 0.05;
+
+/// Why a body whose particle `particle`, of law `law`, reached `det F = jacobian`
+/// (below [`COLLAPSED_JACOBIAN`]) at `position` by the time `time` collapsed, and
+/// what to do about it.
+pub fn collapse_reason(
+    jacobian: f64,
+    particle: usize,
+    position: &str,
+    time: f64,
+    law: &AnyMaterial,
+) -> String {
+    let fix = match law {
+        AnyMaterial::NeoHookean(_) => "the neo-Hookean pressure grows without bound as det F → 0, so the collapse is the discretisation's: a step too long for the impact (lower `time.courant`) or too few particles where the body is crushed (raise `per_block`, `count` or `spacing`)".to_string(),
+        AnyMaterial::Linear(_) | AnyMaterial::Corotational(_) => {
+            let name = if matches!(law, AnyMaterial::Linear(_)) {
+                "linear-elastic"
+            } else {
+                "corotational"
+            };
+            format!("the `{name}` law's stress stays bounded as det F → 0 (at most about λ + 2μ), so it cannot carry a load beyond that: use `model = \"neo-hookean\"`, whose pressure grows without bound in compression, or a stiffer material (check `young`, in Pa)")
+        }
+    };
+    format!(
+        "the body collapsed: det F fell to {jacobian:.1e} at particle {particle} (at {position}, sampled at t = {time:.4}), below {COLLAPSED_JACOBIAN}: compressed to under 5 % of its volume, which no elastic law here models; {fix}"
+    )
+}
+
 /// The rotation angle (radians) above which a run with the paper's non-objective
 /// law ([`LinearElastic`]) is warned about: at `θ = 0.05` a rigid rotation already
 /// gives the spurious strain `cos θ − 1 ≈ −1.2e-3` in every direction.

@@ -108,7 +108,9 @@ pub struct Summary {
     /// summary.
     #[serde(skip)]
     pub energy_growth_hint: Option<String>,
-    /// Why the run stopped early, with the step.
+    /// Why the run stopped early, with the step: a failed step, or a body
+    /// collapsed (a particle's `det F` below [`crate::material::COLLAPSED_JACOBIAN`],
+    /// checked every [`ROTATION_EVERY`] steps and at the end).
     pub failure: Option<String>,
     /// Largest rotation angle (radians) of the polar factor `R` of any particle's
     /// `F = R U`, sampled every [`ROTATION_EVERY`] steps and at the end (0 in 1D).
@@ -363,7 +365,7 @@ pub fn self_weight_warning<const D: usize>(
     (strain > SELF_WEIGHT_STRAIN).then(|| {
         let e = material.elastic(p);
         format!(
-            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {g_norm}, H = {height:.4} along g, E = {}), far beyond the small strains the elastic laws model: check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
+            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {g_norm}, H = {height:.4} along g, E = {}), far beyond small strains (and beyond what the `linear-elastic` and `corotational` laws model): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
             e.density, e.young
         )
     })
@@ -533,6 +535,16 @@ where
             rms.finish_step();
         }
         if r.step % ROTATION_EVERY == 0 {
+            if let Some(reason) = collapse_reason(driver, r.time) {
+                failure = Some(StepError::Collapsed {
+                    step: r.step,
+                    reason,
+                });
+                on_step(&r, driver.particles.view());
+                verdict.observe(&r);
+                last_energy = r.total_energy();
+                break;
+            }
             let now = crate::material::max_rotation(&driver.particles.f);
             max_rotation = max_rotation.max(now);
             max_rotation_non_objective = max_rotation_non_objective.max(
@@ -568,6 +580,27 @@ where
         sampling,
         last_energy,
     }
+}
+
+/// Why the bodies of `driver` collapsed, when a particle's `det F` is below
+/// [`crate::material::COLLAPSED_JACOBIAN`] at `time`
+/// ([`crate::material::collapse_reason`]).
+fn collapse_reason<const D: usize, B: Basis<f64, D>>(
+    driver: &setup::SceneDriver<D, B>,
+    time: f64,
+) -> Option<String> {
+    let particles = &driver.particles;
+    let (j, p) = crate::material::min_jacobian(&particles.f);
+    (j < crate::material::COLLAPSED_JACOBIAN).then(|| {
+        let x: Vec<f64> = particles.x[p].iter().copied().collect();
+        crate::material::collapse_reason(
+            j,
+            p,
+            &crate::driver::point(&x),
+            time,
+            driver.material().law(p),
+        )
+    })
 }
 
 /// The error against the reference solution at the end of the run.
@@ -625,9 +658,11 @@ fn error<const D: usize, B: Basis<f64, D>>(
 /// disks with PL (0.036, 0.017, 0.0083 at Δt = 1.2e-3, 6e-4, 3e-4), and with fewer particles
 /// than functions per element it is larger (9.5 % at 3.6 particles per occupied
 /// element, 3.8 % with four times as many). With a contact wall (`contact_stiffness`
-/// its `κ`), an impact's error does not fall with the step alone: the springs
-/// stiffen as `1 / Δt²` (a block striking a wall: 1.9, 4.6, 8.4 % at `courant` 0.3,
-/// 0.15, 0.075 with `κ = 0.5`; 1.0 % at 0.15 with `κ = 0.25`). `centred_growth`,
+/// its `κ`), the total's swing at an impact does not fall with the step: the springs
+/// ring at `κ / Δt` (a block striking a wall: 1.8, 1.4, 1.5 % at `courant` 0.3,
+/// 0.15, 0.075 with `κ = 0.5`, a time-centred growth of 3e-4 or less; a soft disk
+/// bouncing on a contact floor at 0.125: 1.0 % with `κ = 0.5`, 0.43 % with 0.25).
+/// `centred_growth`,
 /// the growth of the time-centred total, says whether energy is gained or the
 /// total only swings with the step after an impact.
 #[allow(clippy::too_many_arguments)]
@@ -666,7 +701,7 @@ pub fn energy_growth_hint(
     };
     let contact = match contact_stiffness {
         Some(kappa) => format!(
-            "; the scene has a contact wall, whose springs stiffen as 1/Δt²: an impact's error falls only if its `stiffness` (now {kappa}) is lowered with the step (halve both), down to where the message of a particle leaving through the wall says it is too soft"
+            "; the scene has a contact wall, whose springs ring at the frequency κ/Δt whatever the step (`stiffness` κ = {kappa}): the total's swing at an impact falls with κ, not with the step; lower `stiffness` (to {:.2}, say), down to where the message of a particle leaving through the wall says it is too soft", kappa / 2.0
         ),
         None => String::new(),
     };
@@ -714,6 +749,13 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let (energy_drift, energy_growth) = tally.verdict.energy_drift_and_growth();
     let failure = tally.failure;
     let max_condition = tally.verdict.max_condition;
+    // The last state, if the loop's sampling missed it.
+    let failure = failure.or_else(|| {
+        collapse_reason(&run.driver, run.driver.time()).map(|reason| StepError::Collapsed {
+            step: run.driver.steps(),
+            reason,
+        })
+    });
     let stable = tally.verdict.stable(failure.is_some());
     let energy_growth_hint =
         (failure.is_none() && energy_growth >= STABLE_ENERGY_GROWTH).then(|| {

@@ -517,3 +517,69 @@ fn the_time_centred_energy_tells_a_real_gain_from_the_steps_oscillation() {
     let plate = run(&plate, &mut |_| {}).unwrap();
     assert!(plate.energy_growth_centred > 5e-2, "{plate:?}");
 }
+
+/// A user's very soft block (E = 3e3, ρ = 1000, 0.625 high: its weight would strain
+/// it by ρ g H / E = 1.9) on a no-slip floor. The default `corotational` law's
+/// stress stays bounded as det F → 0: the block is crushed into a sheet a
+/// millimetre thick against the floor, where every function around its particles
+/// is fixed, and it stays there with its particles' velocities frozen. The energy
+/// bound alone judged that run stable. Now a particle's det F below 0.05 stops the
+/// run ("the body collapsed"), with the law's limit and the fix; the same block of
+/// neo-Hookean material, whose pressure grows without bound, stands.
+#[test]
+fn a_block_crushed_by_its_own_weight_is_judged_collapsed_not_stable() {
+    let scene = |model: &str| {
+        format!(
+            r#"
+name = "soft-slump"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 3.0]
+y = [0.0, 1.0]
+blocks = [24, 8]
+[material]
+model = "{model}"
+young = 3e3
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.0, 0.0]
+max = [2.0, 0.625]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.25
+t_end = 0.5
+"#
+        )
+    };
+    let crushed = run(
+        &Scene::from_toml(&scene("corotational"), "slump.toml").unwrap(),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(!crushed.stable, "{crushed:?}");
+    let reason = crushed.failure.as_deref().unwrap_or_default();
+    assert!(
+        reason.contains("the body collapsed: det F fell to")
+            && reason.contains("`corotational` law")
+            && reason.contains("neo-hookean")
+            && reason.contains("ρ |g| H / E = 1.9e0"),
+        "{reason}"
+    );
+    // Stopped when the collapse was seen, before the run ended.
+    assert!(crushed.t_end < 0.4, "{crushed:?}");
+    let stands = run(
+        &Scene::from_toml(&scene("neo-hookean"), "slump.toml").unwrap(),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(stands.stable && stands.failure.is_none(), "{stands:?}");
+}

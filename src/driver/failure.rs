@@ -327,6 +327,14 @@ pub enum StepError {
         /// What the driver sees near the particle and what to change.
         hint: String,
     },
+    /// A body compressed to a few percent of its volume: judged by the caller, who
+    /// knows the material (see `crate::material::COLLAPSED_JACOBIAN`).
+    #[error("step {step}: {reason}")]
+    Collapsed {
+        step: usize,
+        /// Where, and what to change.
+        reason: String,
+    },
 }
 
 /// Errors setting up a driver.
