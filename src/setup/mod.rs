@@ -238,9 +238,11 @@ fn outside_the_mesh<const D: usize>(position: &[f64], (lo, hi): ([f64; D], [f64;
         .join(" × ");
     let inside_box = (0..D).all(|k| position.get(k).is_some_and(|&x| lo[k] <= x && x <= hi[k]));
     if inside_box {
-        format!("the particle at {position:?} lies in a hole or notch of the mesh (inside its bounding box {span}, but in no element); the body must not overlap the mesh's holes (`[[mesh.holes]]`) or the parts of its outline cut away")
+        let position = crate::driver::point(position);
+        format!("the particle at {position} lies in a hole or notch of the mesh (inside its bounding box {span}, but in no element); the body must not overlap the mesh's holes (`[[mesh.holes]]`) or the parts of its outline cut away")
     } else {
-        format!("the particle at {position:?} lies outside the mesh, which spans {span}; the body must lie inside the meshed domain")
+        let position = crate::driver::point(position);
+        format!("the particle at {position} lies outside the mesh, which spans {span}; the body must lie inside the meshed domain")
     }
 }
 

@@ -175,7 +175,8 @@ fn check_overlaps(lattice: &Lattice, regions: &[Region]) -> Result<(), SceneErro
                     format!("body[{b}]"),
                     ErrorKind::Conflict,
                     format!(
-                        "body[{a}] and body[{b}] overlap: the particle of body[{j}] at {p:?} lies inside body[{i}]; bodies must not overlap (they may touch)"
+                        "body[{a}] and body[{b}] overlap: the particle of body[{j}] at {} lies inside body[{i}]; bodies must not overlap (they may touch)",
+                        crate::driver::point(p.as_slice())
                     ),
                 ));
             }
