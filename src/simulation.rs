@@ -694,7 +694,7 @@ pub fn energy_growth_hint(
     };
     let sampling = if particles_per_element < functions_per_element as f64 {
         format!(
-            ", or use more particles per element ({particles_per_element:.1} per occupied element for the {functions_per_element} functions of each; `per_block`, `count` or `spacing`)"
+            ", or use more particles per element ({particles_per_element:.1} per occupied element at the end, for the {functions_per_element} functions of each; `per_block`, `count` or `spacing`)"
         )
     } else {
         String::new()

@@ -387,7 +387,7 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
         "it reached the bound at t = 1.01",
         "the time step is 0.50 of the critical step",
         "lower `time.courant` (to 0.25, say; `--courant` on the command line)",
-        "per occupied element for the 9 functions of each",
+        "per occupied element at the end, for the 9 functions of each",
     ] {
         assert!(stderr.contains(part), "`{part}` not in: {stderr}");
     }
