@@ -26,7 +26,8 @@
 //! alone is too soft (a disk of 1 792 particles sank through a slope), one sized on
 //! the grid mass around each particle too stiff once several particles share a
 //! function (a block striking a wall gained 16 % energy at 9 particles per triangle,
-//! 1.9 % with this one; `docs/stability.md`, "Contact walls").
+//! 1.9 % with this one, 1.8 % once springs only soften in contact, below;
+//! `docs/stability.md`, "Contact walls").
 //!
 //! While a particle stays in contact its spring only softens,
 //! `k_p ← min(k_p, m_p (κ / Δt)² / c_p)`: the share `c_p` falls as particles leave
@@ -57,9 +58,11 @@ use std::sync::Mutex;
 
 /// The default `κ`: the grid's contact modes have frequency at most `κ / Δt`. With
 /// `κ = 1` a block striking a wall at 9 particles per triangle gained 11 % of its
-/// energy (UNSTABLE); with `κ = 1/2` 1.9 %, and a rubber disk on a slope
-/// (`docs/examples/disk-slope.toml` with a contact wall) drifts by 2.5e-3 to 7.8e-3
-/// at two particle spacings (`docs/stability.md`, "Contact walls").
+/// energy (UNSTABLE; springs that followed the contact share both ways); with
+/// `κ = 1/2` 1.9 % (1.8 % with springs that only soften in contact, time-centred
+/// 3e-4), and a rubber disk on a slope (`docs/examples/disk-slope.toml` with a
+/// contact wall) loses 7.9e-3 and 1.2e-2 at two particle spacings, gaining nothing
+/// (`docs/stability.md`, "Contact walls").
 pub const DEFAULT_STIFFNESS: f64 = 0.5;
 
 /// The wall geometry of one boundary tag, and the wall items near each element.
