@@ -186,7 +186,7 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
                 Some(m) if (m[0] * n[1] - m[1] * n[0]).abs() > STRAIGHT_WALL => {
                     return Err(conflict(
                         format!("boundary[{b}].fix"),
-                        format!("`normal` needs a straight wall, but `{}` bends", bc.tag),
+                        format!("`normal` needs a straight wall, but `{0}` bends (a hole's or a corner's edges share one tag): for a frictionless wall that bends, make it a contact wall (`[[effect]]` with `kind = \"contact-wall\"` and `tag = \"{0}\"`, in place of this `[[boundary]]`); for a sticking one, `fix = [\"x\", \"y\"]`; or give each straight side its own tag", bc.tag),
                     )
                     .into())
                 }

@@ -310,8 +310,14 @@ fn driver<const D: usize, B: Basis<f64, D>>(
                     particle < first
                 })
                 .unwrap_or(0);
+            // A box past the mesh's low side is its `min`'s doing, past the high
+            // side its `max`'s; in a hole, the whole body's.
+            let (lo, hi) = extent;
+            let below = (0..D).any(|k| position.get(k).is_some_and(|&x| x < lo[k]));
+            let above = (0..D).any(|k| position.get(k).is_some_and(|&x| x > hi[k]));
             let field = match scene.bodies.get(body) {
-                Some(b) if b.shape.is_box() => format!("body[{body}].max"),
+                Some(b) if b.shape.is_box() && below => format!("body[{body}].min"),
+                Some(b) if b.shape.is_box() && above => format!("body[{body}].max"),
                 _ => format!("body[{body}]"),
             };
             SceneError::new(

@@ -754,9 +754,12 @@ fn inconsistent_cases() -> Vec<Case> {
         case("body-outside-the-mesh", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 2.0]")
             .at(22, 1).at(24, 7).expect("body[0].max: the particle at [0.125, 1.125] lies outside the mesh, which spans [0, 4] × [0, 1]; the body must lie inside the meshed domain"),
+        case("body-below-the-mesh", BAR)
+            .edit("min = [0.0, 0.0]", "min = [0.0, -1.0]")
+            .at(23, 7).expect("body[0].min: the particle at [0.125, -0.875] lies outside the mesh, which spans [0, 4] × [0, 1]; the body must lie inside the meshed domain"),
         case("body-in-a-hole-of-the-mesh", SQUARE)
             .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]]\ntag = \"post\"\n")
-            .at(24, 7).expect("body[0].max: the particle at [0.40625, 0.40625] lies in a hole or notch of the mesh (inside its bounding box [0, 1] × [0, 1], but in no element); the body must not overlap the mesh's holes (`[[mesh.holes]]`) or the parts of its outline cut away"),
+            .at(22, 1).expect("body[0]: the particle at [0.40625, 0.40625] lies in a hole or notch of the mesh (inside its bounding box [0, 1] × [0, 1], but in no element); the body must not overlap the mesh's holes (`[[mesh.holes]]`) or the parts of its outline cut away"),
         case("body-not-a-whole-number-of-cells", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 0.9]")
             .at(24, 7).expect("body[0].max: the body's extent 0.9 along axis 1 is not a whole number of lattice cells of size 0.25 (the mesh's block size along that axis over `per_block`): make the extent a multiple of it, choose `blocks` (or `--blocks`) so that it is, or give `count` instead of `per_block`"),
@@ -1001,7 +1004,7 @@ fn mesh_cases() -> Vec<Case> {
             .edit("meshes/square.msh", "meshes/square_hole.msh")
             .edit("tag = \"bottom\"\nfix = [\"x\", \"y\"]", "tag = \"hole\"\nfix = [\"normal\"]")
             .edit("min = [0.0, 0.0]\nmax = [1.0, 1.0]", "min = [0.0, 0.0]\nmax = [1.0, 0.25]")
-            .at(22, 7).expect("boundary[0].fix: `normal` needs a straight wall, but `hole` bends"),
+            .at(22, 7).expect("boundary[0].fix: `normal` needs a straight wall, but `hole` bends (a hole's or a corner's edges share one tag): for a frictionless wall that bends, make it a contact wall (`[[effect]]` with `kind = \"contact-wall\"` and `tag = \"hole\"`, in place of this `[[boundary]]`); for a sticking one, `fix = [\"x\", \"y\"]`; or give each straight side its own tag"),
     ]
 }
 
