@@ -304,7 +304,7 @@ pub fn collapse_reason(
             } else {
                 "corotational"
             };
-            format!("the `{name}` law's stress stays bounded as det F → 0 (at most about λ + 2μ), so it cannot carry a load beyond that: use `model = \"neo-hookean\"`, whose pressure grows without bound in compression, or a stiffer material (check `young`, in Pa)")
+            format!("the `{name}` law's stress stays bounded as det F → 0 (at most about λ + 2μ), so it cannot carry a load beyond that: check `young` (in Pa) and use a stiffer material, or `model = \"neo-hookean\"`, whose pressure grows without bound in compression (at strains near 1 it still needs a short step and many particles per element)")
         }
     };
     format!(
