@@ -9,8 +9,8 @@ use crate::particles::Particles;
 use crate::sparse::Scalar;
 use nalgebra::{SMatrix, SVector};
 
-/// Largest growth of the total energy (relative to the energy scale of the run)
-/// for a run to count as stable.
+/// Largest growth of the time-centred total energy ([`StepReport::total_centred`],
+/// relative to the energy scale of the run) for a run to count as stable.
 pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
 /// Largest condition estimate of the solved mass system for a stable run.
 pub const STABLE_CONDITION: f64 = 1e8;
@@ -294,8 +294,8 @@ pub struct Verdict {
     growth: f64,
     /// Largest growth of [`StepReport::total_centred`].
     growth_centred: f64,
-    /// The first step (and its time) at which the growth reached
-    /// [`STABLE_ENERGY_GROWTH`] of the energy scale seen so far.
+    /// The first step (and its time) at which the growth of the time-centred
+    /// total reached [`STABLE_ENERGY_GROWTH`] of the energy scale seen so far.
     pub growth_crossed: Option<(usize, f64)>,
     /// Largest condition estimate seen.
     pub max_condition: Option<f64>,
@@ -338,8 +338,8 @@ impl Verdict {
         self.growth = self.growth.max(change);
         self.growth_centred = self.growth_centred.max(r.total_centred - self.e0);
         if self.growth_crossed.is_none()
-            && self.growth > 0.0
-            && self.growth >= STABLE_ENERGY_GROWTH * self.scale()
+            && self.growth_centred > 0.0
+            && self.growth_centred >= STABLE_ENERGY_GROWTH * self.scale()
         {
             self.growth_crossed = Some((r.step, r.time));
         }
@@ -390,11 +390,16 @@ impl Verdict {
         }
     }
 
-    /// Stable: no failure, energy growth below [`STABLE_ENERGY_GROWTH`], every
-    /// condition estimate below [`STABLE_CONDITION`].
+    /// Stable: no failure, growth of the time-centred total
+    /// ([`Verdict::centred_growth`]) below [`STABLE_ENERGY_GROWTH`], every condition
+    /// estimate below [`STABLE_CONDITION`]. The total itself swings by about `ω Δt`
+    /// of the energy of the modes an impact excites, first order in the step, and
+    /// that swing is not energy gained: a thin plate that lost 30 % of its energy
+    /// bouncing on a contact floor was judged UNSTABLE by its total's 19 % swing
+    /// (centred growth 3e-3; `docs/stability.md`).
     pub fn stable(&self, failed: bool) -> bool {
         !failed
-            && self.energy_drift_and_growth().1 < STABLE_ENERGY_GROWTH
+            && self.centred_growth() < STABLE_ENERGY_GROWTH
             && self.max_condition.is_none_or(|c| c < STABLE_CONDITION)
     }
 }
@@ -415,15 +420,23 @@ mod tests {
         ]
         .iter()
         .enumerate()
-        .map(|(step, &(kinetic, strain, potential))| StepReport {
-            step,
-            time: step as f64,
-            kinetic,
-            strain,
-            potential: potential + shift,
-            ..StepReport::default()
+        .map(|(step, &(kinetic, strain, potential))| {
+            centred(StepReport {
+                step,
+                time: step as f64,
+                kinetic,
+                strain,
+                potential: potential + shift,
+                ..StepReport::default()
+            })
         })
         .collect()
+    }
+
+    /// `r` with its time-centred total equal to its total (no swing).
+    fn centred(mut r: StepReport) -> StepReport {
+        r.total_centred = r.total_energy();
+        r
     }
 
     fn verdict(reports: &[StepReport]) -> Verdict {
@@ -452,10 +465,12 @@ mod tests {
         }
         let as_work: Vec<StepReport> = falling(0.0)
             .into_iter()
-            .map(|r| StepReport {
-                potential: 0.0,
-                work: 100.0 - r.potential,
-                ..r
+            .map(|r| {
+                centred(StepReport {
+                    potential: 0.0,
+                    work: 100.0 - r.potential,
+                    ..r
+                })
             })
             .collect();
         let worked = verdict(&as_work);
@@ -501,10 +516,12 @@ mod tests {
 
         // A start at rest whose total rises to 1.1: UNSTABLE against the motion's
         // own scale (1.1), stable against a stored energy of 100.
-        let state = |k: f64, s: f64| StepReport {
-            kinetic: k,
-            strain: s,
-            ..StepReport::default()
+        let state = |k: f64, s: f64| {
+            centred(StepReport {
+                kinetic: k,
+                strain: s,
+                ..StepReport::default()
+            })
         };
         let history = [state(0.0, 0.0), state(1.0, 0.1), state(0.5, 0.5)];
         let judge = |stored: f64| {
@@ -514,6 +531,35 @@ mod tests {
         };
         assert!(!judge(0.0));
         assert!(judge(100.0));
+    }
+
+    /// The verdict judges the time-centred total: a total that swings 10 % above its
+    /// start after an impact while the centred total stays put is stable (and its
+    /// growth is still reported); a centred total that gains 6 % is not.
+    #[test]
+    fn the_verdict_judges_the_time_centred_total_not_the_swing() {
+        let swing = |total_gain: f64, centred_gain: f64| {
+            let start = centred(StepReport {
+                kinetic: 100.0,
+                ..StepReport::default()
+            });
+            let after = StepReport {
+                step: 1,
+                time: 1.0,
+                kinetic: 100.0 + total_gain,
+                total_centred: 100.0 + centred_gain,
+                ..StepReport::default()
+            };
+            verdict(&[start, after])
+        };
+        let v = swing(10.0, 0.0);
+        assert!(v.stable(false));
+        assert!((v.energy_drift_and_growth().1 - 10.0 / 110.0).abs() < 1e-15);
+        assert_eq!(v.growth_crossed, None);
+        let v = swing(0.0, 6.0);
+        assert!(!v.stable(false));
+        assert!((v.centred_growth() - 0.06).abs() < 1e-15);
+        assert_eq!(v.growth_crossed, Some((1, 1.0)));
     }
 
     /// Nothing moving and nothing changing is no growth, not 0/0.

@@ -257,7 +257,7 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                 }
                 if summaries.iter().any(|s| s.max_condition.is_none()) {
                     println!(
-                        "stable: completed with energy growth under {} of the energy scale; the \
+                        "stable: completed with a growth of the time-centred total energy under {} of the energy scale; the \
                          condition of the solved system enters the verdict only where it was \
                          measured (--condition: below {})",
                         simulation::STABLE_ENERGY_GROWTH,

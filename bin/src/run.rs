@@ -673,9 +673,10 @@ pub fn unstable_reason(summary: &Summary) -> String {
         ),
         _ => {
             let mut reason = format!(
-                "energy growth {:.2e} of the energy scale ≥ {}",
-                summary.energy_growth,
-                simulation::STABLE_ENERGY_GROWTH
+                "energy growth {:.2e} of the energy scale ≥ {} (time-centred total; the total itself grew {:.2e})",
+                summary.energy_growth_centred,
+                simulation::STABLE_ENERGY_GROWTH,
+                summary.energy_growth
             );
             if let Some(hint) = &summary.energy_growth_hint {
                 reason.push_str(": ");

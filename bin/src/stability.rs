@@ -359,10 +359,10 @@ fn reason(s: &Summary) -> Option<String> {
             sci(STABLE_CONDITION)
         ));
     }
-    if above(s.energy_growth, STABLE_ENERGY_GROWTH) {
+    if above(s.energy_growth_centred, STABLE_ENERGY_GROWTH) {
         why.push(format!(
-            "energy growth {} above the bound {}",
-            sci(s.energy_growth),
+            "energy growth {} above the bound {} (time-centred total)",
+            sci(s.energy_growth_centred),
             STABLE_ENERGY_GROWTH
         ));
     }

@@ -90,17 +90,6 @@ impl Scene {
         })
     }
 
-    /// The largest `stiffness` (`κ`) of the scene's contact walls, if it has any.
-    pub fn contact_stiffness(&self) -> Option<f64> {
-        self.effects
-            .iter()
-            .filter_map(|e| match e {
-                EffectSpec::ContactWall { stiffness, .. } => Some(*stiffness),
-                _ => None,
-            })
-            .reduce(f64::max)
-    }
-
     /// The time step `dt`, or with `courant` a mesh-based guess `C h / c` (P-wave
     /// speed `c`, `h` halved for PS) used to set a run up and to estimate its cost;
     /// the run itself takes `C Δt_crit` (see [`TimeSpec::courant`](super::TimeSpec::courant)).

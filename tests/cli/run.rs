@@ -384,7 +384,7 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     for part in [
         "the run is UNSTABLE: energy growth",
-        "it reached the bound at t = 1.01",
+        "it reached the bound at t = 1.02",
         "the time step is 0.50 of the critical step",
         "lower `time.courant` (to 0.25, say; `--courant` on the command line)",
         "per occupied element at the end, for the 9 functions of each",
