@@ -194,8 +194,17 @@ where
             } else {
                 format!("{inside} particles")
             };
+            // At an impact with a long step, more particles alone does not help
+            // (a user's block at `courant = 0.5` failed sooner with more).
+            let step = match self.dt_critical {
+                Some(c) if c > 0.0 && self.dt.to_f64() > 0.3 * c => format!(
+                    "; if it inverted at an impact, lower `time.courant` too (the step is {:.2} of the critical one; impacts want 0.25 or less)",
+                    self.dt.to_f64() / c
+                ),
+                _ => String::new(),
+            };
             return format!(
-                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
+                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`{step}"
             );
         }
         if let Some(critical) = self.dt_critical {
