@@ -168,6 +168,14 @@ impl WallGeometry {
         self.reach
     }
 
+    /// `true` if a wall item is listed for `element` (within [`Self::reach`]).
+    pub fn near(&self, element: usize) -> bool {
+        self.element_start
+            .get(element)
+            .zip(self.element_start.get(element + 1))
+            .is_some_and(|(a, b)| b > a)
+    }
+
     /// Calls `contact(g, n)` for each wall item within `d` of `x` (in `element`):
     /// `g` how far inside the distance, `n` the unit direction from the wall to `x`.
     #[inline]
@@ -430,6 +438,9 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
         for &(p, _) in touching.iter() {
             was_touching[p] = true;
         }
+    }
+    fn walls_element(&self, element: usize) -> bool {
+        self.geometry.near(element)
     }
     fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
         let mut guard = self.state.lock().unwrap_or_else(|e| e.into_inner());

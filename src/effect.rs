@@ -107,6 +107,12 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     /// The run's time step is `dt` (called when the driver is built and whenever
     /// its step changes), for effects whose forces depend on it.
     fn set_time_step(&mut self, _dt: f64) {}
+    /// `true` if the effect is a wall at the particles with a part within its reach
+    /// of `element` (a contact wall): a particle that left the mesh from there
+    /// went through it.
+    fn walls_element(&self, _element: usize) -> bool {
+        false
+    }
 }
 
 /// Uniform gravity `g`: `F^body_{k,i} = Σ_p m_p phi_i(x_p) g_k` (paper eq. (16)),

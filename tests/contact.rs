@@ -340,3 +340,63 @@ t_end = 0.9
     assert!(s.energy_growth < 2e-2, "{s:?}");
     assert!(s.energy_drift < 3e-2, "{s:?}");
 }
+
+/// A particle that leaves the mesh through a contact wall is told so (the wall's
+/// springs too soft: lower the step or stiffen them); one that leaves through a
+/// side without a wall, in a scene that has a contact wall elsewhere, is told to
+/// add a wall there, not about the contact wall's springs.
+#[test]
+fn a_particle_leaving_the_mesh_is_told_whether_it_went_through_a_contact_wall() {
+    let scene = |wall: &str, stiffness: f64| {
+        format!(
+            r#"
+name = "strike"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 3.0]
+y = [0.0, 2.0]
+blocks = [24, 16]
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [2.0, 0.75]
+max = [2.5, 1.25]
+per_block = [3, 3]
+[body.initial_velocity]
+kind = "uniform"
+value = [6.0, 0.0]
+[[effect]]
+kind = "contact-wall"
+tag = "{wall}"
+stiffness = {stiffness}
+[time]
+courant = 0.3
+t_end = 0.6
+"#
+        )
+    };
+    let failure = |text: &str| {
+        let scene = Scene::from_toml(text, "strike.toml").unwrap();
+        simulation::run(&scene, &mut |_| {})
+            .unwrap()
+            .failure
+            .unwrap_or_default()
+    };
+    let through = failure(&scene("right", 0.02));
+    assert!(
+        through.contains("left the mesh")
+            && through.contains("and went through a contact wall, whose springs were too soft"),
+        "{through}"
+    );
+    let free = failure(&scene("left", 0.5));
+    assert!(
+        free.contains("left the mesh")
+            && free.contains("add a wall")
+            && !free.contains("went through a contact wall"),
+        "{free}"
+    );
+}

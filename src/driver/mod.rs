@@ -488,18 +488,23 @@ where
             let p = o.particle;
             let speed = self.particles.v[p].norm().to_f64();
             let moved = speed * self.dt.to_f64();
-            let contact = if self.effects.iter().any(|e| e.name() == "contact-wall") {
-                "; if it went through a contact wall, the wall's springs were too soft for the load or the speed: lower the time step (they stiffen as 1/Δt²) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable)"
+            // The element it was in before this step (location failed, so the
+            // particle's element is still the last one found).
+            let from = self.particles.element[p];
+            let hint = if self.effects.iter().any(|e| e.walls_element(from)) {
+                format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went through a contact wall, whose springs were too soft for the load or the speed: lower `time.courant` (impacts on contact walls want 0.25 or less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                )
             } else {
-                ""
+                format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`, or a contact wall) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                )
             };
             StepError::ParticleLeftMesh {
                 step: self.step + 1,
                 particle: p,
                 position: to_f64(&self.particles.x[p]),
-                hint: format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column){contact}"
-                ),
+                hint,
             }
         })
     }
