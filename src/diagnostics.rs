@@ -399,8 +399,14 @@ impl Verdict {
     /// (centred growth 3e-3; `docs/stability.md`).
     pub fn stable(&self, failed: bool) -> bool {
         !failed
-            && self.centred_growth() < STABLE_ENERGY_GROWTH
+            && !self.energy_bound_broken()
             && self.max_condition.is_none_or(|c| c < STABLE_CONDITION)
+    }
+
+    /// The energy part of the verdict: the time-centred total grew by
+    /// [`STABLE_ENERGY_GROWTH`] of the energy scale or more (NaN counts as grown).
+    pub fn energy_bound_broken(&self) -> bool {
+        self.centred_growth().partial_cmp(&STABLE_ENERGY_GROWTH) != Some(std::cmp::Ordering::Less)
     }
 }
 

@@ -720,7 +720,6 @@ fn error<const D: usize, B: Basis<f64, D>>(
 /// 0.2, 0.1: `docs/stability.md`), and with fewer particles than functions per
 /// element it is larger (9.5 % at 3.6 particles per occupied element, 3.8 % with
 /// four times as many, measured on the total).
-#[allow(clippy::too_many_arguments)]
 pub fn energy_growth_hint(
     crossed: Option<(usize, f64)>,
     steps: usize,
@@ -796,7 +795,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     });
     let stable = tally.verdict.stable(failure.is_some());
     let energy_growth_hint =
-        (failure.is_none() && tally.verdict.centred_growth() >= STABLE_ENERGY_GROWTH).then(|| {
+        (failure.is_none() && tally.verdict.energy_bound_broken()).then(|| {
             energy_growth_hint(
                 tally.verdict.growth_crossed,
                 run.driver.steps(),
