@@ -70,6 +70,9 @@ pub const DEFAULT_STIFFNESS: f64 = 0.5;
 pub struct WallGeometry {
     /// Edges `(a, b, n)`, `n` the unit normal into the mesh.
     segments: Vec<(Vec2, Vec2, Vec2)>,
+    /// Per edge, whether its end `a` and its end `b` are free ends of the wall (no
+    /// wall edge beyond them): there the wall is bevelled ([`Self::contacts`]).
+    free: Vec<[bool; 2]>,
     /// Reflex corners: the vertex and its two wall edges.
     corners: Vec<(Vec2, [usize; 2])>,
     /// Per element, the segments (`i`) and corners (`segments.len() + j`) within
@@ -99,6 +102,18 @@ impl WallGeometry {
         if segments.is_empty() {
             return None;
         }
+        let free = edge_of_segment
+            .iter()
+            .map(|&k| {
+                let [a, b] = mesh.edges()[k].vertices;
+                let joined = |vertex: usize, side: usize| {
+                    edge_of_segment
+                        .iter()
+                        .any(|&l| mesh.edges()[l].vertices[side] == vertex)
+                };
+                [!joined(a, 1), !joined(b, 0)]
+            })
+            .collect();
         // Reflex corners: vertices shared by two wall edges where the mesh's angle
         // exceeds π.
         let mut corners = Vec::new();
@@ -156,6 +171,7 @@ impl WallGeometry {
         }
         Some(WallGeometry {
             segments,
+            free,
             corners,
             element_start,
             element_items,
@@ -177,7 +193,22 @@ impl WallGeometry {
     }
 
     /// Calls `contact(g, n)` for each wall item within `d` of `x` (in `element`):
-    /// `g` how far inside the distance, `n` the unit direction from the wall to `x`.
+    /// `g` how far inside the distance, `n = −∇g` the direction from the wall to
+    /// `x` (a unit vector, but for the bevels).
+    ///
+    /// A free end of the wall (where the tagged boundary goes on untagged, or turns
+    /// into another tag) is bevelled over the contact distance: within `d` of the
+    /// end `c` along the edge, `g = d − (x − c)·n − (d − σ)`, `σ = (x − c)·u` the
+    /// distance from the end along the edge (`u` pointing into it), so that `g`
+    /// is `−(x − c)·n ≤ 0` at the end itself and the potential `½ k g²` is
+    /// continuous there. Without the bevel a particle that comes round the end
+    /// (off a slanted slip wall over a contact cliff) entered the edge's strip from
+    /// the side already `g ≈ d` deep, with the energy `½ k g²` its spring then
+    /// released: a block sliding off a 30° ramp past a contact cliff gained 21 % of
+    /// its energy at `courant = 0.25` and 57 % at 0.12 (the springs stiffen as
+    /// `1 / Δt²`). A capsule end (radial push from `c`) keeps `g` continuous too,
+    /// but stopped the block on the ramp: its particles sit slightly closer than
+    /// `d` to the ramp, and the end pushed them back.
     #[inline]
     fn contacts(&self, element: usize, x: Vec2, d: f64, mut contact: impl FnMut(f64, Vec2)) {
         let Some(range) = self
@@ -195,12 +226,26 @@ impl WallGeometry {
         for &item in &self.element_items[*range.0..*range.1] {
             let item = item as usize;
             if item < self.segments.len() {
-                let (a, _, n) = self.segments[item];
+                let (a, b, n) = self.segments[item];
                 let t = along(item);
                 if (0.0..=1.0).contains(&t) {
-                    let g = d - (x - a).dot(&n);
+                    let mut g = d - (x - a).dot(&n);
+                    let mut direction = n;
+                    let [free_a, free_b] = self.free[item];
+                    if free_a || free_b {
+                        let length = (b - a).norm();
+                        let u = (b - a) / length;
+                        if free_a && t * length < d {
+                            g -= d - t * length;
+                            direction -= u;
+                        }
+                        if free_b && (1.0 - t) * length < d {
+                            g -= d - (1.0 - t) * length;
+                            direction += u;
+                        }
+                    }
                     if g > 0.0 {
-                        contact(g, n);
+                        contact(g, direction);
                     }
                 }
             } else {

@@ -890,6 +890,28 @@ mod tests {
     /// A 10 × 10 lattice of spacing 0.1 has no stray particle, jittered by up to a
     /// third of its spacing neither; a particle flung 0.25 away from it is stray,
     /// and the warning asks for 1 % of the particles and 3.
+    /// The hint of an energy growth says when the bound was crossed, the Courant
+    /// number and half of it, and asks for more particles only where an element
+    /// holds fewer than its functions.
+    #[test]
+    fn the_energy_growth_hint_fits_the_step_and_the_sampling() {
+        let sparse = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), 4.5, 9);
+        for part in [
+            "it reached the bound at t = 0.2500 (step 120 of 400)",
+            "the time step is 0.50 of the critical step",
+            "lower `time.courant` (to 0.25, say",
+            "4.5 per occupied element at the end, for the 9 functions of each",
+        ] {
+            assert!(sparse.contains(part), "`{part}` not in: {sparse}");
+        }
+        let dense = energy_growth_hint(None, 400, 1e-3, None, 12.0, 3);
+        assert!(!dense.contains("per occupied element"), "{dense}");
+        assert!(
+            dense.contains("lower `time.dt`") && !dense.contains("reached"),
+            "{dense}"
+        );
+    }
+
     #[test]
     fn a_particle_flung_off_a_lattice_is_stray() {
         let lattice = |jitter: f64, flung: usize| {

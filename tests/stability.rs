@@ -429,12 +429,12 @@ fn a_freely_spinning_disk_keeps_its_rotation_with_pl() {
 /// The plate of `drop-plate.toml` vibrating in free space
 /// (`docs/examples/plate-vibration.toml`, written from the docs: no gravity, no
 /// contact, about 18 % strain): with the default mass at `courant = 0.5` the energy
-/// grows by 3.4 % over the run (stable), and the growth is the time integration's
-/// error at this strain: it falls with the square of the step (0.91 % at 0.25),
-/// while the momentum stays that of the start (docs/stability.md, "Impacts at
-/// `courant = 0.5`").
+/// grows by 0.90 % over the run (3.4 % while rows at the plate's edge switched
+/// between lumped and consistent at every other step), and by 0.31 % at 0.25, while
+/// the momentum stays that of the start (docs/stability.md, "Rows that switch at
+/// every other step").
 #[test]
-fn a_plate_vibrating_in_free_space_gains_energy_only_as_the_square_of_the_step() {
+fn a_plate_vibrating_in_free_space_gains_little_energy_and_less_with_the_step() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/docs/examples/plate-vibration.toml"
@@ -471,13 +471,13 @@ fn a_plate_vibrating_in_free_space_gains_energy_only_as_the_square_of_the_step()
         drift.push(s.energy_drift);
     }
     assert!(
-        drift[0] < 5e-2,
+        drift[0] < 1.5e-2,
         "courant 0.5: energy drift {:.3e}",
         drift[0]
     );
     assert!(
-        drift[1] < drift[0] / 3.0,
-        "half the step: energy drift {:.3e} → {:.3e}, not about a quarter",
+        drift[1] < drift[0] / 2.0,
+        "half the step: energy drift {:.3e} → {:.3e}, not less than half",
         drift[0],
         drift[1]
     );
@@ -486,12 +486,14 @@ fn a_plate_vibrating_in_free_space_gains_energy_only_as_the_square_of_the_step()
 /// The block of `docs/scenes.md` (4 × 4 particles per block, PS, the default) dropped
 /// onto a slip floor and bouncing, to t = 1.5 at `courant = 0.5`: the reported total
 /// swings after each impact by about `ω Δt` of what the impact excites, the
-/// time-centred total (`StepReport::total_centred`) does not move (measured 1.3e-2
-/// and 8e-15 of the scale). With the slip floor projected as a general constraint
+/// time-centred total (`StepReport::total_centred`) barely moves (measured 1.3e-2
+/// and 5.2e-5 of the scale; 8e-15 before the hysteresis of the default's sampling
+/// rule, which lets a row switch back to consistent at one step of the run). With the slip floor projected as a general constraint
 /// (before 2026-12-04) the centred total gained 7.7e-2: a real gain, which it shows
 /// and the oscillation hid. A jittered soft plate (`docs/examples/drop-plate.toml`)
-/// at the same Courant number does gain energy with the default (6.9e-2, open in
-/// `docs/stability.md`), and the centred total says so.
+/// at the same Courant number gained 6.9e-2 (centred) while rows at its edge
+/// switched between lumped and consistent at every other step, and 9.1e-3 since
+/// (`docs/stability.md`, "Rows that switch at every other step").
 #[test]
 fn the_time_centred_energy_tells_a_real_gain_from_the_steps_oscillation() {
     let doc = include_str!("../docs/scenes.md");
@@ -507,7 +509,7 @@ fn the_time_centred_energy_tells_a_real_gain_from_the_steps_oscillation() {
     .unwrap();
     assert!(block.failure.is_none(), "{block:?}");
     assert!(block.energy_growth > 5e-3, "{block:?}");
-    assert!(block.energy_growth_centred < 1e-6, "{block:?}");
+    assert!(block.energy_growth_centred < 1e-3, "{block:?}");
     let plate = Scene::from_toml(
         &include_str!("../docs/examples/drop-plate.toml")
             .replace("courant = 0.25", "courant = 0.5"),
@@ -515,7 +517,8 @@ fn the_time_centred_energy_tells_a_real_gain_from_the_steps_oscillation() {
     )
     .unwrap();
     let plate = run(&plate, &mut |_| {}).unwrap();
-    assert!(plate.energy_growth_centred > 5e-2, "{plate:?}");
+    assert!(plate.failure.is_none() && plate.stable, "{plate:?}");
+    assert!(plate.energy_growth_centred < 2e-2, "{plate:?}");
 }
 
 /// A user's very soft block (E = 3e3, ρ = 1000, 0.625 high: its weight would strain

@@ -433,3 +433,37 @@ fn modify_rows_for_test(
 ) {
     super::masked::modify_rows(pattern, values, lumped, masked, 1.0, diagonal_add, out);
 }
+
+/// The default strategy lumps the row of a function sampled by less than one
+/// particle, and keeps it lumped until the function is sampled by
+/// `RESTORE_PARTICLE_COUNT` (hysteresis): a function at the edge of a vibrating body
+/// whose count hovers about one would otherwise switch its row at every other step
+/// (`extended::RESTORE_PARTICLE_COUNT`).
+#[test]
+fn a_row_lumped_for_too_few_particles_stays_lumped_until_well_sampled() {
+    use super::extended::{MIN_PARTICLE_COUNT, RESTORE_PARTICLE_COUNT};
+    let mut c = column_mass();
+    let mut m = prepared(&c, MassKind::parse("default").unwrap());
+    let lumped = |m: &mut Box<dyn MassStrategy<f64>>, c: &Column| {
+        m.classify(&c.pattern, &c.values, context(c))
+            .map(|l| l.to_vec())
+            .unwrap_or_else(|| vec![false; c.ps.num_functions()])
+    };
+    // A well-covered, well-sampled function whose row is consistent.
+    let start = lumped(&mut m, &c);
+    let i = (0..c.ps.num_functions())
+        .find(|&i| !start[i] && c.particle_count[i] > RESTORE_PARTICLE_COUNT + 1.0)
+        .expect("an interior function");
+    let well = c.particle_count[i];
+    for (count, expected) in [
+        (0.5 * MIN_PARTICLE_COUNT, true),
+        (0.5 * (MIN_PARTICLE_COUNT + RESTORE_PARTICLE_COUNT), true),
+        (0.99 * RESTORE_PARTICLE_COUNT, true),
+        (well, false),
+        (0.5 * (MIN_PARTICLE_COUNT + RESTORE_PARTICLE_COUNT), false),
+        (0.5 * MIN_PARTICLE_COUNT, true),
+    ] {
+        c.particle_count[i] = count;
+        assert_eq!(lumped(&mut m, &c)[i], expected, "sampled by {count}");
+    }
+}
