@@ -331,6 +331,8 @@ struct Tally {
     sampling: f64,
     /// [`stray_particles`] at the start.
     stray_at_start: usize,
+    /// The number of [`pieces`] at the start.
+    pieces_at_start: usize,
     /// The total energy after the last completed step (the initial one before any).
     last_energy: f64,
 }
@@ -393,15 +395,18 @@ pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
 /// neighbour must be for it to count as stray ([`stray_particles`]).
 pub const STRAY_DISTANCE: f64 = 2.0;
 
-/// Particles with no other particle within [`STRAY_DISTANCE`] times their own
-/// spacing: none in a body sampled on a lattice or jittered in its cells; one for
-/// each particle a body that came apart flung off alone. A hash grid of cells of
-/// that distance (the largest particle's), the 3^D cells around each particle.
-pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
+/// Calls `pair(p, q)` for each particle `q` within [`STRAY_DISTANCE`] times the
+/// spacing `√V⁰_p` of particle `p` (`V⁰_p` in 1D): a hash grid of cells of that
+/// distance (the largest particle's), the 3^D cells around each particle. `false`
+/// when the particles have no size to measure by.
+fn neighbours<const D: usize>(
+    particles: &Particles<f64, D>,
+    mut pair: impl FnMut(usize, usize),
+) -> bool {
     let spacing = |p: usize| particles.volume0[p].powf(1.0 / D as f64);
     let reach = (0..particles.len()).map(spacing).fold(0.0, f64::max) * STRAY_DISTANCE;
     if !(reach > 0.0 && reach.is_finite()) {
-        return 0;
+        return false;
     }
     let cell = |p: usize| -> [i64; D] {
         std::array::from_fn(|k| (particles.x[p][k] / reach).floor() as i64)
@@ -410,20 +415,82 @@ pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
     for p in 0..particles.len() {
         grid.entry(cell(p)).or_default().push(p);
     }
-    (0..particles.len())
-        .filter(|&p| {
-            let (c, r) = (cell(p), STRAY_DISTANCE * spacing(p));
-            let neighbours = 3usize.pow(D as u32);
-            !(0..neighbours).any(|n| {
-                let key: [i64; D] =
-                    std::array::from_fn(|k| c[k] + ((n / 3usize.pow(k as u32)) % 3) as i64 - 1);
-                grid.get(&key).is_some_and(|near| {
-                    near.iter()
-                        .any(|&q| q != p && (particles.x[q] - particles.x[p]).norm() <= r)
-                })
-            })
-        })
-        .count()
+    for p in 0..particles.len() {
+        let (c, r) = (cell(p), STRAY_DISTANCE * spacing(p));
+        for n in 0..3usize.pow(D as u32) {
+            let key: [i64; D] =
+                std::array::from_fn(|k| c[k] + ((n / 3usize.pow(k as u32)) % 3) as i64 - 1);
+            for &q in grid.get(&key).map_or(&[][..], |v| &v[..]) {
+                if q != p && (particles.x[q] - particles.x[p]).norm() <= r {
+                    pair(p, q);
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Particles with no other particle within [`STRAY_DISTANCE`] times their own
+/// spacing: none in a body sampled on a lattice or jittered in its cells; one for
+/// each particle a body that came apart flung off alone.
+pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
+    let mut near = vec![false; particles.len()];
+    if !neighbours(particles, |p, _| near[p] = true) {
+        return 0;
+    }
+    near.iter().filter(|&&n| !n).count()
+}
+
+/// The pieces the particles form, largest first: the connected sets of the
+/// neighbour relation of [`stray_particles`] (a particle and those within
+/// [`STRAY_DISTANCE`] of its spacing), counting those of at least 3 particles and
+/// [`STRAY_WARNING`] of all. One per body on a lattice, stretched by up to about
+/// twice its spacing; two for a body torn in two.
+pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
+    fn root(parent: &mut [usize], mut a: usize) -> usize {
+        while parent[a] != a {
+            parent[a] = parent[parent[a]];
+            a = parent[a];
+        }
+        a
+    }
+    let n = particles.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    neighbours(particles, |p, q| {
+        let (a, b) = (root(&mut parent, p), root(&mut parent, q));
+        if a != b {
+            parent[a.max(b)] = a.min(b);
+        }
+    });
+    let mut size = vec![0usize; n];
+    for p in 0..n {
+        size[root(&mut parent, p)] += 1;
+    }
+    let least = 3.max((STRAY_WARNING * n as f64).ceil() as usize);
+    let mut sizes: Vec<usize> = size.into_iter().filter(|&s| s >= least).collect();
+    sizes.sort_unstable_by(|a, b| b.cmp(a));
+    sizes
+}
+
+/// The warning for a run whose particles form more [`pieces`] at the end (`end`,
+/// their sizes) than at the start (`start`): a body came apart, torn where it was
+/// stretched or broken at an impact, which an energy verdict of stable does not
+/// show (a soft neo-Hookean block hanging from a no-slip ceiling at 4 × 4 particles
+/// per block tore below its top rows and fell, its energy bounded).
+pub fn pieces_warning(start: usize, end: &[usize], particles: usize) -> Option<String> {
+    (end.len() > start).then(|| {
+        let shares: Vec<String> = end
+            .iter()
+            .take(4)
+            .map(|&s| format!("{:.0} %", 100.0 * s as f64 / particles as f64))
+            .collect();
+        let more = if end.len() > 4 { ", …" } else { "" };
+        format!(
+            "the particles form {} pieces at the end ({start} at the start), holding {}{more} of them: a body came apart (torn where it was stretched, or broken at an impact; bodies that started in contact and separated count too), which the energy verdict does not show: look at the particles (`--out`); a body torn where it stretches needs more particles per element there (`per_block`, `count` or `spacing`), one broken at an impact also a smaller `courant`",
+            end.len(),
+            shares.join(", ")
+        )
+    })
 }
 
 /// The warning for a run that ends with `end` stray particles
@@ -557,6 +624,7 @@ where
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
     let stray_at_start = stray_particles(&driver.particles);
+    let pieces_at_start = pieces(&driver.particles).len();
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
     let mut max_rotation_non_objective = driver
         .material()
@@ -639,6 +707,7 @@ where
         max_rotation_non_objective,
         sampling,
         stray_at_start,
+        pieces_at_start,
         last_energy,
     }
 }
@@ -871,6 +940,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     stray_particles(&driver.particles),
                     driver.particles.len(),
                 ))
+                .chain(pieces_warning(
+                    tally.pieces_at_start,
+                    &pieces(&driver.particles),
+                    driver.particles.len(),
+                ))
                 .collect(),
             interrupted: tally.interrupted,
             seconds: tally.seconds,
@@ -890,28 +964,6 @@ mod tests {
     /// A 10 × 10 lattice of spacing 0.1 has no stray particle, jittered by up to a
     /// third of its spacing neither; a particle flung 0.25 away from it is stray,
     /// and the warning asks for 1 % of the particles and 3.
-    /// The hint of an energy growth says when the bound was crossed, the Courant
-    /// number and half of it, and asks for more particles only where an element
-    /// holds fewer than its functions.
-    #[test]
-    fn the_energy_growth_hint_fits_the_step_and_the_sampling() {
-        let sparse = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), 4.5, 9);
-        for part in [
-            "it reached the bound at t = 0.2500 (step 120 of 400)",
-            "the time step is 0.50 of the critical step",
-            "lower `time.courant` (to 0.25, say",
-            "4.5 per occupied element at the end, for the 9 functions of each",
-        ] {
-            assert!(sparse.contains(part), "`{part}` not in: {sparse}");
-        }
-        let dense = energy_growth_hint(None, 400, 1e-3, None, 12.0, 3);
-        assert!(!dense.contains("per occupied element"), "{dense}");
-        assert!(
-            dense.contains("lower `time.dt`") && !dense.contains("reached"),
-            "{dense}"
-        );
-    }
-
     #[test]
     fn a_particle_flung_off_a_lattice_is_stray() {
         let lattice = |jitter: f64, flung: usize| {
@@ -938,5 +990,60 @@ mod tests {
             .unwrap()
             .contains("3 of the 100 particles"));
         assert!(stray_warning(3, 5, 100).is_none());
+    }
+
+    /// The hint of an energy growth says when the bound was crossed, the Courant
+    /// number and half of it, and asks for more particles only where an element
+    /// holds fewer than its functions.
+    #[test]
+    fn the_energy_growth_hint_fits_the_step_and_the_sampling() {
+        let sparse = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), 4.5, 9);
+        for part in [
+            "it reached the bound at t = 0.2500 (step 120 of 400)",
+            "the time step is 0.50 of the critical step",
+            "lower `time.courant` (to 0.25, say",
+            "4.5 per occupied element at the end, for the 9 functions of each",
+        ] {
+            assert!(sparse.contains(part), "`{part}` not in: {sparse}");
+        }
+        let dense = energy_growth_hint(None, 400, 1e-3, None, 12.0, 3);
+        assert!(!dense.contains("per occupied element"), "{dense}");
+        assert!(
+            dense.contains("lower `time.dt`") && !dense.contains("reached"),
+            "{dense}"
+        );
+    }
+
+    /// A lattice is one piece, stretched by half its spacing too; torn in two it is
+    /// two, and the warning gives their shares; a few particles flung off are not a
+    /// piece (they are stray).
+    #[test]
+    fn a_lattice_torn_in_two_is_two_pieces() {
+        let lattice = |stretch: f64, gap: f64, flung: usize| {
+            let x: Vec<Vector2<f64>> = (0..100)
+                .map(|i| {
+                    let (a, b) = ((i % 10) as f64, (i / 10) as f64);
+                    let mut x = Vector2::new(
+                        0.1 * a,
+                        0.1 * stretch * b + if b >= 7.0 { gap } else { 0.0 },
+                    );
+                    if i < flung {
+                        x.x = -0.5 - 0.3 * i as f64;
+                    }
+                    x
+                })
+                .collect();
+            Particles::<f64, 2>::new(x, vec![0.01; 100], 1.0)
+        };
+        assert_eq!(pieces(&lattice(1.0, 0.0, 0)), vec![100]);
+        assert_eq!(pieces(&lattice(1.5, 0.0, 0)), vec![100]);
+        assert_eq!(pieces(&lattice(1.0, 0.5, 0)), vec![70, 30]);
+        assert_eq!(pieces(&lattice(1.0, 0.0, 2)), vec![98]);
+        assert!(pieces_warning(1, &[100], 100).is_none());
+        let warning = pieces_warning(1, &[70, 30], 100).unwrap();
+        assert!(
+            warning.contains("2 pieces at the end (1 at the start), holding 70 %, 30 %"),
+            "{warning}"
+        );
     }
 }
