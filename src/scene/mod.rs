@@ -159,9 +159,10 @@ pub struct Resolution {
 
 /// How a refinement study refines a scene: level `l` multiplies the block counts
 /// along the `refine` axes (all axes by default) and the elements of an interval by
-/// `2^l`, divides a polygon's edge length by `2^l` (and multiplies particle counts
-/// along every axis by `2^l`, keeping particles per element about constant). The
-/// time step and particles per block stay.
+/// `2^l` and divides a polygon's edge length by `2^l`. Along the axes whose element
+/// size shrinks, body particle counts are multiplied and spacings divided by `2^l`,
+/// keeping particles per element about constant. The time step and particles per
+/// block stay.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StudySpec {
