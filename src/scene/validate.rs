@@ -4,8 +4,8 @@ use super::limits::{
     MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
 };
 use super::{
-    bad, conflict, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference,
-    Scene, SceneError,
+    bad, conflict, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec,
+    Reference, Scene, SceneError,
 };
 
 impl Scene {
@@ -441,6 +441,12 @@ impl Scene {
                     return Err(bad(
                         field("per_block"),
                         "needs a `blocks` or `interval` mesh",
+                    ));
+                }
+                if self.bodies.iter().all(|b| b.shape == BodyShape::Gmsh) {
+                    return Err(conflict(
+                        field("per_block"),
+                        "every body is a Gmsh body (`shape = \"gmsh\"`), whose particles `per_triangle` and `subdivide` set: `per_block` would change none",
                     ));
                 }
             }
