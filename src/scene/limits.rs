@@ -95,9 +95,31 @@ pub fn echo(text: &str) -> String {
     out
 }
 
+/// A number as it is echoed in messages: Rust's shortest round-trip digits, in
+/// exponent notation outside `1e-4 ≤ |x| < 1e16`, so that no value (`1e-320`,
+/// `1e300`) is printed as hundreds of digits.
+pub fn echo_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn echo_number_is_short() {
+        assert_eq!(echo_number(-100.0), "-100");
+        assert_eq!(echo_number(0.25), "0.25");
+        assert_eq!(echo_number(0.0), "0");
+        assert_eq!(echo_number(f64::NAN), "NaN");
+        assert_eq!(echo_number(1e-320), "1e-320");
+        assert_eq!(echo_number(-2.5e300), "-2.5e300");
+        assert_eq!(echo_number(1e15), "1000000000000000");
+    }
 
     #[test]
     fn echo_escapes_and_cuts() {

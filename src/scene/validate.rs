@@ -139,7 +139,7 @@ impl Scene {
                 check_elements("mesh.elements", *elements)?;
             }
         }
-        super::bodies::validate_material("material", &self.material)?;
+        super::bodies::validate_material("material", &self.material, self.dim)?;
         self.validate_bodies()?;
         self.validate_velocity("initial_velocity", &self.initial_velocity)?;
         for (i, bc) in self.boundaries.iter().enumerate() {

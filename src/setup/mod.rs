@@ -142,11 +142,19 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
     // one (a mesh-based guess) only sets the driver up.
     let dt = scene.dt(h);
-    if !(dt > 0.0 && dt.is_finite()) {
+    if !(dt.is_normal() && dt > 0.0) {
+        // A fixed `dt` is validated; this is the Courant-number guess `C h / c`.
+        use crate::scene::limits::echo_number;
         return Err(SceneError::new(
-            "time",
-            ErrorKind::Value,
-            format!("the time step {dt} is not positive"),
+            "time.courant",
+            ErrorKind::Conflict,
+            format!(
+                "the time step C h / c = {} from courant = {}, element size h = {} and P-wave speed c = {} (of the materials' young, poisson and density) is not a finite positive number: the element size and the materials' constants are too far apart",
+                echo_number(dt),
+                echo_number(scene.time.courant.unwrap_or(f64::NAN)),
+                echo_number(h),
+                echo_number(scene.wave_speed())
+            ),
         )
         .into());
     }

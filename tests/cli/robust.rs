@@ -308,7 +308,7 @@ fn scene_cases() -> Vec<Case> {
         scene_case(
             "density-underflows",
             bar(&[("density = 1.0", "density = 5e-324")]),
-            "material.density: the particles of body[0] would have mass 0e0",
+            "material.density: density = 5e-324 is out of range: ρ ≥ 2.2e-308 (subnormal numbers are refused)",
         ),
         scene_case(
             "body-volume-underflows",
