@@ -109,7 +109,10 @@ impl Scene {
             .filter(|f| *f <= 4096)
             .ok_or_else(|| bad("study", format!("level {level} is too fine")))?;
         let listed = |axis: usize| {
-            self.study.refine.is_empty() || self.study.refine.iter().any(|c| c.index() == axis)
+            self.study
+                .refine
+                .as_ref()
+                .is_none_or(|r| r.iter().any(|a| a.index() == axis))
         };
         // The axes along which the element size shrinks: a polygon mesh's edge
         // length shrinks along every axis, an interval's along its one axis.

@@ -166,9 +166,30 @@ pub struct Resolution {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StudySpec {
-    /// Axes whose block counts are refined (empty: all).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub refine: Vec<Component>,
+    /// Axes whose block counts are refined (absent: all; an empty list is an
+    /// error, so is an axis listed twice).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refine: Option<Vec<Axis>>,
+}
+
+/// A coordinate axis (`study.refine`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// First axis.
+    X,
+    /// Second axis.
+    Y,
+}
+
+impl Axis {
+    /// Axis index: 0 for `x`, 1 for `y`.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+        }
+    }
 }
 
 /// The mesh of a scene.
@@ -529,12 +550,6 @@ impl Component {
             Component::Y => Some(1),
             Component::Normal => None,
         }
-    }
-
-    /// Axis index of `x` and `y`; the normal counts as axis 0 (for `study.refine`,
-    /// where only axes are meaningful and validation rejects `normal`).
-    pub fn index(self) -> usize {
-        self.axis().unwrap_or(0)
     }
 }
 

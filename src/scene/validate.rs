@@ -1,11 +1,12 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
+    echo, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS,
+    MAX_TRIANGLES,
 };
 use super::{
-    bad, conflict, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec,
-    Reference, Scene, SceneError,
+    bad, conflict, Axis, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel,
+    MeshSpec, Reference, Scene, SceneError,
 };
 
 impl Scene {
@@ -146,6 +147,30 @@ impl Scene {
             if bc.fix.is_empty() {
                 return Err(bad(format!("boundary[{i}].fix"), "lists no component"));
             }
+            if let Some((k, c)) = bc
+                .fix
+                .iter()
+                .enumerate()
+                .find(|(k, c)| bc.fix[..*k].contains(c))
+            {
+                return Err(bad(
+                    format!("boundary[{i}].fix"),
+                    format!(
+                        "`{}` is listed twice (entries {} and {k})",
+                        format!("{c:?}").to_lowercase(),
+                        bc.fix.iter().position(|b| b == c).unwrap_or(0)
+                    ),
+                ));
+            }
+            if let Some(j) = self.boundaries[..i].iter().position(|o| o.tag == bc.tag) {
+                return Err(conflict(
+                    format!("boundary[{i}].tag"),
+                    format!(
+                        "`{}` is already held by boundary[{j}]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)",
+                        echo(&bc.tag)
+                    ),
+                ));
+            }
             if bc.fix.contains(&Component::Normal) && bc.fix.len() > 1 {
                 return Err(conflict(
                     format!("boundary[{i}].fix"),
@@ -270,14 +295,33 @@ impl Scene {
                 ));
             }
         }
-        if self.study.refine.contains(&Component::Normal) {
-            return Err(bad("study.refine", "lists axes, `x` or `y`"));
-        }
-        if d == 1 && self.study.refine.contains(&Component::Y) {
-            return Err(bad(
-                "study.refine",
-                "`y` does not exist in a 1D scene (refine `x` or leave it out)",
-            ));
+        if let Some(refine) = &self.study.refine {
+            if refine.is_empty() {
+                return Err(bad(
+                    "study.refine",
+                    "lists no axis: list `x`, `y` or both, or leave `refine` out to refine every axis",
+                ));
+            }
+            if let Some((i, a)) = refine
+                .iter()
+                .enumerate()
+                .find(|(i, a)| refine[..*i].contains(a))
+            {
+                return Err(bad(
+                    "study.refine",
+                    format!(
+                        "`{}` is listed twice (entries {} and {i})",
+                        format!("{a:?}").to_lowercase(),
+                        refine.iter().position(|b| b == a).unwrap_or(0)
+                    ),
+                ));
+            }
+            if d == 1 && refine.contains(&Axis::Y) {
+                return Err(bad(
+                    "study.refine",
+                    "`y` does not exist in a 1D scene (refine `x` or leave it out)",
+                ));
+            }
         }
         self.validate_resolutions()?;
         for (i, t) in self.output.tracked.iter().enumerate() {
@@ -385,6 +429,18 @@ impl Scene {
         let d = self.dim;
         for (i, r) in self.resolutions.iter().enumerate() {
             let field = |f: &str| format!("resolution[{i}].{f}");
+            if let Some(j) = self.resolutions[..i]
+                .iter()
+                .position(|o| o.basis == r.basis)
+            {
+                return Err(conflict(
+                    field("basis"),
+                    format!(
+                        "`{}` already has a resolution (resolution[{j}]): give each basis one [[resolution]]",
+                        r.basis.name()
+                    ),
+                ));
+            }
             if r.basis.dim() != d {
                 return Err(bad(
                     field("basis"),

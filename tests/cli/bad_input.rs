@@ -760,8 +760,26 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]", "tags = @@[\"bottom\", \"right\"]")
             .expect("mesh.tags: needs one tag per outline segment (4), got 2"),
         case("refine-normal", BAR)
-            .edit("refine = [\"x\"]", "refine = @@[\"normal\"]")
-            .expect("study.refine: lists axes, `x` or `y`"),
+            .edit("refine = [\"x\"]", "refine = [@@\"normal\"]")
+            .expect("study.refine: unknown variant `normal`, expected `x` or `y`"),
+        case("refine-z", BAR)
+            .edit("refine = [\"x\"]", "refine = [@@\"z\"]")
+            .expect("study.refine: unknown variant `z`, expected `x` or `y`"),
+        case("refine-nothing", BAR)
+            .edit("refine = [\"x\"]", "refine = @@[]")
+            .expect("study.refine: lists no axis: list `x`, `y` or both, or leave `refine` out to refine every axis"),
+        case("refine-an-axis-twice", BAR)
+            .edit("refine = [\"x\"]", "refine = @@[\"x\", \"y\", \"x\"]")
+            .expect("study.refine: `x` is listed twice (entries 0 and 2)"),
+        case("fix-a-component-twice", BAR)
+            .edit("tag = \"right\"\nfix = [\"x\", \"y\"]", "tag = \"right\"\nfix = @@[\"y\", \"y\"]")
+            .expect("boundary[1].fix: `y` is listed twice (entries 0 and 1)"),
+        case("a-tag-in-two-boundaries", BAR)
+            .edit("tag = \"right\"\nfix = [\"x\", \"y\"]", "tag = \"right\"\nfix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = @@\"left\"\nfix = [\"normal\"]")
+            .expect("boundary[2].tag: `left` is already held by boundary[0]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)"),
+        case("a-basis-in-two-resolutions", BAR)
+            .edit("[study]", "[[resolution]]\nbasis = @@\"pl\"\nblocks = [16, 2]\n\n[study]")
+            .expect("resolution[1].basis: `pl` already has a resolution (resolution[0]): give each basis one [[resolution]]"),
         case("tracked-point-with-one-coordinate", BAR)
             .edit("tracked = [[2.0, 0.5]]", "tracked = @@[[2.0]]")
             .expect("output.tracked[0]: needs 2 entries, got 1"),

@@ -366,7 +366,7 @@ fn scene_cases() -> Vec<Case> {
         scene_case(
             "study-refine-normal",
             format!("{BAR}\n[study]\nrefine = [\"normal\"]\n"),
-            "study.refine: lists axes",
+            "study.refine: unknown variant `normal`, expected `x` or `y`",
         ),
         scene_case(
             "boundary-tag-with-control-characters",
