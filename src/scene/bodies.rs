@@ -7,7 +7,8 @@ use super::{
     bad, conflict, Body, BodyShape, ErrorKind, InitialVelocity, MaterialSpec, MeshSpec, Scene,
     SceneError,
 };
-use psmpm_basis::mesh::generators::PolygonDomain;
+use psmpm_basis::mesh::generators::{PolygonDomain, PolygonPart};
+use psmpm_basis::mesh::MeshError;
 use psmpm_basis::Vec2;
 
 /// The fields each shape takes beyond the common ones (`shape`, `material`,
@@ -214,14 +215,12 @@ impl Scene {
                 }
                 // The mesher's domain check: no crossing or touching segments, holes
                 // inside the outline and not nested.
-                region_polygon(body).validate().map_err(|e| {
-                    let message = e.to_string();
-                    let name = if message.contains("hole") {
-                        "holes"
-                    } else {
-                        "outline"
+                region_polygon(body).check().map_err(|f| {
+                    let name = match f.part {
+                        PolygonPart::Hole(h) | PolygonPart::HoleTag(h) => format!("holes[{h}]"),
+                        PolygonPart::Outer | PolygonPart::OuterTags => "outline".to_string(),
                     };
-                    bad(field(name), message)
+                    bad(field(&name), MeshError::from(f).to_string())
                 })?;
             }
             BodyShape::Disk => {

@@ -759,6 +759,26 @@ fn inconsistent_cases() -> Vec<Case> {
         case("polygon-with-two-tags", SQUARE)
             .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]", "tags = @@[\"bottom\", \"right\"]")
             .expect("mesh.tags: needs one tag per outline segment (4), got 2"),
+        // A polygon mesh's faults name the part at fault, at its line.
+        case("hole-crossing-the-outline", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = @@[[0.8, 0.4], [1.2, 0.4], [1.2, 0.6], [0.8, 0.6]]\ntag = \"a\"\n")
+            .expect("mesh.holes[0].outline: invalid mesh parameter: the boundary intersects itself: segment (1, 0)–(1, 1) of the outer polygon meets segment (0.8, 0.4)–(1.2, 0.4) of hole `a`"),
+        case("second-hole-inside-the-first", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.2, 0.2], [0.8, 0.2], [0.8, 0.8], [0.2, 0.8]]\ntag = \"a\"\n\n[[mesh.holes]]\noutline = @@[[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]\ntag = \"b\"\n")
+            .expect("mesh.holes[1].outline: invalid mesh parameter: holes `a` and `b` are nested (one lies inside the other)"),
+        case("hole-with-two-corners", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = @@[[0.4, 0.4], [0.6, 0.4]]\ntag = \"a\"\n")
+            .expect("mesh.holes[0].outline: invalid mesh parameter: hole `a` needs at least 3 corners, got 2"),
+        case("hole-with-an-empty-tag", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]\ntag = @@\"\"\n")
+            .expect("mesh.holes[0].tag: invalid mesh parameter: boundary tags must not be empty"),
+        case("outline-with-an-empty-tag", SQUARE)
+            .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]", "tags = @@[\"bottom\", \"\", \"top\", \"left\"]")
+            .expect("mesh.tags: invalid mesh parameter: boundary tags must not be empty"),
+        case("outline-on-one-line", SQUARE)
+            .edit("outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]", "outline = @@[[0.0, 0.0], [0.5, 0.0], [1.0, 0.0]]")
+            .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]\n", "")
+            .expect("mesh.outline: invalid mesh parameter: the outer polygon encloses no area (its corners lie on one line)"),
         case("refine-normal", BAR)
             .edit("refine = [\"x\"]", "refine = [@@\"normal\"]")
             .expect("study.refine: unknown variant `normal`, expected `x` or `y`"),
