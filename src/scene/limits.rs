@@ -77,6 +77,12 @@ pub fn read_mesh(file: &str) -> Result<psmpm_basis::TriMesh, String> {
         .map_err(|e| e.to_string())
 }
 
+/// Most characters of a scene's `name` (printed in tables and titles).
+pub const MAX_NAME_CHARS: usize = 200;
+
+/// Most characters of a scene's `description` (one line).
+pub const MAX_DESCRIPTION_CHARS: usize = 2000;
+
 /// User text as it is echoed in messages: control characters escaped (`\n`,
 /// `\u{1b}`, …) and cut to [`MAX_ECHO_CHARS`] characters with an ellipsis.
 pub fn echo(text: &str) -> String {

@@ -304,6 +304,18 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
         };
         return (at, Some(name.clone()), format!("{name}: {message}"));
     }
+    // A table header given twice (`[material]` … `[material]`): name the table.
+    if message.starts_with("duplicate key") {
+        let line_start = text[..at.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
+        let line = text[line_start..].lines().next().unwrap_or("");
+        if let Some((name, false)) = header(line) {
+            return (
+                line_start + (line.len() - line.trim_start().len()),
+                Some(name.clone()),
+                format!("{name}: duplicate table `[{name}]`: give each table once"),
+            );
+        }
+    }
     // Name the field when the error is about a key or a value (not about the
     // syntax between them).
     let about_value = {

@@ -1,8 +1,8 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    echo, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS,
-    MAX_TRIANGLES,
+    echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D,
+    MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
 };
 use super::{
     bad, conflict, Axis, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel,
@@ -27,7 +27,23 @@ impl Scene {
             ));
         }
         // Names and descriptions are printed and written into SVG and JSON files.
-        for (field, text) in [("name", &self.name), ("description", &self.description)] {
+        if self.name.trim().is_empty() {
+            return Err(bad(
+                "name",
+                "is empty: the scene's name is printed and names its output files",
+            ));
+        }
+        for (field, text, limit) in [
+            ("name", &self.name, MAX_NAME_CHARS),
+            ("description", &self.description, MAX_DESCRIPTION_CHARS),
+        ] {
+            let chars = text.chars().count();
+            if chars > limit {
+                return Err(bad(
+                    field,
+                    format!("is {chars} characters long, above the limit of {limit}"),
+                ));
+            }
             if let Some(c) = text.chars().find(|c| c.is_control()) {
                 return Err(bad(
                     field,
@@ -43,14 +59,20 @@ impl Scene {
             if v.is_finite() {
                 Ok(())
             } else {
-                Err(bad(field, format!("must be finite, got {v}")))
+                Err(bad(
+                    field,
+                    format!("must be finite, got {}", echo_number(v)),
+                ))
             }
         };
         let positive = |field: &str, v: f64| -> Result<(), SceneError> {
             if v > 0.0 && v.is_finite() {
                 Ok(())
             } else {
-                Err(bad(field, format!("must be positive and finite, got {v}")))
+                Err(bad(
+                    field,
+                    format!("must be positive and finite, got {}", echo_number(v)),
+                ))
             }
         };
         let vector = |field: &str, v: &[f64]| -> Result<(), SceneError> {

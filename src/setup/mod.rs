@@ -370,7 +370,7 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
     driver: &mut SceneDriver<D, B>,
     dt: f64,
 ) -> Result<(f64, usize, Option<f64>), RunError> {
-    use crate::scene::limits::MAX_STEPS;
+    use crate::scene::limits::{echo_number, MAX_STEPS};
     let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
     match scene.time.courant {
         Some(c) => {
@@ -383,7 +383,11 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                 return Err(SceneError::new(
                     "time.t_end",
                     ErrorKind::Conflict,
-                    format!("is shorter than one time step (t_end = {t_end}, courant = {c} gives dt = {step:e})"),
+                    format!(
+                        "is shorter than one time step (t_end = {}, courant = {} gives dt = {step:e})",
+                        echo_number(t_end),
+                        echo_number(c)
+                    ),
                 )
                 .into());
             }
@@ -391,7 +395,11 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                 return Err(SceneError::new(
                     "time.t_end",
                     ErrorKind::Value,
-                    format!("t_end = {t_end} with courant = {c} (dt = {step:e}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}"),
+                    format!(
+                        "t_end = {} with courant = {} (dt = {step:e}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}",
+                        echo_number(t_end),
+                        echo_number(c)
+                    ),
                 )
                 .into());
             }

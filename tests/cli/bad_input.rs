@@ -362,6 +362,9 @@ fn syntax_cases() -> Vec<Case> {
         case("duplicate-key", BAR)
             .edit("density = 1.0", "density = 1.0\n@@density = 2.0")
             .expect("material.density: duplicate key"),
+        case("duplicate-table", BAR)
+            .edit("[time]", "@@[material]\nyoung = 5.0\ndensity = 1.0\n\n[time]")
+            .expect("material: duplicate table `[material]`: give each table once"),
         case("key-without-value", BAR)
             .edit("young = 100.0", "young @@100.0")
             .expect("key with no value, expected `=`"),
@@ -536,6 +539,18 @@ fn unknown_name_cases() -> Vec<Case> {
 
 fn range_cases() -> Vec<Case> {
     vec![
+        case("empty-name", BAR)
+            .edit("name = \"bar\"", "name = @@\" \"")
+            .expect("name: is empty: the scene's name is printed and names its output files"),
+        case("long-name", BAR)
+            .edit("name = \"bar\"", &format!("name = @@\"{}\"", "n".repeat(201)))
+            .expect("name: is 201 characters long, above the limit of 200"),
+        case("long-description", BAR)
+            .edit("description = \"a bar fixed at both ends\"", &format!("description = @@\"{}\"", "d".repeat(2001)))
+            .expect("description: is 2001 characters long, above the limit of 2000"),
+        case("tiny-t-end-in-short-form", COLUMN)
+            .edit("t_end = 0.01", "t_end = @@1e-300")
+            .expect("time.t_end: is shorter than one time step (t_end = 1e-300, courant = 0.5 gives dt = 1.1374681029968743e-3)"),
         case("dim-3", BAR)
             .edit("dim = 2", "dim = @@3")
             .expect("dim: must be 1 or 2, got 3"),
