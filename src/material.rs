@@ -28,7 +28,7 @@ use nalgebra::SMatrix;
 /// Invalid material parameters.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MaterialError {
-    #[error("{name} = {value} is out of range: {allowed}")]
+    #[error("{name} = {} is out of range: {allowed}", crate::scene::limits::echo_number(*value))]
     OutOfRange {
         name: &'static str,
         value: f64,
@@ -48,28 +48,46 @@ pub struct Elastic {
 }
 
 impl Elastic {
-    /// Checks `E > 0`, `ρ > 0`, `−1 < ν < 0.5`.
+    /// Checks `E > 0`, `ρ > 0`, `−1 < ν < 0.5`, each a finite normal float (`ν`
+    /// may be 0): a subnormal `E` or `ρ` (below 2.2e-308) would turn the wave speed
+    /// and the time step into 0 or infinity.
     pub fn new(young: f64, poisson: f64, density: f64) -> Result<Self, MaterialError> {
+        let out = |name, value, allowed| {
+            Err(MaterialError::OutOfRange {
+                name,
+                value,
+                allowed,
+            })
+        };
         if !(young > 0.0 && young.is_finite()) {
-            return Err(MaterialError::OutOfRange {
-                name: "young",
-                value: young,
-                allowed: "E > 0",
-            });
+            return out("young", young, "E > 0");
+        }
+        if !young.is_normal() {
+            return out(
+                "young",
+                young,
+                "E ≥ 2.2e-308 (subnormal numbers are refused)",
+            );
         }
         if !(density > 0.0 && density.is_finite()) {
-            return Err(MaterialError::OutOfRange {
-                name: "density",
-                value: density,
-                allowed: "ρ > 0",
-            });
+            return out("density", density, "ρ > 0");
+        }
+        if !density.is_normal() {
+            return out(
+                "density",
+                density,
+                "ρ ≥ 2.2e-308 (subnormal numbers are refused)",
+            );
         }
         if !(poisson > -1.0 && poisson < 0.5) {
-            return Err(MaterialError::OutOfRange {
-                name: "poisson",
-                value: poisson,
-                allowed: "−1 < ν < 0.5",
-            });
+            return out("poisson", poisson, "−1 < ν < 0.5");
+        }
+        if poisson != 0.0 && !poisson.is_normal() {
+            return out(
+                "poisson",
+                poisson,
+                "ν = 0 or |ν| ≥ 2.2e-308 (subnormal numbers are refused)",
+            );
         }
         Ok(Elastic {
             young,

@@ -396,7 +396,7 @@ fn bad_bodies_are_errors_naming_the_field() {
                 "[[body]]\nshape = \"polygon\"\noutline = [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]\nholes = [[[3.0, 3.0], [3.5, 3.0], [3.5, 3.5]]]\ncount = [4, 4]",
                 "",
             ),
-            "body[0].holes",
+            "body[0].holes[0]",
             ErrorKind::Value,
             "outside the outer polygon",
         ),

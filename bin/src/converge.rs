@@ -38,8 +38,14 @@ pub struct ConvergeArgs {
     overrides: Overrides,
     /// Write the table as CSV and JSON and the log-log error-vs-h and
     /// error-vs-wall-time plots (SVG) into this directory.
-    #[arg(long)]
+    /// DIR must be new, empty or hold only these files, checked before the study runs.
+    #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// With --out: replace the files of an earlier study in DIR (converge.csv,
+    /// converge.json and the two plots). Without it a DIR that is not empty is
+    /// refused; a DIR holding other files is refused even with it.
+    #[arg(long, requires = "out")]
+    overwrite: bool,
     /// Exit with status 1 when a variant failed or is unstable (default: 0, the
     /// table marks it).
     #[arg(long)]
@@ -59,6 +65,14 @@ pub struct ConvergeArgs {
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
+
+/// The files `--out` writes.
+const OUT_FILES: [&str; 4] = [
+    "converge.csv",
+    "converge.json",
+    "error-vs-h.svg",
+    "work-precision.svg",
+];
 
 /// The columns of the table and of `converge.csv`.
 const COLUMNS: [&str; 11] = [
@@ -358,6 +372,9 @@ pub fn prepare(args: &ConvergeArgs) -> Result<Vec<Scene>, CliError> {
 /// Runs the study and prints it.
 pub fn converge(args: ConvergeArgs) -> Result<(), CliError> {
     let (base, against, scenes) = levels(&args)?;
+    if let Some(dir) = &args.out {
+        crate::out::prepare_out(dir, args.overwrite, |name| OUT_FILES.contains(&name))?;
+    }
     let pool = crate::run::thread_pool(args.threads)?;
     pool.install(|| study(&args, base, against, scenes))
 }
@@ -683,7 +700,6 @@ fn write_outputs(dir: &std::path::Path, scene: &str, study: &Study) -> Result<()
     let io = |path: &std::path::Path, e: std::io::Error| {
         CliError::Input(format!("{}: cannot write: {e}", path.display()))
     };
-    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
     let path = dir.join("converge.csv");
     std::fs::write(&path, csv(rows)).map_err(|e| io(&path, e))?;
     let path = dir.join("converge.json");

@@ -155,6 +155,31 @@ pub fn is_output_file(name: &str) -> bool {
         .contains(&name)
 }
 
+/// Prepares the `--out DIR` of a command before it runs anything: `DIR` must be new,
+/// empty, or hold only files the command writes (`owned`), which `overwrite`
+/// (`--overwrite`) removes and which are refused without it; anything else in `DIR`
+/// is refused. Returns whether `DIR` was made.
+pub fn prepare_out(
+    dir: &Path,
+    overwrite: bool,
+    owned: impl Fn(&str) -> bool,
+) -> Result<bool, CliError> {
+    let created = !dir.exists();
+    prepare_dir(dir, overwrite, owned).map_err(|e| {
+        let hint = match e {
+            OutputError::NotEmpty { .. } => {
+                "; pass --overwrite to replace them, or choose another --out"
+            }
+            OutputError::Foreign { .. } => {
+                "; choose another --out (--overwrite only replaces the files this command writes)"
+            }
+            _ => "",
+        };
+        CliError::Input(format!("{e}{hint}"))
+    })?;
+    Ok(created)
+}
+
 /// How `run --out` writes its directory.
 #[derive(Debug, Clone, Copy)]
 pub struct OutOptions {
@@ -225,19 +250,7 @@ impl Recorder {
     /// header of `diagnostics.csv`, so that a directory that cannot be written is
     /// reported before the run.
     pub fn create(dir: &Path, options: OutOptions, scene: &Scene) -> Result<Self, CliError> {
-        let created_dir = !dir.exists();
-        prepare_dir(dir, options.overwrite, is_output_file).map_err(|e| {
-            let hint = match e {
-                OutputError::NotEmpty { .. } => {
-                    "; pass --overwrite to replace them, or choose another --out"
-                }
-                OutputError::Foreign { .. } => {
-                    "; choose another --out (--overwrite only replaces the files of a run)"
-                }
-                _ => "",
-            };
-            CliError::Input(format!("{e}{hint}"))
-        })?;
+        let created_dir = prepare_out(dir, options.overwrite, is_output_file)?;
         let every = options.every;
         let out = OutputDir::create(dir, 0)
             .map_err(output_error)?

@@ -12,7 +12,7 @@ use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
 use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
-use psmpm::scene::{parse_split, BlockLayout, Scene, SceneError};
+use psmpm::scene::{parse_split, BlockLayout, BodyShape, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
 use std::io::Write;
@@ -59,6 +59,9 @@ pub struct Overrides {
     pub condition: bool,
 }
 
+/// Why `--particles` has no effect on a scene whose bodies are all Gmsh bodies.
+const GMSH_BODIES_ONLY: &str = "every body is a Gmsh body (`shape = \"gmsh\"`), whose particles `per_triangle` and `subdivide` set; --particles sets the particles per block of box, polygon and disk bodies";
+
 impl Overrides {
     /// Applies the overrides to `s` and validates it.
     pub fn apply(&self, mut s: Scene) -> Result<Scene, CliError> {
@@ -82,6 +85,12 @@ impl Overrides {
         if let Some(p) = &self.particles {
             let (px, py) = pair(p, "--particles")?;
             one_d("--particles", p, py)?;
+            if s.bodies.iter().all(|b| b.shape == BodyShape::Gmsh) {
+                return Err(CliError::Input(format!(
+                    "--particles {}: {GMSH_BODIES_ONLY}",
+                    echo(p)
+                )));
+            }
             s.set_particles_per_block([px, py]);
         }
         if let Some(split) = &self.split {

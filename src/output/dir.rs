@@ -48,7 +48,7 @@ pub enum OutputError {
     },
     /// The directory holds entries that are not output files (never removed).
     #[error(
-        "output directory `{}` holds {} that this tool does not write ({}); they are never removed or mixed with a run's files",
+        "output directory `{}` holds {} that this command does not write ({}); they are never removed or mixed with its files",
         path.display(), count(*files), listing(names)
     )]
     Foreign {

@@ -2,12 +2,13 @@
 //! lattice, its material and initial velocity (its own or the scene's), and the
 //! number of particles of all bodies, bounded before any is made.
 
-use super::limits::{MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS};
+use super::limits::{echo_number, MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS};
 use super::{
     bad, conflict, Body, BodyShape, ErrorKind, InitialVelocity, MaterialSpec, MeshSpec, Scene,
     SceneError,
 };
-use psmpm_basis::mesh::generators::PolygonDomain;
+use psmpm_basis::mesh::generators::{PolygonDomain, PolygonPart};
+use psmpm_basis::mesh::MeshError;
 use psmpm_basis::Vec2;
 
 /// The fields each shape takes beyond the common ones (`shape`, `material`,
@@ -31,7 +32,7 @@ impl Scene {
             self.validate_shape(b, body)?;
             self.validate_lattice(b, body)?;
             if let Some(m) = &body.material {
-                validate_material(&format!("body[{b}].material"), m)?;
+                validate_material(&format!("body[{b}].material"), m, self.dim)?;
             }
             if let Some(v) = &body.initial_velocity {
                 self.validate_velocity(&format!("body[{b}].initial_velocity"), v)?;
@@ -214,14 +215,12 @@ impl Scene {
                 }
                 // The mesher's domain check: no crossing or touching segments, holes
                 // inside the outline and not nested.
-                region_polygon(body).validate().map_err(|e| {
-                    let message = e.to_string();
-                    let name = if message.contains("hole") {
-                        "holes"
-                    } else {
-                        "outline"
+                region_polygon(body).check().map_err(|f| {
+                    let name = match f.part {
+                        PolygonPart::Hole(h) | PolygonPart::HoleTag(h) => format!("holes[{h}]"),
+                        PolygonPart::Outer | PolygonPart::OuterTags => "outline".to_string(),
                     };
-                    bad(field(name), message)
+                    bad(field(&name), MeshError::from(f).to_string())
                 })?;
             }
             BodyShape::Disk => {
@@ -431,14 +430,35 @@ impl Scene {
     }
 }
 
-/// A material's constants in range; the error names `field.young` and so on.
-pub(super) fn validate_material(field: &str, m: &MaterialSpec) -> Result<(), SceneError> {
-    crate::material::Elastic::new(m.young, m.poisson, m.density).map_err(|e| {
+/// A material's constants in range; the error names `field.young` and so on. The
+/// P-wave speed `√((λ + 2μ) / ρ)` in dimension `dim` they give must be a finite
+/// positive normal number too (each constant in range, `young / density` can still
+/// overflow or underflow): the critical time step is inversely proportional to it.
+pub(super) fn validate_material(
+    field: &str,
+    m: &MaterialSpec,
+    dim: usize,
+) -> Result<(), SceneError> {
+    let elastic = crate::material::Elastic::new(m.young, m.poisson, m.density).map_err(|e| {
         let name = match &e {
             crate::material::MaterialError::OutOfRange { name, .. } => name,
         };
         SceneError::new(format!("{field}.{name}"), ErrorKind::Value, e.to_string())
     })?;
+    let c = (elastic.p_modulus(dim) / m.density).sqrt();
+    if !(c.is_normal() && c > 0.0) {
+        return Err(SceneError::new(
+            format!("{field}.young"),
+            ErrorKind::Conflict,
+            format!(
+                "young = {}, poisson = {} and density = {} give a P-wave speed √((λ + 2μ) / ρ) of {}, which sets no time step: `{field}.young`, `{field}.poisson` and `{field}.density` must give a speed between 1e-300 and 1e300 or so",
+                echo_number(m.young),
+                echo_number(m.poisson),
+                echo_number(m.density),
+                echo_number(c)
+            ),
+        ));
+    }
     Ok(())
 }
 

@@ -108,28 +108,31 @@ impl Scene {
             .checked_shl(level)
             .filter(|f| *f <= 4096)
             .ok_or_else(|| bad("study", format!("level {level} is too fine")))?;
-        let refine = |axis: usize| {
-            self.study.refine.is_empty() || self.study.refine.iter().any(|c| c.index() == axis)
+        let listed = |axis: usize| {
+            self.study
+                .refine
+                .as_ref()
+                .is_none_or(|r| r.iter().any(|a| a.index() == axis))
         };
+        // The axes along which the element size shrinks: a polygon mesh's edge
+        // length shrinks along every axis, an interval's along its one axis.
+        let mut axes = [false; 2];
         match &mut s.mesh {
             MeshSpec::Blocks { blocks, .. } => {
                 for (axis, n) in blocks.iter_mut().enumerate() {
-                    if refine(axis) {
-                        *n *= factor;
+                    if listed(axis) {
+                        *n = refine_count("mesh.blocks", *n, factor)?;
+                        axes[axis] = true;
                     }
                 }
             }
-            MeshSpec::Interval { elements, .. } => *elements *= factor,
+            MeshSpec::Interval { elements, .. } => {
+                *elements = refine_count("mesh.elements", *elements, factor)?;
+                axes[0] = true;
+            }
             MeshSpec::Polygon { edge_length, .. } => {
                 *edge_length /= factor as f64;
-                for body in &mut s.bodies {
-                    if let Some(c) = &mut body.count {
-                        c.iter_mut().for_each(|n| *n *= factor);
-                    }
-                    if let Some(h) = &mut body.spacing {
-                        h.iter_mut().for_each(|h| *h /= factor as f64);
-                    }
-                }
+                axes = [true, true];
             }
             MeshSpec::Gmsh { .. } => {
                 return Err(conflict(
@@ -138,7 +141,34 @@ impl Scene {
                 ))
             }
         }
+        for (i, body) in s.bodies.iter_mut().enumerate() {
+            if let Some(c) = &mut body.count {
+                for (axis, n) in c.iter_mut().enumerate() {
+                    if axes[axis] {
+                        *n = refine_count(&format!("body[{i}].count"), *n, factor)?;
+                    }
+                }
+            }
+            if let Some(h) = &mut body.spacing {
+                for (axis, h) in h.iter_mut().enumerate() {
+                    if axes[axis] {
+                        *h /= factor as f64;
+                    }
+                }
+            }
+        }
         s.validate()?;
         Ok(s)
     }
+}
+
+/// `n` multiplied by a refinement `factor`, or an error naming `field` when the
+/// product does not fit in a `usize` (the scene's limits reject large products).
+fn refine_count(field: &str, n: usize, factor: usize) -> Result<usize, SceneError> {
+    n.checked_mul(factor).ok_or_else(|| {
+        bad(
+            field,
+            format!("{n} refined by a factor {factor} does not fit in a count"),
+        )
+    })
 }

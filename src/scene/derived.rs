@@ -131,7 +131,12 @@ impl Scene {
     pub fn mesh_size(&self) -> Option<f64> {
         match &self.mesh {
             MeshSpec::Blocks { x, y, blocks, .. } => {
-                let axis = self.study.refine.first().map_or(0, |c| c.index());
+                let axis = self
+                    .study
+                    .refine
+                    .as_ref()
+                    .and_then(|r| r.first())
+                    .map_or(0, |a| a.index());
                 let r = if axis == 0 { x } else { y };
                 Some((r[1] - r[0]) / blocks[axis] as f64)
             }

@@ -77,6 +77,12 @@ pub fn read_mesh(file: &str) -> Result<psmpm_basis::TriMesh, String> {
         .map_err(|e| e.to_string())
 }
 
+/// Most characters of a scene's `name` (printed in tables and titles).
+pub const MAX_NAME_CHARS: usize = 200;
+
+/// Most characters of a scene's `description` (one line).
+pub const MAX_DESCRIPTION_CHARS: usize = 2000;
+
 /// User text as it is echoed in messages: control characters escaped (`\n`,
 /// `\u{1b}`, …) and cut to [`MAX_ECHO_CHARS`] characters with an ellipsis.
 pub fn echo(text: &str) -> String {
@@ -95,9 +101,31 @@ pub fn echo(text: &str) -> String {
     out
 }
 
+/// A number as it is echoed in messages: Rust's shortest round-trip digits, in
+/// exponent notation outside `1e-4 ≤ |x| < 1e16`, so that no value (`1e-320`,
+/// `1e300`) is printed as hundreds of digits.
+pub fn echo_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn echo_number_is_short() {
+        assert_eq!(echo_number(-100.0), "-100");
+        assert_eq!(echo_number(0.25), "0.25");
+        assert_eq!(echo_number(0.0), "0");
+        assert_eq!(echo_number(f64::NAN), "NaN");
+        assert_eq!(echo_number(1e-320), "1e-320");
+        assert_eq!(echo_number(-2.5e300), "-2.5e300");
+        assert_eq!(echo_number(1e15), "1000000000000000");
+    }
 
     #[test]
     fn echo_escapes_and_cuts() {

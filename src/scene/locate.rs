@@ -106,100 +106,125 @@ fn field_at(text: &str, at: usize) -> Option<String> {
     })
 }
 
-/// Byte offset of the value of field `path` (`time.dt`, `body[1].count`, `mesh`) in
-/// the TOML `text`, found by walking its tables; the start of the file if not found.
+/// The name of a table header line (`mesh.holes` of `[[mesh.holes]]`) and whether
+/// it is an array of tables; `None` for other lines (a line of a multi-line array
+/// such as `[0.0, 1.0],` is not a header).
+fn header(line: &str) -> Option<(String, bool)> {
+    let trimmed = line.trim();
+    let (inner, array) = match trimmed.strip_prefix("[[") {
+        Some(rest) => (rest.split_once("]]")?, true),
+        None => (trimmed.strip_prefix('[')?.split_once(']')?, false),
+    };
+    let (name, after) = inner;
+    let after = after.trim();
+    let name = name.trim();
+    let bare = name
+        .chars()
+        .all(|c| c.is_alphanumeric() || matches!(c, '_' | '-' | '.' | ' ' | '"'));
+    let starts = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_' || c == '"');
+    (bare && starts && (after.is_empty() || after.starts_with('#'))).then(|| {
+        (
+            name.split('.').map(str::trim).collect::<Vec<_>>().join("."),
+            array,
+        )
+    })
+}
+
+/// Byte offset of the value of field `path` (`time.dt`, `body[1].count`,
+/// `body[0].material.young`, `mesh.holes[1].outline`, `mesh`) in the TOML `text`,
+/// found by walking its tables (arrays of tables numbered, sub-tables such as
+/// `[body.material]` taken as part of the last `[[body]]`, inline tables searched
+/// for the key). When the field itself is not written, the nearest enclosing table
+/// or key that is (its header, or its value); the start of the file if none is.
 pub(super) fn field_offset(text: &str, path: &str) -> usize {
-    // A whole array-of-tables entry (`body[1]`) or table (`body`): its header.
-    if !path.contains('.') {
-        let (name, index) = match path.split_once('[') {
-            Some((n, i)) => (n, i.trim_end_matches(']').parse::<usize>().unwrap_or(0)),
-            None => (path, 0),
-        };
-        let mut offset = 0;
-        let mut seen = 0;
-        for line in text.split_inclusive('\n') {
-            let t = line.trim();
-            if t == format!("[[{name}]]") || t == format!("[{name}]") {
-                if seen == index {
-                    return offset;
-                }
-                seen += 1;
-            }
-            offset += line.len();
-        }
-    }
-    // Split `body[1].count` into table `body`, index 1, key `count`.
-    let (table, index, key) = match path.split_once('.') {
-        Some((head, key)) => {
-            let (name, index) = match head.split_once('[') {
-                Some((n, i)) => (n, i.trim_end_matches(']').parse::<usize>().unwrap_or(0)),
-                None => (head, 0),
-            };
-            (Some(name), index, key)
-        }
-        None => {
-            let (name, _) = path.split_once('[').unwrap_or((path, ""));
-            (None, 0, name)
+    // Whether `loc` is `path` or encloses it (`body[1]` encloses `body[1].count`).
+    let encloses = |loc: &str| {
+        path.strip_prefix(loc)
+            .is_some_and(|rest| rest.is_empty() || rest.starts_with(['.', '[']))
+    };
+    // The longest enclosing location so far: its length and offset.
+    let mut best: Option<(usize, usize)> = None;
+    let consider = |loc: &str, at: usize, best: &mut Option<(usize, usize)>| {
+        if encloses(loc) && best.is_none_or(|(len, _)| loc.len() > len) {
+            *best = Some((loc.len(), at));
         }
     };
+    // The current table's path (`""` at the top level), and per array of tables
+    // (by its path without the last index) the index of its last element.
+    let mut table = String::new();
+    let mut last_index = std::collections::HashMap::<String, usize>::new();
     let mut offset = 0;
-    let mut current: Option<String> = None;
-    let mut seen = std::collections::HashMap::<String, usize>::new();
-    let mut current_index = 0;
-    let mut table_start = None;
     for line in text.split_inclusive('\n') {
         let trimmed = line.trim();
-        if let Some(name) = trimmed
-            .strip_prefix("[[")
-            .and_then(|r| r.split_once("]]"))
-            .map(|(n, _)| n.trim().to_string())
-        {
-            let count = seen.entry(name.clone()).or_insert(0);
-            current_index = *count;
-            *count += 1;
-            current = Some(name);
-            if table.is_some_and(|t| Some(t.to_string()) == current && current_index == index) {
-                table_start = Some(offset);
-            }
-        } else if let Some(name) = trimmed
-            .strip_prefix('[')
-            .and_then(|r| r.split_once(']'))
-            .map(|(n, _)| n.trim().to_string())
-        {
-            current = Some(name);
-            current_index = 0;
-            if table.is_some_and(|t| Some(t.to_string()) == current) && index == 0 {
-                table_start = Some(offset);
-            }
-        } else {
-            let in_table = match table {
-                Some(t) => current.as_deref() == Some(t) && current_index == index,
-                None => current.is_none(),
-            };
-            let key_here = trimmed
-                .split_once('=')
-                .map(|(k, _)| k.trim() == key)
-                .unwrap_or(false);
-            if in_table && key_here {
-                let eq = line.find('=').unwrap_or(0);
-                let after = &line[eq + 1..];
-                return offset + eq + 1 + (after.len() - after.trim_start().len());
-            }
-            // An inline table: `reference = { kind = ... }`.
-            if table.is_some()
-                && current.is_none()
-                && trimmed
-                    .split_once('=')
-                    .is_some_and(|(k, _)| Some(k.trim()) == table)
-            {
-                if let Some(at) = line.find(&format!("{key} ")).or_else(|| line.find(key)) {
-                    return offset + at;
+        if let Some((name, array)) = header(line) {
+            // Resolve `a.b.c`: each enclosing array of tables at its last element.
+            let mut resolved = String::new();
+            for segment in name.split('.') {
+                if !resolved.is_empty() {
+                    resolved.push('.');
                 }
+                resolved.push_str(segment);
+                if let Some(i) = last_index.get(&resolved) {
+                    resolved = format!("{resolved}[{i}]");
+                }
+            }
+            if array {
+                // `resolved` ends in the previous element's index, if any.
+                let plain = resolved
+                    .strip_suffix(']')
+                    .and_then(|r| r.rsplit_once('['))
+                    .filter(|(head, _)| last_index.contains_key(*head))
+                    .map_or(resolved.clone(), |(head, _)| head.to_string());
+                let i = last_index.get(&plain).map_or(0, |i| i + 1);
+                last_index.insert(plain.clone(), i);
+                // Arrays nested in this element start anew.
+                last_index.retain(|k, _| !k.starts_with(&format!("{plain}[")));
+                resolved = format!("{plain}[{i}]");
+            }
+            if resolved == path {
+                return offset;
+            }
+            consider(&resolved, offset, &mut best);
+            table = resolved;
+        } else if let Some((key, value)) = trimmed.split_once('=') {
+            let key = key.trim();
+            if key.is_empty() || key.starts_with('#') {
+                offset += line.len();
+                continue;
+            }
+            let loc = if table.is_empty() {
+                key.to_string()
+            } else {
+                format!("{table}.{key}")
+            };
+            let eq = line.find('=').unwrap_or(0);
+            let value_at = offset + eq + 1 + (value.len() - value.trim_start().len());
+            if loc == path {
+                return value_at;
+            }
+            if encloses(&loc) {
+                // An inline table: `reference = { kind = "…", v0 = 0.1 }`.
+                if let Some(next) = path[loc.len()..]
+                    .strip_prefix('.')
+                    .map(|rest| rest.split(['.', '[']).next().unwrap_or(rest))
+                {
+                    let after = &line[eq + 1..];
+                    let found = after
+                        .find(&format!("{next} "))
+                        .or_else(|| after.find(&format!("{next}=")));
+                    if let Some(at) = found {
+                        return offset + eq + 1 + at;
+                    }
+                }
+                consider(&loc, value_at, &mut best);
             }
         }
         offset += line.len();
     }
-    table_start.unwrap_or(0)
+    best.map_or(0, |(_, at)| at)
 }
 
 /// Where a TOML parse error `e` in `text` belongs (a byte offset), the field it is
@@ -278,6 +303,18 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
             key_line_after(text, at, &field).unwrap_or(at)
         };
         return (at, Some(name.clone()), format!("{name}: {message}"));
+    }
+    // A table header given twice (`[material]` … `[material]`): name the table.
+    if message.starts_with("duplicate key") {
+        let line_start = text[..at.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
+        let line = text[line_start..].lines().next().unwrap_or("");
+        if let Some((name, false)) = header(line) {
+            return (
+                line_start + (line.len() - line.trim_start().len()),
+                Some(name.clone()),
+                format!("{name}: duplicate table `[{name}]`: give each table once"),
+            );
+        }
     }
     // Name the field when the error is about a key or a value (not about the
     // syntax between them).

@@ -159,15 +159,37 @@ pub struct Resolution {
 
 /// How a refinement study refines a scene: level `l` multiplies the block counts
 /// along the `refine` axes (all axes by default) and the elements of an interval by
-/// `2^l`, divides a polygon's edge length by `2^l` (and multiplies particle counts
-/// along every axis by `2^l`, keeping particles per element about constant). The
-/// time step and particles per block stay.
+/// `2^l` and divides a polygon's edge length by `2^l`. Along the axes whose element
+/// size shrinks, body particle counts are multiplied and spacings divided by `2^l`,
+/// keeping particles per element about constant. The time step and particles per
+/// block stay.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StudySpec {
-    /// Axes whose block counts are refined (empty: all).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub refine: Vec<Component>,
+    /// Axes whose block counts are refined (absent: all; an empty list is an
+    /// error, so is an axis listed twice).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refine: Option<Vec<Axis>>,
+}
+
+/// A coordinate axis (`study.refine`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// First axis.
+    X,
+    /// Second axis.
+    Y,
+}
+
+impl Axis {
+    /// Axis index: 0 for `x`, 1 for `y`.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+        }
+    }
 }
 
 /// The mesh of a scene.
@@ -528,12 +550,6 @@ impl Component {
             Component::Y => Some(1),
             Component::Normal => None,
         }
-    }
-
-    /// Axis index of `x` and `y`; the normal counts as axis 0 (for `study.refine`,
-    /// where only axes are meaningful and validation rejects `normal`).
-    pub fn index(self) -> usize {
-        self.axis().unwrap_or(0)
     }
 }
 

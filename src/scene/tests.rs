@@ -135,3 +135,54 @@ fn the_material_model_defaults_to_the_objective_law_and_the_papers_law_keeps_its
     println!("{e}");
     assert!(e.message.contains("corotational"), "{e}");
 }
+
+#[test]
+fn refinement_multiplies_count_and_divides_spacing_along_the_refined_axes() {
+    let scene = |mesh: &str, sampling: &str, refine: &str| {
+        let (dim, min, max) = if mesh.contains("interval") {
+            (1, "[0.0]", "[2.0]")
+        } else {
+            (2, "[0.0, 0.0]", "[2.0, 2.0]")
+        };
+        let text = format!(
+            "name = \"r\"\ndim = {dim}\nbasis = \"{}\"\n\n[mesh]\n{mesh}\n\n[material]\nyoung = 1.0\ndensity = 1.0\n\n[[body]]\nmin = {min}\nmax = {max}\n{sampling}\n\n[time]\ndt = 1e-3\nt_end = 1e-2\n\n[study]\nrefine = {refine}\n",
+            if dim == 1 { "bspline" } else { "pl" }
+        );
+        Scene::from_toml(&text, "r.toml").unwrap_or_else(|e| panic!("{e}\n{text}"))
+    };
+    let particles = |s: &Scene| {
+        crate::simulation::particle_lattice(s)
+            .unwrap()
+            .positions
+            .len()
+    };
+    let blocks = "kind = \"blocks\"\nx = [0.0, 2.0]\ny = [0.0, 2.0]\nblocks = [2, 2]";
+    let both = scene(blocks, "count = [6, 4]", "[\"x\", \"y\"]");
+    let counts: Vec<usize> = (0..3)
+        .map(|l| particles(&both.refined(l).unwrap()))
+        .collect();
+    assert_eq!(counts, [24, 96, 384]);
+    let x_only = scene(blocks, "count = [6, 4]", "[\"x\"]")
+        .refined(2)
+        .unwrap();
+    assert_eq!(x_only.bodies[0].count, Some(vec![24, 4]));
+    let spacing = scene(blocks, "spacing = [0.5, 0.25]", "[\"y\"]")
+        .refined(1)
+        .unwrap();
+    assert_eq!(spacing.bodies[0].spacing, Some(vec![0.5, 0.125]));
+    let interval = scene(
+        "kind = \"interval\"\nx = [0.0, 2.0]\nelements = 4",
+        "count = [8]",
+        "[\"x\"]",
+    );
+    assert_eq!(particles(&interval.refined(2).unwrap()), 32);
+    let polygon = scene(
+        "kind = \"polygon\"\noutline = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]\nedge_length = 0.5",
+        "spacing = [0.5, 0.5]",
+        "[\"x\"]",
+    );
+    assert_eq!(
+        polygon.refined(1).unwrap().bodies[0].spacing,
+        Some(vec![0.25, 0.25])
+    );
+}

@@ -1,11 +1,12 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
+    echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D,
+    MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
 };
 use super::{
-    bad, conflict, Component, EffectSpec, InitialVelocity, MaterialModel, MeshSpec, Reference,
-    Scene, SceneError,
+    bad, conflict, Axis, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel,
+    MeshSpec, Reference, Scene, SceneError,
 };
 
 impl Scene {
@@ -26,7 +27,23 @@ impl Scene {
             ));
         }
         // Names and descriptions are printed and written into SVG and JSON files.
-        for (field, text) in [("name", &self.name), ("description", &self.description)] {
+        if self.name.trim().is_empty() {
+            return Err(bad(
+                "name",
+                "is empty: the scene's name is printed and names its output files",
+            ));
+        }
+        for (field, text, limit) in [
+            ("name", &self.name, MAX_NAME_CHARS),
+            ("description", &self.description, MAX_DESCRIPTION_CHARS),
+        ] {
+            let chars = text.chars().count();
+            if chars > limit {
+                return Err(bad(
+                    field,
+                    format!("is {chars} characters long, above the limit of {limit}"),
+                ));
+            }
             if let Some(c) = text.chars().find(|c| c.is_control()) {
                 return Err(bad(
                     field,
@@ -42,14 +59,20 @@ impl Scene {
             if v.is_finite() {
                 Ok(())
             } else {
-                Err(bad(field, format!("must be finite, got {v}")))
+                Err(bad(
+                    field,
+                    format!("must be finite, got {}", echo_number(v)),
+                ))
             }
         };
         let positive = |field: &str, v: f64| -> Result<(), SceneError> {
             if v > 0.0 && v.is_finite() {
                 Ok(())
             } else {
-                Err(bad(field, format!("must be positive and finite, got {v}")))
+                Err(bad(
+                    field,
+                    format!("must be positive and finite, got {}", echo_number(v)),
+                ))
             }
         };
         let vector = |field: &str, v: &[f64]| -> Result<(), SceneError> {
@@ -139,12 +162,36 @@ impl Scene {
                 check_elements("mesh.elements", *elements)?;
             }
         }
-        super::bodies::validate_material("material", &self.material)?;
+        super::bodies::validate_material("material", &self.material, self.dim)?;
         self.validate_bodies()?;
         self.validate_velocity("initial_velocity", &self.initial_velocity)?;
         for (i, bc) in self.boundaries.iter().enumerate() {
             if bc.fix.is_empty() {
                 return Err(bad(format!("boundary[{i}].fix"), "lists no component"));
+            }
+            if let Some((k, c)) = bc
+                .fix
+                .iter()
+                .enumerate()
+                .find(|(k, c)| bc.fix[..*k].contains(c))
+            {
+                return Err(bad(
+                    format!("boundary[{i}].fix"),
+                    format!(
+                        "`{}` is listed twice (entries {} and {k})",
+                        format!("{c:?}").to_lowercase(),
+                        bc.fix.iter().position(|b| b == c).unwrap_or(0)
+                    ),
+                ));
+            }
+            if let Some(j) = self.boundaries[..i].iter().position(|o| o.tag == bc.tag) {
+                return Err(conflict(
+                    format!("boundary[{i}].tag"),
+                    format!(
+                        "`{}` is already held by boundary[{j}]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)",
+                        echo(&bc.tag)
+                    ),
+                ));
             }
             if bc.fix.contains(&Component::Normal) && bc.fix.len() > 1 {
                 return Err(conflict(
@@ -270,14 +317,33 @@ impl Scene {
                 ));
             }
         }
-        if self.study.refine.contains(&Component::Normal) {
-            return Err(bad("study.refine", "lists axes, `x` or `y`"));
-        }
-        if d == 1 && self.study.refine.contains(&Component::Y) {
-            return Err(bad(
-                "study.refine",
-                "`y` does not exist in a 1D scene (refine `x` or leave it out)",
-            ));
+        if let Some(refine) = &self.study.refine {
+            if refine.is_empty() {
+                return Err(bad(
+                    "study.refine",
+                    "lists no axis: list `x`, `y` or both, or leave `refine` out to refine every axis",
+                ));
+            }
+            if let Some((i, a)) = refine
+                .iter()
+                .enumerate()
+                .find(|(i, a)| refine[..*i].contains(a))
+            {
+                return Err(bad(
+                    "study.refine",
+                    format!(
+                        "`{}` is listed twice (entries {} and {i})",
+                        format!("{a:?}").to_lowercase(),
+                        refine.iter().position(|b| b == a).unwrap_or(0)
+                    ),
+                ));
+            }
+            if d == 1 && refine.contains(&Axis::Y) {
+                return Err(bad(
+                    "study.refine",
+                    "`y` does not exist in a 1D scene (refine `x` or leave it out)",
+                ));
+            }
         }
         self.validate_resolutions()?;
         for (i, t) in self.output.tracked.iter().enumerate() {
@@ -385,6 +451,18 @@ impl Scene {
         let d = self.dim;
         for (i, r) in self.resolutions.iter().enumerate() {
             let field = |f: &str| format!("resolution[{i}].{f}");
+            if let Some(j) = self.resolutions[..i]
+                .iter()
+                .position(|o| o.basis == r.basis)
+            {
+                return Err(conflict(
+                    field("basis"),
+                    format!(
+                        "`{}` already has a resolution (resolution[{j}]): give each basis one [[resolution]]",
+                        r.basis.name()
+                    ),
+                ));
+            }
             if r.basis.dim() != d {
                 return Err(bad(
                     field("basis"),
@@ -441,6 +519,12 @@ impl Scene {
                     return Err(bad(
                         field("per_block"),
                         "needs a `blocks` or `interval` mesh",
+                    ));
+                }
+                if self.bodies.iter().all(|b| b.shape == BodyShape::Gmsh) {
+                    return Err(conflict(
+                        field("per_block"),
+                        "every body is a Gmsh body (`shape = \"gmsh\"`), whose particles `per_triangle` and `subdivide` set: `per_block` would change none",
                     ));
                 }
             }

@@ -11,7 +11,7 @@ use psmpm_basis::basis::bspline1d::QuadraticBSpline;
 use psmpm_basis::basis::linear::Linear;
 use psmpm_basis::basis::linear1d::Linear1d;
 use psmpm_basis::basis::powell_sabin::PowellSabin;
-use psmpm_basis::mesh::generators::{self, PolygonDomain};
+use psmpm_basis::mesh::generators::{self, PolygonDomain, PolygonPart};
 use psmpm_basis::mesh::MeshError;
 use psmpm_basis::{Mesh1d, TriMesh, Vec2};
 
@@ -130,6 +130,16 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
                     .map(|h| (points(&h.outline), h.tag.clone()))
                     .collect(),
             };
+            // The domain's faults name the part at fault (a hole's outline, a tag).
+            domain.check().map_err(|f| {
+                let field = match f.part {
+                    PolygonPart::Outer => "mesh.outline".to_string(),
+                    PolygonPart::OuterTags => "mesh.tags".to_string(),
+                    PolygonPart::Hole(h) => format!("mesh.holes[{h}].outline"),
+                    PolygonPart::HoleTag(h) => format!("mesh.holes[{h}].tag"),
+                };
+                value(&field, MeshError::from(f))
+            })?;
             generators::polygon_mesh(&domain, *edge_length).map_err(|e| match e {
                 MeshError::EdgeLength(_) => value("mesh.edge_length", e),
                 _ => value("mesh.outline", e),

@@ -142,11 +142,19 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
     // one (a mesh-based guess) only sets the driver up.
     let dt = scene.dt(h);
-    if !(dt > 0.0 && dt.is_finite()) {
+    if !(dt.is_normal() && dt > 0.0) {
+        // A fixed `dt` is validated; this is the Courant-number guess `C h / c`.
+        use crate::scene::limits::echo_number;
         return Err(SceneError::new(
-            "time",
-            ErrorKind::Value,
-            format!("the time step {dt} is not positive"),
+            "time.courant",
+            ErrorKind::Conflict,
+            format!(
+                "the time step C h / c = {} from courant = {}, element size h = {} and P-wave speed c = {} (of the materials' young, poisson and density) is not a finite positive number: the element size and the materials' constants are too far apart",
+                echo_number(dt),
+                echo_number(scene.time.courant.unwrap_or(f64::NAN)),
+                echo_number(h),
+                echo_number(scene.wave_speed())
+            ),
         )
         .into());
     }
@@ -362,7 +370,7 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
     driver: &mut SceneDriver<D, B>,
     dt: f64,
 ) -> Result<(f64, usize, Option<f64>), RunError> {
-    use crate::scene::limits::MAX_STEPS;
+    use crate::scene::limits::{echo_number, MAX_STEPS};
     let dt_critical = driver.critical_time_step().ok().filter(|c| c.is_finite());
     match scene.time.courant {
         Some(c) => {
@@ -375,7 +383,11 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                 return Err(SceneError::new(
                     "time.t_end",
                     ErrorKind::Conflict,
-                    format!("is shorter than one time step (t_end = {t_end}, courant = {c} gives dt = {step:e})"),
+                    format!(
+                        "is shorter than one time step (t_end = {}, courant = {} gives dt = {step:e})",
+                        echo_number(t_end),
+                        echo_number(c)
+                    ),
                 )
                 .into());
             }
@@ -383,7 +395,11 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                 return Err(SceneError::new(
                     "time.t_end",
                     ErrorKind::Value,
-                    format!("t_end = {t_end} with courant = {c} (dt = {step:e}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}"),
+                    format!(
+                        "t_end = {} with courant = {} (dt = {step:e}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}",
+                        echo_number(t_end),
+                        echo_number(c)
+                    ),
                 )
                 .into());
             }

@@ -362,6 +362,9 @@ fn syntax_cases() -> Vec<Case> {
         case("duplicate-key", BAR)
             .edit("density = 1.0", "density = 1.0\n@@density = 2.0")
             .expect("material.density: duplicate key"),
+        case("duplicate-table", BAR)
+            .edit("[time]", "@@[material]\nyoung = 5.0\ndensity = 1.0\n\n[time]")
+            .expect("material: duplicate table `[material]`: give each table once"),
         case("key-without-value", BAR)
             .edit("young = 100.0", "young @@100.0")
             .expect("key with no value, expected `=`"),
@@ -536,6 +539,18 @@ fn unknown_name_cases() -> Vec<Case> {
 
 fn range_cases() -> Vec<Case> {
     vec![
+        case("empty-name", BAR)
+            .edit("name = \"bar\"", "name = @@\" \"")
+            .expect("name: is empty: the scene's name is printed and names its output files"),
+        case("long-name", BAR)
+            .edit("name = \"bar\"", &format!("name = @@\"{}\"", "n".repeat(201)))
+            .expect("name: is 201 characters long, above the limit of 200"),
+        case("long-description", BAR)
+            .edit("description = \"a bar fixed at both ends\"", &format!("description = @@\"{}\"", "d".repeat(2001)))
+            .expect("description: is 2001 characters long, above the limit of 2000"),
+        case("tiny-t-end-in-short-form", COLUMN)
+            .edit("t_end = 0.01", "t_end = @@1e-300")
+            .expect("time.t_end: is shorter than one time step (t_end = 1e-300, courant = 0.5 gives dt = 1.1374681029968743e-3)"),
         case("dim-3", BAR)
             .edit("dim = 2", "dim = @@3")
             .expect("dim: must be 1 or 2, got 3"),
@@ -551,6 +566,30 @@ fn range_cases() -> Vec<Case> {
         case("zero-density", BAR)
             .edit("density = 1.0", "density = @@0.0")
             .expect("material.density: density = 0 is out of range: ρ > 0"),
+        // Subnormal constants are named, not blamed on the time step they break.
+        case("subnormal-density", COLUMN)
+            .edit("density = 1.0", "density = @@1e-320")
+            .expect("material.density: density = 1e-320 is out of range: ρ ≥ 2.2e-308 (subnormal numbers are refused)"),
+        case("subnormal-young", COLUMN)
+            .edit("young = 5e4", "young = @@1e-310")
+            .expect("material.young: young = 1e-310 is out of range: E ≥ 2.2e-308 (subnormal numbers are refused)"),
+        case("subnormal-poisson", BAR)
+            .edit("poisson = 0.25", "poisson = @@-1e-315")
+            .expect("material.poisson: poisson = -1e-315 is out of range: ν = 0 or |ν| ≥ 2.2e-308 (subnormal numbers are refused)"),
+        case("infinite-wave-speed", COLUMN)
+            .edit("young = 5e4", "young = @@1e300")
+            .edit("density = 1.0", "density = 1e-300")
+            .expect("material.young: young = 1e300, poisson = 0 and density = 1e-300 give a P-wave speed √((λ + 2μ) / ρ) of inf, which sets no time step: `material.young`, `material.poisson` and `material.density` must give a speed between 1e-300 and 1e300 or so"),
+        case("courant-step-overflows", BAR_1D)
+            .edit("x = [0.0, 4.0]", "x = [0.0, 4e200]")
+            .edit("max = [4.0]", "max = [4e200]")
+            .edit("young = 100.0", "young = 1e-290")
+            .edit("density = 1.0", "density = 1e10")
+            .edit("dt = 1e-3", "courant = @@0.5")
+            .expect("time.courant: the time step C h / c = inf from courant = 0.5, element size h = 1e200 and P-wave speed c = 1e-150 (of the materials' young, poisson and density) is not a finite positive number: the element size and the materials' constants are too far apart"),
+        case("body-material-zero-wave-speed", BAR_1D)
+            .edit("per_block = [2]\n", "per_block = [2]\n\n[body.material]\nyoung = @@1e-300\ndensity = 1e300\n")
+            .expect("body[0].material.young: young = 1e-300, poisson = 0 and density = 1e300 give a P-wave speed √((λ + 2μ) / ρ) of 0, which sets no time step: `body[0].material.young`, `body[0].material.poisson` and `body[0].material.density` must give a speed between 1e-300 and 1e300 or so"),
         case("zero-dt", BAR)
             .edit("dt = 1e-3", "dt = @@0.0")
             .expect("time.dt: must be positive and finite, got 0"),
@@ -735,12 +774,49 @@ fn inconsistent_cases() -> Vec<Case> {
         case("polygon-with-two-tags", SQUARE)
             .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]", "tags = @@[\"bottom\", \"right\"]")
             .expect("mesh.tags: needs one tag per outline segment (4), got 2"),
+        // A polygon mesh's faults name the part at fault, at its line.
+        case("hole-crossing-the-outline", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = @@[[0.8, 0.4], [1.2, 0.4], [1.2, 0.6], [0.8, 0.6]]\ntag = \"a\"\n")
+            .expect("mesh.holes[0].outline: invalid mesh parameter: the boundary intersects itself: segment (1, 0)–(1, 1) of the outer polygon meets segment (0.8, 0.4)–(1.2, 0.4) of hole `a`"),
+        case("second-hole-inside-the-first", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.2, 0.2], [0.8, 0.2], [0.8, 0.8], [0.2, 0.8]]\ntag = \"a\"\n\n[[mesh.holes]]\noutline = @@[[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]\ntag = \"b\"\n")
+            .expect("mesh.holes[1].outline: invalid mesh parameter: holes `a` and `b` are nested (one lies inside the other)"),
+        case("hole-with-two-corners", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = @@[[0.4, 0.4], [0.6, 0.4]]\ntag = \"a\"\n")
+            .expect("mesh.holes[0].outline: invalid mesh parameter: hole `a` needs at least 3 corners, got 2"),
+        case("hole-with-an-empty-tag", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]\ntag = @@\"\"\n")
+            .expect("mesh.holes[0].tag: invalid mesh parameter: boundary tags must not be empty"),
+        case("outline-with-an-empty-tag", SQUARE)
+            .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]", "tags = @@[\"bottom\", \"\", \"top\", \"left\"]")
+            .expect("mesh.tags: invalid mesh parameter: boundary tags must not be empty"),
+        case("outline-on-one-line", SQUARE)
+            .edit("outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]", "outline = @@[[0.0, 0.0], [0.5, 0.0], [1.0, 0.0]]")
+            .edit("tags = [\"bottom\", \"right\", \"top\", \"left\"]\n", "")
+            .expect("mesh.outline: invalid mesh parameter: the outer polygon encloses no area (its corners lie on one line)"),
         case("refine-normal", BAR)
-            .edit("refine = [\"x\"]", "refine = @@[\"normal\"]")
-            .expect("study.refine: lists axes, `x` or `y`"),
+            .edit("refine = [\"x\"]", "refine = [@@\"normal\"]")
+            .expect("study.refine: unknown variant `normal`, expected `x` or `y`"),
+        case("refine-z", BAR)
+            .edit("refine = [\"x\"]", "refine = [@@\"z\"]")
+            .expect("study.refine: unknown variant `z`, expected `x` or `y`"),
+        case("refine-nothing", BAR)
+            .edit("refine = [\"x\"]", "refine = @@[]")
+            .expect("study.refine: lists no axis: list `x`, `y` or both, or leave `refine` out to refine every axis"),
+        case("refine-an-axis-twice", BAR)
+            .edit("refine = [\"x\"]", "refine = @@[\"x\", \"y\", \"x\"]")
+            .expect("study.refine: `x` is listed twice (entries 0 and 2)"),
+        case("fix-a-component-twice", BAR)
+            .edit("tag = \"right\"\nfix = [\"x\", \"y\"]", "tag = \"right\"\nfix = @@[\"y\", \"y\"]")
+            .expect("boundary[1].fix: `y` is listed twice (entries 0 and 1)"),
+        case("a-tag-in-two-boundaries", BAR)
+            .edit("tag = \"right\"\nfix = [\"x\", \"y\"]", "tag = \"right\"\nfix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = @@\"left\"\nfix = [\"normal\"]")
+            .expect("boundary[2].tag: `left` is already held by boundary[0]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)"),
+        case("a-basis-in-two-resolutions", BAR)
+            .edit("[study]", "[[resolution]]\nbasis = @@\"pl\"\nblocks = [16, 2]\n\n[study]")
+            .expect("resolution[1].basis: `pl` already has a resolution (resolution[0]): give each basis one [[resolution]]"),
         case("tracked-point-with-one-coordinate", BAR)
-            .edit("[output]", "@@[output]")
-            .edit("tracked = [[2.0, 0.5]]", "tracked = [[2.0]]")
+            .edit("tracked = [[2.0, 0.5]]", "tracked = @@[[2.0]]")
             .expect("output.tracked[0]: needs 2 entries, got 1"),
         case("empty-gmsh-file-name", GMSH)
             .edit("file = \"meshes/square.msh\"", "file = @@\"\"")

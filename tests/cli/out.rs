@@ -1,4 +1,4 @@
-//! `mpm-cli run --out DIR`: every file is written, agrees with the printed
+//! `mpm-cli run --out DIR` (and `converge --out DIR`): every file is written, agrees with the printed
 //! diagnostics and summary, and reads back with independent readers (Python's
 //! `meshio` for the `.vtu` files, `xml.etree` for the `.pvd` and the SVGs); write
 //! errors are input errors; no progress bar reaches a captured stderr.
@@ -598,6 +598,91 @@ fn a_folder_is_reused_only_with_overwrite_and_never_over_other_files() {
     );
     assert_eq!(frames_in(dir.path()), 3);
     assert!(dir.join("summary.json").is_file());
+}
+
+/// `converge vibrating-bar-1d --levels 2 --out DIR` with `extra` arguments.
+fn converge_1d(dir: &Path, extra: &[&str]) -> std::process::Output {
+    cli()
+        .args([
+            "converge",
+            "vibrating-bar-1d",
+            "--levels",
+            "2",
+            "--format",
+            "json",
+            "--out",
+            key(dir),
+        ])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn converge_checks_its_folder_before_the_first_level_with_the_rules_of_run() {
+    let dir = TempDir::new("converge-reuse");
+    // A regular file as --out: refused before any level runs (nothing printed).
+    std::fs::create_dir_all(dir.path()).unwrap();
+    let file = dir.join("plain-file");
+    std::fs::write(&file, "not a directory").unwrap();
+    let out = converge_1d(&file, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(key(&file)), "{stderr}");
+    assert!(out.stdout.is_empty(), "a level ran");
+
+    let study = dir.join("study");
+    let out = converge_1d(&study, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let files = |d: &Path| {
+        let mut names: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    let written = files(&study);
+    assert_eq!(
+        written,
+        [
+            "converge.csv",
+            "converge.json",
+            "error-vs-h.svg",
+            "work-precision.svg"
+        ]
+    );
+
+    // Again: refused up front, naming the folder and the flag; with --overwrite it
+    // runs.
+    let out = converge_1d(&study, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(key(&study)) && stderr.contains("--overwrite"),
+        "{stderr}"
+    );
+    assert!(out.stdout.is_empty(), "a level ran");
+    let out = converge_1d(&study, &["--overwrite"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    // A file converge does not write (here a run's): refused even with
+    // --overwrite, nothing removed.
+    std::fs::write(study.join("summary.json"), "{}").unwrap();
+    let out = converge_1d(&study, &["--overwrite"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("summary.json"), "{stderr}");
+    assert!(out.stdout.is_empty(), "a level ran");
+    assert_eq!(files(&study).len(), 5);
 }
 
 #[test]

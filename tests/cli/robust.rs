@@ -308,7 +308,7 @@ fn scene_cases() -> Vec<Case> {
         scene_case(
             "density-underflows",
             bar(&[("density = 1.0", "density = 5e-324")]),
-            "material.density: the particles of body[0] would have mass 0e0",
+            "material.density: density = 5e-324 is out of range: ρ ≥ 2.2e-308 (subnormal numbers are refused)",
         ),
         scene_case(
             "body-volume-underflows",
@@ -366,7 +366,7 @@ fn scene_cases() -> Vec<Case> {
         scene_case(
             "study-refine-normal",
             format!("{BAR}\n[study]\nrefine = [\"normal\"]\n"),
-            "study.refine: lists axes",
+            "study.refine: unknown variant `normal`, expected `x` or `y`",
         ),
         scene_case(
             "boundary-tag-with-control-characters",
@@ -390,7 +390,19 @@ fn command_line_cases() -> Vec<Case> {
     ));
     let refine_y = Some(format!("{ROD}\n[study]\nrefine = [\"y\"]\n"));
     let long = "m".repeat(1000);
+    // A block mesh whose only body is a Gmsh body: no lattice for --particles.
+    let gmsh_body = format!(
+        "name = \"g\"\ndim = 2\nbasis = \"pl\"\n\n[mesh]\nkind = \"blocks\"\nx = [0.0, 1.0]\ny = [0.0, 1.0]\nblocks = [4, 4]\n\n[material]\nyoung = 100.0\ndensity = 1.0\n\n[[body]]\nshape = \"gmsh\"\nfile = \"{}/../tests/data/square.msh\"\nsurface = \"domain\"\n\n[time]\ndt = 1e-3\nt_end = 0.01\n",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let gmsh_resolution = Some(format!(
+        "{gmsh_body}\n[[resolution]]\nbasis = \"pl\"\nper_block = [2, 2]\n"
+    ));
+    let gmsh_body = Some(gmsh_body);
     vec![
+        args_case("particles-with-gmsh-bodies-only", gmsh_body.clone(), &["run", "@", "--particles", "2x2"], "--particles 2x2: every body is a Gmsh body (`shape = \"gmsh\"`), whose particles `per_triangle` and `subdivide` set"),
+        args_case("converge-particles-with-gmsh-bodies-only", gmsh_body, &["converge", "@", "--particles", "2x2"], "--particles 2x2: every body is a Gmsh body"),
+        args_case("resolution-per-block-with-gmsh-bodies-only", gmsh_resolution, &["run", "@"], "resolution[0].per_block: every body is a Gmsh body"),
         args_case("1d-blocks-second-number", rod.clone(), &["run", "@", "--blocks", "8x3"], "--blocks 8x3: a 1D scene has one count; the second number must be 1"),
         args_case("1d-particles-second-number", rod.clone(), &["run", "@", "--particles", "4x2"], "--particles 4x2: a 1D scene has one count"),
         args_case("1d-builtin-blocks", None, &["run", "vibrating-bar-1d", "--blocks", "8x2"], "the second number must be 1"),

@@ -103,6 +103,36 @@ fn inside_polygon(p: Vec2, poly: &[Vec2]) -> bool {
     inside
 }
 
+/// The part of a [`PolygonDomain`] a [`PolygonFault`] is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PolygonPart {
+    /// The outer polygon's corners.
+    Outer,
+    /// The outer polygon's segment tags.
+    OuterTags,
+    /// The corners of hole `i`.
+    Hole(usize),
+    /// The tag of hole `i`.
+    HoleTag(usize),
+}
+
+/// Why a [`PolygonDomain`] cannot be meshed, and the part at fault: of two loops that
+/// meet or nest, the later one (a hole rather than the outer polygon, the second
+/// hole rather than the first).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolygonFault {
+    /// The part at fault.
+    pub part: PolygonPart,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl From<PolygonFault> for MeshError {
+    fn from(f: PolygonFault) -> Self {
+        MeshError::InvalidParameter(f.message)
+    }
+}
+
 impl PolygonDomain {
     /// Checks the domain: at least 3 finite corners per polygon, one non-empty tag per
     /// outer segment, segments of positive length that neither cross nor touch
@@ -112,50 +142,98 @@ impl PolygonDomain {
     /// total number of corners), so the cost is about `O(N)` for corners spread along
     /// the boundary, and `O(N²)` only when most segments cross most cells.
     pub fn validate(&self) -> Result<f64, MeshError> {
-        let invalid = |m: String| Err(MeshError::InvalidParameter(m));
+        Ok(self.check()?)
+    }
+
+    /// [`PolygonDomain::validate`] with the part at fault.
+    pub fn check(&self) -> Result<f64, PolygonFault> {
+        let invalid = |part: PolygonPart, message: String| Err(PolygonFault { part, message });
+        // Loop `l` of `loops()` (0 the outer polygon) as a part.
+        let part_of = |l: usize| match l {
+            0 => PolygonPart::Outer,
+            h => PolygonPart::Hole(h - 1),
+        };
         if self.outer.len() < 3 {
-            return invalid(format!(
-                "the outer polygon needs at least 3 corners, got {}",
-                self.outer.len()
-            ));
+            return invalid(
+                PolygonPart::Outer,
+                format!(
+                    "the outer polygon needs at least 3 corners, got {}",
+                    self.outer.len()
+                ),
+            );
         }
         if self.outer_tags.len() != self.outer.len() {
-            return invalid(format!(
-                "the outer polygon has {} segments but {} tags (one per segment i → i + 1)",
-                self.outer.len(),
-                self.outer_tags.len()
-            ));
+            return invalid(
+                PolygonPart::OuterTags,
+                format!(
+                    "the outer polygon has {} segments but {} tags (one per segment i → i + 1)",
+                    self.outer.len(),
+                    self.outer_tags.len()
+                ),
+            );
         }
-        for (hole, tag) in &self.holes {
+        for (h, (hole, tag)) in self.holes.iter().enumerate() {
             if hole.len() < 3 {
-                return invalid(format!(
-                    "hole `{tag}` needs at least 3 corners, got {}",
-                    hole.len()
-                ));
+                return invalid(
+                    PolygonPart::Hole(h),
+                    format!("hole `{tag}` needs at least 3 corners, got {}", hole.len()),
+                );
             }
         }
         let loops = self.loops();
-        for (corners, name) in &loops {
+        for (l, (corners, name)) in loops.iter().enumerate() {
             if let Some(p) = corners
                 .iter()
                 .find(|p| !(p.x.is_finite() && p.y.is_finite()))
             {
-                return invalid(format!("{name} has a non-finite corner ({}, {})", p.x, p.y));
+                return invalid(
+                    part_of(l),
+                    format!("{name} has a non-finite corner ({}, {})", p.x, p.y),
+                );
             }
         }
-        let segments = self.segments();
-        if segments.iter().any(|s| s.2.is_empty()) {
-            return invalid("boundary tags must not be empty".into());
+        if self.outer_tags.iter().any(String::is_empty) {
+            return invalid(
+                PolygonPart::OuterTags,
+                "boundary tags must not be empty".into(),
+            );
+        }
+        if let Some(h) = self.holes.iter().position(|(_, tag)| tag.is_empty()) {
+            return invalid(
+                PolygonPart::HoleTag(h),
+                "boundary tags must not be empty".into(),
+            );
         }
         let (lo, hi) = crate::mesh::bounding_box(&self.outer);
         let size = (hi - lo).norm();
         let tol = 1e-9 * size;
-        for (a, b, tag) in &segments {
-            if (b - a).norm() <= tol {
-                return invalid(format!(
-                    "a segment tagged `{tag}` has zero length at ({}, {})",
-                    a.x, a.y
-                ));
+        for (l, (corners, name)) in loops.iter().enumerate() {
+            let n = corners.len();
+            for i in 0..n {
+                let (a, b) = (corners[i], corners[(i + 1) % n]);
+                if (b - a).norm() <= tol {
+                    return invalid(
+                        part_of(l),
+                        format!("a segment of {name} has zero length at ({}, {})", a.x, a.y),
+                    );
+                }
+            }
+            // Corners on one line: the loop folds onto itself and encloses nothing
+            // (said so, rather than that it intersects itself).
+            let far = corners
+                .iter()
+                .map(|c| c - corners[0])
+                .max_by(|a, b| a.norm_squared().total_cmp(&b.norm_squared()))
+                .unwrap_or_default();
+            let on_line = corners.iter().all(|c| {
+                let v = c - corners[0];
+                (v.x * far.y - v.y * far.x).abs() <= tol * far.norm()
+            });
+            if on_line {
+                return invalid(
+                    part_of(l),
+                    format!("{name} encloses no area (its corners lie on one line)"),
+                );
             }
         }
         // Pairs of segments: (loop, index in loop) identifies each one. Only pairs
@@ -194,7 +272,7 @@ impl PolygonDomain {
         });
         if let Some((m, u)) = first {
             let ((a, b), (c, d)) = (all[m], all[u]);
-            return invalid(format!(
+            return invalid(part_of(ids[u].0), format!(
                 "the boundary intersects itself: segment ({}, {})–({}, {}) of {} meets segment ({}, {})–({}, {}) of {}",
                 a.x, a.y, b.x, b.y, loops[ids[m].0].1, c.x, c.y, d.x, d.y, loops[ids[u].0].1
             ));
@@ -204,7 +282,10 @@ impl PolygonDomain {
         for (h, (hole, tag)) in self.holes.iter().enumerate() {
             let parity = grid.crossings(hole[0], |m| ids[m].0, loops.len());
             if !parity[0] {
-                return invalid(format!("hole `{tag}` lies outside the outer polygon"));
+                return invalid(
+                    PolygonPart::Hole(h),
+                    format!("hole `{tag}` lies outside the outer polygon"),
+                );
             }
             for (other, (_, other_tag)) in self.holes.iter().enumerate() {
                 if other != h && parity[other + 1] {
@@ -213,9 +294,12 @@ impl PolygonDomain {
                     } else {
                         (tag, other_tag)
                     };
-                    return invalid(format!(
-                        "holes `{first}` and `{second}` are nested (one lies inside the other)"
-                    ));
+                    return invalid(
+                        PolygonPart::Hole(h.max(other)),
+                        format!(
+                            "holes `{first}` and `{second}` are nested (one lies inside the other)"
+                        ),
+                    );
                 }
             }
         }
@@ -487,6 +571,11 @@ mod tests {
         d.outer.insert(1, Vec2::new(0.0, 0.0));
         d.outer_tags.insert(1, "x".into());
         assert!(msg(&d).contains("zero length"));
+        // Corners on one line enclose no area.
+        let mut d = square.clone();
+        d.outer = pts(&[(0.0, 0.0), (2.0, 0.0), (4.0, 0.0)]);
+        d.outer_tags.truncate(3);
+        assert!(msg(&d).contains("the outer polygon encloses no area"));
         // A bow tie.
         let mut d = square.clone();
         d.outer.swap(1, 2);
@@ -505,6 +594,23 @@ mod tests {
         nested.holes.push((tri(0.15, 0.15, 0.1), "inner".into()));
         assert!(msg(&nested).contains("nested"));
         assert!(msg(&with_hole(tri(0.1, 0.1, 0.3)[..2].to_vec())).contains("at least 3"));
+        // The part at fault: of two loops that meet or nest, the later one.
+        let part = |d: &PolygonDomain| d.check().unwrap_err().part;
+        assert_eq!(part(&with_hole(tri(0.8, 0.5, 0.4))), PolygonPart::Hole(0));
+        assert_eq!(part(&with_hole(tri(2.0, 2.0, 0.4))), PolygonPart::Hole(0));
+        assert_eq!(part(&nested), PolygonPart::Hole(1));
+        let mut crossing = with_hole(tri(0.1, 0.1, 0.2));
+        crossing.holes.push((tri(0.2, 0.15, 0.2), "second".into()));
+        assert_eq!(part(&crossing), PolygonPart::Hole(1));
+        let mut untagged = with_hole(tri(0.1, 0.1, 0.2));
+        untagged.holes[0].1.clear();
+        assert_eq!(part(&untagged), PolygonPart::HoleTag(0));
+        let mut d = square.clone();
+        d.outer_tags[2] = String::new();
+        assert_eq!(part(&d), PolygonPart::OuterTags);
+        d.outer.swap(1, 2);
+        d.outer_tags[2] = "top".into();
+        assert_eq!(part(&d), PolygonPart::Outer);
         // Target edge length.
         for h in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-6] {
             match polygon_mesh(&square, h) {
