@@ -940,11 +940,25 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     stray_particles(&driver.particles),
                     driver.particles.len(),
                 ))
-                .chain(pieces_warning(
-                    tally.pieces_at_start,
-                    &pieces(&driver.particles),
-                    driver.particles.len(),
-                ))
+                .chain(
+                    // After a step that failed numerically the particles lie where
+                    // the failure put them; a body that left the mesh in pieces, or
+                    // collapsed, is still one to count.
+                    (!matches!(
+                        failure,
+                        Some(
+                            StepError::NotFinite { .. } | StepError::MassNotPositiveDefinite { .. }
+                        )
+                    ))
+                    .then(|| {
+                        pieces_warning(
+                            tally.pieces_at_start,
+                            &pieces(&driver.particles),
+                            driver.particles.len(),
+                        )
+                    })
+                    .flatten(),
+                )
                 .collect(),
             interrupted: tally.interrupted,
             seconds: tally.seconds,
