@@ -239,6 +239,16 @@ fn an_output_directory_that_cannot_be_created_is_an_error() {
         message.starts_with("cannot create output directory"),
         "{message}"
     );
+    // The path of an existing file is named as such.
+    let err = OutputDir::create(&file, 1).unwrap_err();
+    assert!(matches!(err, OutputError::NotADirectory { .. }), "{err:?}");
+    assert!(
+        err.to_string()
+            .contains("a-file` exists and is not a directory"),
+        "{err}"
+    );
+    let err = prepare_dir(&file, true, |_| true).unwrap_err();
+    assert!(matches!(err, OutputError::NotADirectory { .. }), "{err:?}");
 }
 
 #[test]

@@ -33,6 +33,16 @@ pub enum OutputError {
         /// What the operating system said.
         source: io::Error,
     },
+    /// The path names an existing entry that is not a directory (a file, a link to
+    /// one, a device).
+    #[error(
+        "output directory `{}` exists and is not a directory: give the path of a new or empty directory",
+        path.display()
+    )]
+    NotADirectory {
+        /// The path.
+        path: PathBuf,
+    },
     /// The directory holds files of an earlier run and overwriting was not asked for.
     #[error(
         "output directory `{}` is not empty: it holds {} of an earlier run ({})",
@@ -144,6 +154,11 @@ pub fn prepare_dir(
         }
         return Ok(ours);
     }
+    if std::fs::metadata(path).is_ok() {
+        return Err(OutputError::NotADirectory {
+            path: path.to_path_buf(),
+        });
+    }
     std::fs::create_dir_all(path).map_err(|source| OutputError::CreateDir {
         path: path.to_path_buf(),
         source,
@@ -194,6 +209,9 @@ impl OutputDir {
     /// writes none there ([`OutputDir::write_particles`] still does).
     pub fn create(path: impl Into<PathBuf>, every: usize) -> Result<Self, OutputError> {
         let path = path.into();
+        if std::fs::metadata(&path).is_ok_and(|m| !m.is_dir()) {
+            return Err(OutputError::NotADirectory { path });
+        }
         if let Err(source) = std::fs::create_dir_all(&path) {
             return Err(OutputError::CreateDir { path, source });
         }
