@@ -53,7 +53,7 @@ use crate::particles::Particles;
 use crate::sparse::Scalar;
 use nalgebra::SVector;
 use psmpm_basis::{TriMesh, Vec2};
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 use std::sync::Mutex;
 
 /// The default `κ`: the grid's contact modes have frequency at most `κ / Δt`. With
@@ -102,16 +102,19 @@ impl WallGeometry {
         if segments.is_empty() {
             return None;
         }
+        // The wall edge that starts and the one that ends at each vertex (the first,
+        // in edge order), for the free ends and the corners.
+        let (mut starting, mut ending) = (HashMap::new(), HashMap::new());
+        for (s, &k) in edge_of_segment.iter().enumerate() {
+            let [a, b] = mesh.edges()[k].vertices;
+            starting.entry(a).or_insert(s);
+            ending.entry(b).or_insert(s);
+        }
         let free = edge_of_segment
             .iter()
             .map(|&k| {
                 let [a, b] = mesh.edges()[k].vertices;
-                let joined = |vertex: usize, side: usize| {
-                    edge_of_segment
-                        .iter()
-                        .any(|&l| mesh.edges()[l].vertices[side] == vertex)
-                };
-                [!joined(a, 1), !joined(b, 0)]
+                [!ending.contains_key(&a), !starting.contains_key(&b)]
             })
             .collect();
         // Reflex corners: vertices shared by two wall edges where the mesh's angle
@@ -119,10 +122,7 @@ impl WallGeometry {
         let mut corners = Vec::new();
         for (s, &k) in edge_of_segment.iter().enumerate() {
             let end = mesh.edges()[k].vertices[1];
-            let Some(next) = edge_of_segment
-                .iter()
-                .position(|&l| mesh.edges()[l].vertices[0] == end)
-            else {
+            let Some(&next) = starting.get(&end) else {
                 continue;
             };
             let angle: f64 = mesh

@@ -430,23 +430,24 @@ fn neighbours<const D: usize>(
     true
 }
 
-/// Particles with no other particle within [`STRAY_DISTANCE`] times their own
-/// spacing: none in a body sampled on a lattice or jittered in its cells; one for
-/// each particle a body that came apart flung off alone.
-pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
-    let mut near = vec![false; particles.len()];
-    if !neighbours(particles, |p, _| near[p] = true) {
-        return 0;
-    }
-    near.iter().filter(|&&n| !n).count()
+/// What the neighbour relation of the particles (a particle and those within
+/// [`STRAY_DISTANCE`] times its spacing) says of them, from one pass over it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Fragments {
+    /// Particles with no other particle within [`STRAY_DISTANCE`] times their own
+    /// spacing: none in a body sampled on a lattice or jittered in its cells; one
+    /// for each particle a body that came apart flung off alone.
+    pub stray: usize,
+    /// The sizes of the pieces the particles form, largest first: the connected
+    /// sets of the relation, counting those of at least 3 particles and
+    /// [`STRAY_WARNING`] of all. One per body on a lattice, stretched by up to
+    /// about twice its spacing; two for a body torn in two.
+    pub pieces: Vec<usize>,
 }
 
-/// The pieces the particles form, largest first: the connected sets of the
-/// neighbour relation of [`stray_particles`] (a particle and those within
-/// [`STRAY_DISTANCE`] of its spacing), counting those of at least 3 particles and
-/// [`STRAY_WARNING`] of all. One per body on a lattice, stretched by up to about
-/// twice its spacing; two for a body torn in two.
-pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
+/// The [`Fragments`] of `particles`: the neighbour relation walked once, marking
+/// the particles with a neighbour and joining the pieces (union–find).
+pub fn fragments<const D: usize>(particles: &Particles<f64, D>) -> Fragments {
     fn root(parent: &mut [usize], mut a: usize) -> usize {
         while parent[a] != a {
             parent[a] = parent[parent[a]];
@@ -455,21 +456,42 @@ pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
         a
     }
     let n = particles.len();
+    let mut near = vec![false; n];
     let mut parent: Vec<usize> = (0..n).collect();
-    neighbours(particles, |p, q| {
+    let measured = neighbours(particles, |p, q| {
+        near[p] = true;
         let (a, b) = (root(&mut parent, p), root(&mut parent, q));
         if a != b {
             parent[a.max(b)] = a.min(b);
         }
     });
+    if !measured {
+        return Fragments {
+            stray: 0,
+            pieces: Vec::new(),
+        };
+    }
     let mut size = vec![0usize; n];
     for p in 0..n {
         size[root(&mut parent, p)] += 1;
     }
     let least = 3.max((STRAY_WARNING * n as f64).ceil() as usize);
-    let mut sizes: Vec<usize> = size.into_iter().filter(|&s| s >= least).collect();
-    sizes.sort_unstable_by(|a, b| b.cmp(a));
-    sizes
+    let mut pieces: Vec<usize> = size.into_iter().filter(|&s| s >= least).collect();
+    pieces.sort_unstable_by(|a, b| b.cmp(a));
+    Fragments {
+        stray: near.iter().filter(|&&n| !n).count(),
+        pieces,
+    }
+}
+
+/// [`Fragments::stray`] of `particles`.
+pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
+    fragments(particles).stray
+}
+
+/// [`Fragments::pieces`] of `particles`.
+pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
+    fragments(particles).pieces
 }
 
 /// The warning for a run whose particles form more [`pieces`] at the end (`end`,
@@ -623,8 +645,8 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
-    let stray_at_start = stray_particles(&driver.particles);
-    let pieces_at_start = pieces(&driver.particles).len();
+    let at_start = fragments(&driver.particles);
+    let (stray_at_start, pieces_at_start) = (at_start.stray, at_start.pieces.len());
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
     let mut max_rotation_non_objective = driver
         .material()
@@ -885,6 +907,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .max_rotation_of_non_objective(&driver.particles.f, now),
         ),
     );
+    let at_end = fragments(&driver.particles);
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
@@ -937,7 +960,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .chain(stray_warning(
                     tally.stray_at_start,
-                    stray_particles(&driver.particles),
+                    at_end.stray,
                     driver.particles.len(),
                 ))
                 .chain(
@@ -953,7 +976,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     .then(|| {
                         pieces_warning(
                             tally.pieces_at_start,
-                            &pieces(&driver.particles),
+                            &at_end.pieces,
                             driver.particles.len(),
                         )
                     })
