@@ -253,6 +253,7 @@ mod assemble {
                 matrix,
                 &mut self.values,
                 &mut self.force,
+                None,
             );
         }
     }

@@ -209,6 +209,11 @@ pub struct Local<T: Scalar, const D: usize> {
     pub(super) stride: usize,
     pub(super) matrix: Vec<T>,
     pub(super) vector: Vec<T>,
+    /// Per element `2 × stride`, when asked for ([`Local::with_coverage`], else
+    /// empty): each local function's particle volume and particle count,
+    /// `Σ_p V_p phi_a(x_p)` and `Σ_p phi_a(x_p)` (the coverage), written by the
+    /// assembly of phase 2a alongside the mass matrix.
+    pub(super) coverage: Vec<T>,
     /// Per element: its blocks may hold nonzero values.
     dirty: Vec<bool>,
 }
@@ -223,6 +228,17 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
         self.occupied_blocks(bins, true)
+            .map(|(e, (lm, lv, _))| (e, (lm, lv)))
+    }
+
+    /// [`Local::par_elements`] with each element's coverage block (empty without
+    /// [`Local::with_coverage`]; not zeroed: its writer overwrites it):
+    /// `(e, (matrix, vector, coverage))`.
+    pub(super) fn par_elements_with_coverage<'a>(
+        &'a mut self,
+        bins: &'a Bins,
+    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T], &'a mut [T]))> + 'a {
+        self.occupied_blocks(bins, true)
     }
 
     /// The local vector of each element that holds a particle in `bins`, zeroed
@@ -232,27 +248,36 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, &'a mut [T])> + 'a {
         self.occupied_blocks(bins, false)
-            .map(|(e, (_, lv))| (e, lv))
+            .map(|(e, (_, lv, _))| (e, lv))
     }
 
     /// The blocks of the occupied elements, the vector zeroed and the matrix block
-    /// too with `matrix`; an element emptied since the last call has both zeroed
-    /// and is skipped, so that every unoccupied element's blocks stay zero.
+    /// too with `matrix` (the coverage block is left to its writer); an element
+    /// emptied since the last call has all its blocks zeroed and is skipped, so
+    /// that every unoccupied element's blocks stay zero.
     fn occupied_blocks<'a>(
         &'a mut self,
         bins: &'a Bins,
         matrix: bool,
-    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
+    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T], &'a mut [T]))> + 'a {
         let stride = self.stride;
+        let elements = self.dirty.len();
+        // Without coverage sums, an empty coverage block per element.
+        let coverage = if self.coverage.is_empty() {
+            rayon::iter::Either::Left((0..elements).into_par_iter().map(|_| &mut [][..]))
+        } else {
+            rayon::iter::Either::Right(self.coverage.par_chunks_mut(2 * stride))
+        };
         (
             self.matrix.par_chunks_mut(packed_len(stride)),
             self.vector.par_chunks_mut(stride * D),
+            coverage,
             self.dirty.par_iter_mut(),
         )
             .into_par_iter()
             .with_min_len(ELEMENT_CHUNK)
             .enumerate()
-            .filter_map(move |(e, (lm, lv, dirty))| {
+            .filter_map(move |(e, (lm, lv, lc, dirty))| {
                 let occupied = bins.occupied(e);
                 if (occupied && matrix) || (!occupied && *dirty) {
                     lm.iter_mut().for_each(|v| *v = T::zero());
@@ -260,8 +285,11 @@ impl<T: Scalar, const D: usize> Local<T, D> {
                 if occupied || *dirty {
                     lv.iter_mut().for_each(|v| *v = T::zero());
                 }
+                if !occupied && *dirty {
+                    lc.iter_mut().for_each(|v| *v = T::zero());
+                }
                 *dirty = occupied;
-                occupied.then_some((e, (lm, lv)))
+                occupied.then_some((e, (lm, lv, lc)))
             })
     }
 
@@ -271,8 +299,15 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             stride,
             matrix: vec![T::zero(); elements * packed_len(stride)],
             vector: vec![T::zero(); elements * stride * D],
+            coverage: Vec::new(),
             dirty: vec![false; elements],
         }
+    }
+
+    /// With the coverage blocks, for the coverage sums of phase 2a.
+    pub fn with_coverage(mut self) -> Self {
+        self.coverage = vec![T::zero(); self.dirty.len() * 2 * self.stride];
+        self
     }
 }
 
@@ -409,12 +444,6 @@ impl Gather {
         &self.live
     }
 
-    /// Whether function `i` is live ([`Gather::mark_live`]).
-    #[inline]
-    pub(super) fn is_live(&self, i: usize) -> bool {
-        self.live[i]
-    }
-
     /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order,
     /// over the live columns; the entries of a column that is no longer live are
     /// set to zero (what the sum over its empty elements gives).
@@ -492,6 +521,36 @@ impl Gather {
         elements
             .checked_mul(packed_len(stride))
             .is_some_and(|e| e < u32::MAX as usize)
+    }
+
+    /// `volume_i = Σ` of the local particle volumes of function `i` and
+    /// `count_i` likewise of the particle counts ([`Local::with_coverage`]), in
+    /// element order, in `f64`; `0` for a function that is not live.
+    pub(super) fn coverage<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        volume: &mut [f64],
+        count: &mut [f64],
+    ) {
+        for (k, out) in [volume, count].into_iter().enumerate() {
+            out.par_iter_mut()
+                .with_min_len(ENTRY_CHUNK)
+                .enumerate()
+                .for_each(|(i, o)| {
+                    // A function that is not live sums `+0`.
+                    if !self.live[i] {
+                        *o = 0.0;
+                        return;
+                    }
+                    let mut sum = 0.0;
+                    let sources =
+                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
+                    for &s in &self.function_source[sources] {
+                        sum += local.coverage[s as usize * 2 + k].to_f64();
+                    }
+                    *o = sum;
+                });
+        }
     }
 
     /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in

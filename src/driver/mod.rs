@@ -324,7 +324,11 @@ where
                 .collect(),
             evals: Evaluations::for_basis(&basis, np),
             bins: Bins::new(basis.num_elements(), np),
-            local: Local::new(basis.num_elements(), stride),
+            local: if needs.coverage {
+                Local::new(basis.num_elements(), stride).with_coverage()
+            } else {
+                Local::new(basis.num_elements(), stride)
+            },
             gather: Gather::new(&basis, &pattern, stride),
             values: vec![T::zero(); pattern.nnz()],
             rhs: vec![vec![T::zero(); n]; D],
@@ -525,6 +529,10 @@ where
             },
             &mut self.values,
             &mut self.rhs,
+            self.inputs.needs.coverage.then_some((
+                &mut self.inputs.particle_volume[..],
+                &mut self.inputs.particle_count[..],
+            )),
         );
         if self.inputs.needs.empty_elements {
             phases::mark_empty_elements(
@@ -536,39 +544,6 @@ where
                     .unwrap_or(&phases::Touching::default()),
                 &mut self.inputs.touches_empty,
             );
-        }
-        if self.inputs.needs.coverage {
-            let inputs = &mut self.inputs;
-            let weights = [
-                phases::Weight::Each(&self.particles.volume[..]),
-                phases::Weight::One,
-            ];
-            let mut out = [
-                &mut inputs.particle_volume[..],
-                &mut inputs.particle_count[..],
-            ];
-            if D >= 2 {
-                // Both in one pass over the basis data.
-                phases::particle_sums_by_elements(
-                    &self.evals,
-                    &self.bins,
-                    &self.gather,
-                    &mut self.local,
-                    &weights,
-                    &mut out,
-                );
-            } else {
-                for (w, o) in weights.iter().zip(out.iter_mut()) {
-                    phases::particle_sums_by_elements(
-                        &self.evals,
-                        &self.bins,
-                        &self.gather,
-                        &mut self.local,
-                        &[*w],
-                        &mut [o],
-                    );
-                }
-            }
         }
         if self.inputs.needs.correction == Correction::InMass {
             let context = StepContext {

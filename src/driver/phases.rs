@@ -28,8 +28,8 @@ use nalgebra::{SMatrix, SVector};
 use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 
+use super::binning::packed;
 pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local, Touching};
-use super::binning::{packed, ENTRY_CHUNK};
 
 /// Particles per parallel task of the per-particle phases: fixed, so that the
 /// split (and with it every result) does not depend on the number of threads.
@@ -233,6 +233,12 @@ fn copy_entries<E: Copy>(source: &[E], out: &mut [E]) {
 /// row sums `Σ_j M_ij = Σ_p m_p phi_i(x_p)` (the basis is a partition of unity,
 /// `Σ_j phi_j = 1`), and every other entry is zero: what the lumped mass reads,
 /// at one product per function and particle instead of one per pair.
+///
+/// With `coverage = Some((volume, count))` (and `local` built
+/// [`Local::with_coverage`]) the same pass over the particles' basis data also
+/// sums what the coverage of each function reads, `volume_i = Σ_p V_p phi_i(x_p)`
+/// and `count_i = Σ_p phi_i(x_p)` (in `f64`, `0` for a function that is not live):
+/// the sums [`particle_volume`] gives, element by element.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     particles: &Particles<T, D>,
@@ -243,33 +249,60 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     matrix: MassMatrix,
     values: &mut [T],
     force: &mut [Vec<T>],
+    coverage: Option<(&mut [f64], &mut [f64])>,
 ) {
     let stride = local.stride;
     let full = matrix == MassMatrix::Full;
-    local.par_elements(bins).for_each(|(e, (lm, lv))| {
-        let inside = bins.particles(e);
-        // Every particle of an element has the element's functions; with as many
-        // as the stride (every PS and PL element) the block is summed in a
-        // fixed-size array, in the same order (the same bits).
-        let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
-        match (m == stride, m) {
-            (true, 9) => {
-                return element_block::<T, D, 9, 45>(inside, particles, evals, full, lm, lv)
+    let sums = coverage.is_some();
+    assert!(
+        !sums || !local.coverage.is_empty(),
+        "coverage sums need Local::with_coverage"
+    );
+    let block = Block {
+        full,
+        coverage: sums,
+    };
+    local
+        .par_elements_with_coverage(bins)
+        .for_each(|(e, (lm, lv, lc))| {
+            let inside = bins.particles(e);
+            // Every particle of an element has the element's functions; with as many
+            // as the stride (every PS and PL element) the block is summed in a
+            // fixed-size array, in the same order (the same bits).
+            let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
+            let out = (lm, lv, lc);
+            match (m == stride, m) {
+                (true, 9) => {
+                    return element_block::<T, D, 9, 45>(inside, particles, evals, block, out)
+                }
+                (true, 3) => {
+                    return element_block::<T, D, 3, 6>(inside, particles, evals, block, out)
+                }
+                (true, 2) => {
+                    return element_block::<T, D, 2, 3>(inside, particles, evals, block, out)
+                }
+                _ => {}
             }
-            (true, 3) => {
-                return element_block::<T, D, 3, 6>(inside, particles, evals, full, lm, lv)
-            }
-            (true, 2) => {
-                return element_block::<T, D, 2, 3>(inside, particles, evals, full, lm, lv)
-            }
-            _ => {}
-        }
-        element_block_any(inside, particles, evals, stride, full, lm, lv);
-    });
+            element_block_any(inside, particles, evals, stride, block, out);
+        });
     gather.matrix_assign(local, values);
     zero(force);
     gather.functions(local, true, force);
+    if let Some((volume, count)) = coverage {
+        gather.coverage(local, volume, count);
+    }
 }
+
+/// What phase 2a sums on an element: the whole mass block or its row sums, and
+/// the coverage sums or not.
+#[derive(Clone, Copy)]
+struct Block {
+    full: bool,
+    coverage: bool,
+}
+
+/// An element's local mass block, force coefficients and coverage sums.
+type BlockOut<'a, T> = (&'a mut [T], &'a mut [T], &'a mut [T]);
 
 /// Phase 2a on one element, any number of functions per particle (up to
 /// `stride`): the sums of [`assemble_mass_and_internal_force`] through the packed
@@ -279,16 +312,22 @@ fn element_block_any<T: Scalar, const D: usize>(
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
     stride: usize,
-    full: bool,
-    lm: &mut [T],
-    lv: &mut [T],
+    Block { full, coverage }: Block,
+    (lm, lv, lc): BlockOut<'_, T>,
 ) {
+    if coverage {
+        lc.iter_mut().for_each(|v| *v = T::zero());
+    }
     for &p in inside {
         let p = p as usize;
         let range = evals.range(p);
         let (base, m) = (range.start, range.len());
         let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
         for a in 0..m {
+            if coverage {
+                lc[2 * a] += vol * evals.phi[base + a];
+                lc[2 * a + 1] += evals.phi[base + a];
+            }
             let w = mass * evals.phi[base + a];
             if full {
                 for b in a..m {
@@ -314,15 +353,16 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
     inside: &[u32],
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
-    full: bool,
-    lm: &mut [T],
-    lv: &mut [T],
+    Block { full, coverage }: Block,
+    (lm, lv, lc): BlockOut<'_, T>,
 ) {
     debug_assert_eq!(P, M * (M + 1) / 2);
     // The whole square (vectorised rows); the upper triangle is kept.
     let mut square = [[T::zero(); M]; M];
     let mut diagonal = [T::zero(); M];
     let mut vector = [SVector::<T, D>::zeros(); M];
+    let mut volume = [T::zero(); M];
+    let mut count = [T::zero(); M];
     for &p in inside {
         let p = p as usize;
         let base = evals.range(p).start;
@@ -331,6 +371,12 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
             .try_into()
             .expect("M functions");
         let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+        if coverage {
+            for a in 0..M {
+                volume[a] += vol * phi[a];
+                count[a] += phi[a];
+            }
+        }
         for a in 0..M {
             let w = mass * phi[a];
             if full {
@@ -355,6 +401,12 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
     }
     for (a, f) in vector.iter().enumerate() {
         lv[a * D..(a + 1) * D].copy_from_slice(f.as_slice());
+    }
+    if coverage {
+        for a in 0..M {
+            lc[2 * a] = volume[a];
+            lc[2 * a + 1] = count[a];
+        }
     }
 }
 
@@ -874,64 +926,6 @@ pub fn mark_empty_elements<T: Scalar, const D: usize, B: Basis<T, D>>(
                 touches_empty[i] = true;
             }
         }
-    }
-}
-
-/// A per-particle weight of [`particle_sums_by_elements`].
-#[derive(Clone, Copy)]
-pub enum Weight<'a, T> {
-    /// `w_p`, one per particle.
-    Each(&'a [T]),
-    /// `w_p = 1` (the particle count), without an array of ones (`1 · phi` is
-    /// `phi` exactly).
-    One,
-}
-
-/// [`particle_volume`] summed element by element (the step's version; see the
-/// module's notes on threads), for several per-particle weights at once
-/// (`weights.len() ≤ D`, one component of the local vectors each: the volumes and
-/// the particle counts of the coverage in one pass over the particles' basis data),
-/// the same sums in the same order as one weight at a time.
-pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
-    evals: &Evaluations<T, D>,
-    bins: &Bins,
-    gather: &Gather,
-    local: &mut Local<T, D>,
-    weights: &[Weight<'_, T>],
-    out: &mut [&mut [f64]],
-) {
-    assert!(weights.len() <= D && weights.len() == out.len());
-    local.par_vectors(bins).for_each(|(e, lv)| {
-        for &p in bins.particles(e) {
-            let p = p as usize;
-            for (a, s) in evals.range(p).enumerate() {
-                for (k, w) in weights.iter().enumerate() {
-                    lv[a * D + k] += match w {
-                        Weight::Each(w) => w[p] * evals.phi[s],
-                        Weight::One => evals.phi[s],
-                    };
-                }
-            }
-        }
-    });
-    for (k, out) in out.iter_mut().enumerate() {
-        out.par_iter_mut()
-            .with_min_len(ENTRY_CHUNK)
-            .enumerate()
-            .for_each(|(i, o)| {
-                // A function that is not live sums `+0`.
-                if !gather.is_live(i) {
-                    *o = 0.0;
-                    return;
-                }
-                let mut sum = 0.0;
-                let sources =
-                    gather.function_start[i] as usize..gather.function_start[i + 1] as usize;
-                for &s in &gather.function_source[sources] {
-                    sum += local.vector[s as usize * D + k].to_f64();
-                }
-                *o = sum;
-            });
     }
 }
 
