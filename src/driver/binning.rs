@@ -532,25 +532,24 @@ impl Gather {
         volume: &mut [f64],
         count: &mut [f64],
     ) {
-        for (k, out) in [volume, count].into_iter().enumerate() {
-            out.par_iter_mut()
-                .with_min_len(ENTRY_CHUNK)
-                .enumerate()
-                .for_each(|(i, o)| {
-                    // A function that is not live sums `+0`.
-                    if !self.live[i] {
-                        *o = 0.0;
-                        return;
-                    }
-                    let mut sum = 0.0;
+        (volume, count)
+            .into_par_iter()
+            .with_min_len(ENTRY_CHUNK)
+            .enumerate()
+            .for_each(|(i, (volume, count))| {
+                // A function that is not live sums `+0`.
+                let mut sum = [0.0; 2];
+                if self.live[i] {
                     let sources =
                         self.function_start[i] as usize..self.function_start[i + 1] as usize;
                     for &s in &self.function_source[sources] {
-                        sum += local.coverage[s as usize * 2 + k].to_f64();
+                        let s = s as usize * 2;
+                        sum[0] += local.coverage[s].to_f64();
+                        sum[1] += local.coverage[s + 1].to_f64();
                     }
-                    *o = sum;
-                });
-        }
+                }
+                [*volume, *count] = sum;
+            });
     }
 
     /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in
@@ -663,6 +662,7 @@ mod tests {
         round: f64,
         values: &mut [f64],
         out: &mut [Vec<f64>],
+        coverage: [&mut [f64]; 2],
     ) {
         gather.mark_live(basis, bins);
         let vector = |e: usize, lv: &mut [f64]| {
@@ -674,16 +674,23 @@ mod tests {
         if round as usize % 2 == 1 {
             local.par_vectors(bins).for_each(|(e, lv)| vector(e, lv));
         }
-        local.par_elements(bins).for_each(|(e, (lm, lv))| {
-            for (k, v) in lm.iter_mut().enumerate() {
-                *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
-            }
-            vector(e, lv);
-        });
+        local
+            .par_elements_with_coverage(bins)
+            .for_each(|(e, (lm, lv, lc))| {
+                for (k, v) in lm.iter_mut().enumerate() {
+                    *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
+                }
+                vector(e, lv);
+                for (k, v) in lc.iter_mut().enumerate() {
+                    *v = (e as f64 + 3.0) * 0.19 + k as f64 * 0.013 + round;
+                }
+            });
         gather.matrix_assign(local, values);
         out.iter_mut()
             .for_each(|o| o.iter_mut().for_each(|v| *v = 0.0));
         gather.functions(local, false, out);
+        let [volume, count] = coverage;
+        gather.coverage(local, volume, count);
     }
 
     /// The gathers over the live functions give, bit for bit, the sums over every
@@ -697,10 +704,11 @@ mod tests {
         let (ne, n) = (basis.num_elements(), basis.num_functions());
         let stride = basis.max_functions_per_element();
         let mut gather = Gather::new(&basis, &pattern, stride);
-        let mut local = Local::<f64, 2>::new(ne, stride);
+        let mut local = Local::<f64, 2>::new(ne, stride).with_coverage();
         let mut bins = Bins::new(ne, 6);
         let mut values = vec![0.0; pattern.nnz()];
         let mut out = vec![vec![0.0; n]; 2];
+        let mut coverage = [vec![0.0; n], vec![0.0; n]];
         for (r, elements) in [
             [0, 0, 1, 5, 5, 7],
             [5, 9, 9, 30, 31, 31],
@@ -718,6 +726,7 @@ mod tests {
                 r as f64,
                 &mut values,
                 &mut out,
+                coverage.each_mut().map(|c| &mut c[..]),
             );
             // The full sums, from the blocks of the occupied elements alone.
             let occupied = |s: usize, per: usize| bins.occupied(s / per);
@@ -746,10 +755,26 @@ mod tests {
                     assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, function {i}");
                 }
             }
+            for (k, o) in coverage.iter().enumerate() {
+                for (i, v) in o.iter().enumerate() {
+                    let mut sum = 0.0;
+                    for &s in &gather.function_source
+                        [gather.function_start[i] as usize..gather.function_start[i + 1] as usize]
+                    {
+                        if occupied(s as usize, stride) {
+                            sum += local.coverage[s as usize * 2 + k];
+                        }
+                    }
+                    assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, coverage {k} of {i}");
+                }
+            }
             assert!(values.iter().any(|&v| v != 0.0));
         }
         // The blocks of the elements emptied in the last round are zero.
         for e in [0, 1, 5, 7, 9, 30, 31] {
+            assert!(local.coverage[e * 2 * stride..(e + 1) * 2 * stride]
+                .iter()
+                .all(|&v| v == 0.0));
             assert!(
                 local.matrix[e * packed_len(stride)..(e + 1) * packed_len(stride)]
                     .iter()

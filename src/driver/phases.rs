@@ -977,7 +977,8 @@ mod tests {
     use nalgebra::{Matrix2, Vector2};
 
     /// The fixed-size element block gives the general loop's sums to the last bit,
-    /// for the full matrix and for the row sums (PS: 9 functions, PL: 3).
+    /// for the full matrix and for the row sums, and the coverage sums (PS: 9
+    /// functions, PL: 3).
     #[test]
     fn element_blocks_equal_the_general_loop_bit_for_bit() {
         let mut seed = 12345u64;
@@ -1004,15 +1005,34 @@ mod tests {
                 .iter_mut()
                 .for_each(|g| *g = Vector2::new(next() - 0.5, next() - 0.5));
             let inside: Vec<u32> = vec![3, 0, 6, 1, 5, 2, 4];
-            for full in [true, false] {
-                let (mut lm, mut lv) = (vec![0.0; P], vec![0.0; M * 2]);
-                element_block::<f64, 2, M, P>(&inside, &particles, &evals, full, &mut lm, &mut lv);
-                let (mut rm, mut rv) = (vec![0.0; P], vec![0.0; M * 2]);
-                element_block_any(&inside, &particles, &evals, M, full, &mut rm, &mut rv);
+            for (full, coverage) in [(true, false), (false, false), (true, true)] {
+                let block = Block { full, coverage };
+                let [mut lm, mut rm] = [0, 1].map(|_| vec![0.0; P]);
+                let [mut lv, mut rv] = [0, 1].map(|_| vec![0.0; M * 2]);
+                // Stale values in the coverage blocks: the element's sums overwrite them.
+                let [mut lc, mut rc] = [0, 1].map(|_| vec![0.25; M * 2]);
+                let out = (&mut lm[..], &mut lv[..], &mut lc[..]);
+                element_block::<f64, 2, M, P>(&inside, &particles, &evals, block, out);
+                let out = (&mut rm[..], &mut rv[..], &mut rc[..]);
+                element_block_any(&inside, &particles, &evals, M, block, out);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&lm), bits(&rm), "M = {M}, full = {full}");
                 assert_eq!(bits(&lv), bits(&rv), "M = {M}, full = {full}");
+                assert_eq!(bits(&lc), bits(&rc), "M = {M}, coverage = {coverage}");
                 assert!(rm.iter().any(|&x| x != 0.0));
+                if coverage {
+                    // The volume and the count each function sees, in particle order.
+                    for a in 0..M {
+                        let (mut volume, mut count) = (0.0, 0.0);
+                        for &p in &inside {
+                            let phi = evals.phi[evals.range(p as usize).start + a];
+                            volume += particles.volume[p as usize] * phi;
+                            count += phi;
+                        }
+                        assert_eq!(lc[2 * a].to_bits(), volume.to_bits());
+                        assert_eq!(lc[2 * a + 1].to_bits(), count.to_bits());
+                    }
+                }
             }
         }
         check::<9, 45>(&mut next);
