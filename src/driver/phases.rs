@@ -209,7 +209,11 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
 /// 3) as fixed-size copies: a copy of a runtime length calls the C library's
 /// `memmove` (2 % of a PS step in the profile); phase 1 for PS is about 1.5 %
 /// faster (`cargo bench --bench kernels -- eval`, `ps_phase` fastest of 20:
-/// 6.03 and 6.10 ms against 6.12 and 6.19 ms, two alternating rounds).
+/// 6.03 and 6.10 ms against 6.12 and 6.19 ms, two alternating rounds). The nine
+/// PS gradients (144 bytes) are copied in two halves: in one, the compiler still
+/// called `memmove` for them (a fixed copy of more than 128 bytes on the baseline
+/// x86-64 target); in halves, `ps_phase` 8.36–8.77 ms against 9.65–9.72 ms
+/// (fastest of 20, four alternating rounds, `docs/performance.md`).
 #[inline(always)]
 fn copy_entries<E: Copy>(source: &[E], out: &mut [E]) {
     fn fixed<E: Copy, const N: usize>(source: &[E], out: &mut [E]) {
@@ -218,7 +222,11 @@ fn copy_entries<E: Copy>(source: &[E], out: &mut [E]) {
         *out = *source;
     }
     match out.len() {
-        9 => fixed::<E, 9>(source, out),
+        // In two halves, each copied inline (see above).
+        9 => {
+            fixed::<E, 4>(source, &mut out[..4]);
+            fixed::<E, 5>(&source[4..], &mut out[4..]);
+        }
         3 => fixed::<E, 3>(source, out),
         m => out.copy_from_slice(&source[..m]),
     }
