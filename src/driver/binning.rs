@@ -198,6 +198,9 @@ pub(super) fn packed(stride: usize, a: usize, b: usize) -> usize {
     a * stride - a * a.saturating_sub(1) / 2 + (b - a)
 }
 
+/// An element's local blocks: its mass block, vector coefficients and coverage sums.
+pub(super) type ElementBlocks<'a, T> = (&'a mut [T], &'a mut [T], &'a mut [T]);
+
 /// Element-local sums: per element an upper-triangular `stride × stride` block of
 /// the mass matrix and `stride × D` coefficients of a vector field (local
 /// function `a` is the element's `a`-th function, as evaluated in phase 1).
@@ -237,7 +240,7 @@ impl<T: Scalar, const D: usize> Local<T, D> {
     pub(super) fn par_elements_with_coverage<'a>(
         &'a mut self,
         bins: &'a Bins,
-    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T], &'a mut [T]))> + 'a {
+    ) -> impl ParallelIterator<Item = (usize, ElementBlocks<'a, T>)> + 'a {
         self.occupied_blocks(bins, true)
     }
 
@@ -259,7 +262,7 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         &'a mut self,
         bins: &'a Bins,
         matrix: bool,
-    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T], &'a mut [T]))> + 'a {
+    ) -> impl ParallelIterator<Item = (usize, ElementBlocks<'a, T>)> + 'a {
         let stride = self.stride;
         let elements = self.dirty.len();
         // Without coverage sums, an empty coverage block per element.
@@ -654,6 +657,7 @@ mod tests {
 
     /// Fills the blocks of the occupied elements with values that depend on the
     /// element, the entry and the round, then gathers the matrix and the vector.
+    #[allow(clippy::too_many_arguments)]
     fn round(
         basis: &PowellSabin<f64>,
         gather: &mut Gather,

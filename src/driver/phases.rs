@@ -28,8 +28,8 @@ use nalgebra::{SMatrix, SVector};
 use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 
-use super::binning::packed;
 pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local, Touching};
+use super::binning::{packed, ElementBlocks};
 
 /// Particles per parallel task of the per-particle phases: fixed, so that the
 /// split (and with it every result) does not depend on the number of threads.
@@ -309,9 +309,6 @@ struct Block {
     coverage: bool,
 }
 
-/// An element's local mass block, force coefficients and coverage sums.
-type BlockOut<'a, T> = (&'a mut [T], &'a mut [T], &'a mut [T]);
-
 /// Phase 2a on one element, any number of functions per particle (up to
 /// `stride`): the sums of [`assemble_mass_and_internal_force`] through the packed
 /// index of each pair.
@@ -321,7 +318,7 @@ fn element_block_any<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
     stride: usize,
     Block { full, coverage }: Block,
-    (lm, lv, lc): BlockOut<'_, T>,
+    (lm, lv, lc): ElementBlocks<'_, T>,
 ) {
     if coverage {
         lc.iter_mut().for_each(|v| *v = T::zero());
@@ -362,7 +359,7 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
     Block { full, coverage }: Block,
-    (lm, lv, lc): BlockOut<'_, T>,
+    (lm, lv, lc): ElementBlocks<'_, T>,
 ) {
     debug_assert_eq!(P, M * (M + 1) / 2);
     // The whole square (vectorised rows); the upper triangle is kept.
