@@ -208,6 +208,8 @@ mod assemble {
         local: Local<f64, 2>,
         pub values: Vec<f64>,
         force: Vec<Vec<f64>>,
+        /// The coverage sums (particle volume, particle count per function).
+        coverage: [Vec<f64>; 2],
     }
 
     impl Assembly {
@@ -233,9 +235,13 @@ mod assemble {
             .unwrap();
             Assembly {
                 gather: Gather::new(basis, &pattern, stride),
-                local: Local::new(basis.num_elements(), stride),
+                local: Local::new(basis.num_elements(), stride).with_coverage(),
                 values: vec![0.0; pattern.nnz()],
                 force: vec![vec![0.0; basis.num_functions()]; 2],
+                coverage: [
+                    vec![0.0; basis.num_functions()],
+                    vec![0.0; basis.num_functions()],
+                ],
                 pattern,
                 evals,
                 bins,
@@ -244,6 +250,13 @@ mod assemble {
 
         /// Phase 2a into `values` and the force.
         pub fn run(&mut self, parts: &Particles<f64, 2>, matrix: MassMatrix) {
+            self.run_with(parts, matrix, false);
+        }
+
+        /// Phase 2a, and the coverage sums with `coverage` (what the default
+        /// strategy asks for).
+        pub fn run_with(&mut self, parts: &Particles<f64, 2>, matrix: MassMatrix, coverage: bool) {
+            let [volume, count] = &mut self.coverage;
             assemble_mass_and_internal_force(
                 parts,
                 &self.evals,
@@ -253,15 +266,25 @@ mod assemble {
                 matrix,
                 &mut self.values,
                 &mut self.force,
+                coverage.then_some((&mut volume[..], &mut count[..])),
             );
         }
     }
 
     fn bench<B: Basis<f64, 2>>(bencher: divan::Bencher, basis: B, matrix: MassMatrix) {
+        bench_with(bencher, basis, matrix, false);
+    }
+
+    fn bench_with<B: Basis<f64, 2>>(
+        bencher: divan::Bencher,
+        basis: B,
+        matrix: MassMatrix,
+        coverage: bool,
+    ) {
         let parts = particles();
         let mut assembly = Assembly::new(&basis, &parts);
         bencher.bench_local(|| {
-            assembly.run(&parts, matrix);
+            assembly.run_with(&parts, matrix, coverage);
             assembly.values[0]
         });
     }
@@ -284,6 +307,12 @@ mod assemble {
     #[divan::bench(sample_count = 20)]
     fn ps_full(bencher: divan::Bencher) {
         bench(bencher, super::ps(), MassMatrix::Full);
+    }
+
+    /// With the coverage sums of the default strategy in the same pass.
+    #[divan::bench(sample_count = 20)]
+    fn ps_full_coverage(bencher: divan::Bencher) {
+        bench_with(bencher, super::ps(), MassMatrix::Full, true);
     }
 }
 

@@ -198,6 +198,9 @@ pub(super) fn packed(stride: usize, a: usize, b: usize) -> usize {
     a * stride - a * a.saturating_sub(1) / 2 + (b - a)
 }
 
+/// An element's local blocks: its mass block, vector coefficients and coverage sums.
+pub(super) type ElementBlocks<'a, T> = (&'a mut [T], &'a mut [T], &'a mut [T]);
+
 /// Element-local sums: per element an upper-triangular `stride × stride` block of
 /// the mass matrix and `stride × D` coefficients of a vector field (local
 /// function `a` is the element's `a`-th function, as evaluated in phase 1).
@@ -209,6 +212,11 @@ pub struct Local<T: Scalar, const D: usize> {
     pub(super) stride: usize,
     pub(super) matrix: Vec<T>,
     pub(super) vector: Vec<T>,
+    /// Per element `2 × stride`, when asked for ([`Local::with_coverage`], else
+    /// empty): each local function's particle volume and particle count,
+    /// `Σ_p V_p phi_a(x_p)` and `Σ_p phi_a(x_p)` (the coverage), written by the
+    /// assembly of phase 2a alongside the mass matrix.
+    pub(super) coverage: Vec<T>,
     /// Per element: its blocks may hold nonzero values.
     dirty: Vec<bool>,
 }
@@ -223,6 +231,17 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
         self.occupied_blocks(bins, true)
+            .map(|(e, (lm, lv, _))| (e, (lm, lv)))
+    }
+
+    /// [`Local::par_elements`] with each element's coverage block (empty without
+    /// [`Local::with_coverage`]; not zeroed: its writer overwrites it):
+    /// `(e, (matrix, vector, coverage))`.
+    pub(super) fn par_elements_with_coverage<'a>(
+        &'a mut self,
+        bins: &'a Bins,
+    ) -> impl ParallelIterator<Item = (usize, ElementBlocks<'a, T>)> + 'a {
+        self.occupied_blocks(bins, true)
     }
 
     /// The local vector of each element that holds a particle in `bins`, zeroed
@@ -232,27 +251,36 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, &'a mut [T])> + 'a {
         self.occupied_blocks(bins, false)
-            .map(|(e, (_, lv))| (e, lv))
+            .map(|(e, (_, lv, _))| (e, lv))
     }
 
     /// The blocks of the occupied elements, the vector zeroed and the matrix block
-    /// too with `matrix`; an element emptied since the last call has both zeroed
-    /// and is skipped, so that every unoccupied element's blocks stay zero.
+    /// too with `matrix` (the coverage block is left to its writer); an element
+    /// emptied since the last call has all its blocks zeroed and is skipped, so
+    /// that every unoccupied element's blocks stay zero.
     fn occupied_blocks<'a>(
         &'a mut self,
         bins: &'a Bins,
         matrix: bool,
-    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
+    ) -> impl ParallelIterator<Item = (usize, ElementBlocks<'a, T>)> + 'a {
         let stride = self.stride;
+        let elements = self.dirty.len();
+        // Without coverage sums, an empty coverage block per element.
+        let coverage = if self.coverage.is_empty() {
+            rayon::iter::Either::Left((0..elements).into_par_iter().map(|_| &mut [][..]))
+        } else {
+            rayon::iter::Either::Right(self.coverage.par_chunks_mut(2 * stride))
+        };
         (
             self.matrix.par_chunks_mut(packed_len(stride)),
             self.vector.par_chunks_mut(stride * D),
+            coverage,
             self.dirty.par_iter_mut(),
         )
             .into_par_iter()
             .with_min_len(ELEMENT_CHUNK)
             .enumerate()
-            .filter_map(move |(e, (lm, lv, dirty))| {
+            .filter_map(move |(e, (lm, lv, lc, dirty))| {
                 let occupied = bins.occupied(e);
                 if (occupied && matrix) || (!occupied && *dirty) {
                     lm.iter_mut().for_each(|v| *v = T::zero());
@@ -260,8 +288,11 @@ impl<T: Scalar, const D: usize> Local<T, D> {
                 if occupied || *dirty {
                     lv.iter_mut().for_each(|v| *v = T::zero());
                 }
+                if !occupied && *dirty {
+                    lc.iter_mut().for_each(|v| *v = T::zero());
+                }
                 *dirty = occupied;
-                occupied.then_some((e, (lm, lv)))
+                occupied.then_some((e, (lm, lv, lc)))
             })
     }
 
@@ -271,8 +302,15 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             stride,
             matrix: vec![T::zero(); elements * packed_len(stride)],
             vector: vec![T::zero(); elements * stride * D],
+            coverage: Vec::new(),
             dirty: vec![false; elements],
         }
+    }
+
+    /// With the coverage blocks, for the coverage sums of phase 2a.
+    pub fn with_coverage(mut self) -> Self {
+        self.coverage = vec![T::zero(); self.dirty.len() * 2 * self.stride];
+        self
     }
 }
 
@@ -409,12 +447,6 @@ impl Gather {
         &self.live
     }
 
-    /// Whether function `i` is live ([`Gather::mark_live`]).
-    #[inline]
-    pub(super) fn is_live(&self, i: usize) -> bool {
-        self.live[i]
-    }
-
     /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order,
     /// over the live columns; the entries of a column that is no longer live are
     /// set to zero (what the sum over its empty elements gives).
@@ -492,6 +524,35 @@ impl Gather {
         elements
             .checked_mul(packed_len(stride))
             .is_some_and(|e| e < u32::MAX as usize)
+    }
+
+    /// `volume_i = Σ` of the local particle volumes of function `i` and
+    /// `count_i` likewise of the particle counts ([`Local::with_coverage`]), in
+    /// element order, in `f64`; `0` for a function that is not live.
+    pub(super) fn coverage<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        volume: &mut [f64],
+        count: &mut [f64],
+    ) {
+        (volume, count)
+            .into_par_iter()
+            .with_min_len(ENTRY_CHUNK)
+            .enumerate()
+            .for_each(|(i, (volume, count))| {
+                // A function that is not live sums `+0`.
+                let mut sum = [0.0; 2];
+                if self.live[i] {
+                    let sources =
+                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
+                    for &s in &self.function_source[sources] {
+                        let s = s as usize * 2;
+                        sum[0] += local.coverage[s].to_f64();
+                        sum[1] += local.coverage[s + 1].to_f64();
+                    }
+                }
+                [*volume, *count] = sum;
+            });
     }
 
     /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in
@@ -596,6 +657,7 @@ mod tests {
 
     /// Fills the blocks of the occupied elements with values that depend on the
     /// element, the entry and the round, then gathers the matrix and the vector.
+    #[allow(clippy::too_many_arguments)]
     fn round(
         basis: &PowellSabin<f64>,
         gather: &mut Gather,
@@ -604,6 +666,7 @@ mod tests {
         round: f64,
         values: &mut [f64],
         out: &mut [Vec<f64>],
+        coverage: [&mut [f64]; 2],
     ) {
         gather.mark_live(basis, bins);
         let vector = |e: usize, lv: &mut [f64]| {
@@ -615,16 +678,23 @@ mod tests {
         if round as usize % 2 == 1 {
             local.par_vectors(bins).for_each(|(e, lv)| vector(e, lv));
         }
-        local.par_elements(bins).for_each(|(e, (lm, lv))| {
-            for (k, v) in lm.iter_mut().enumerate() {
-                *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
-            }
-            vector(e, lv);
-        });
+        local
+            .par_elements_with_coverage(bins)
+            .for_each(|(e, (lm, lv, lc))| {
+                for (k, v) in lm.iter_mut().enumerate() {
+                    *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
+                }
+                vector(e, lv);
+                for (k, v) in lc.iter_mut().enumerate() {
+                    *v = (e as f64 + 3.0) * 0.19 + k as f64 * 0.013 + round;
+                }
+            });
         gather.matrix_assign(local, values);
         out.iter_mut()
             .for_each(|o| o.iter_mut().for_each(|v| *v = 0.0));
         gather.functions(local, false, out);
+        let [volume, count] = coverage;
+        gather.coverage(local, volume, count);
     }
 
     /// The gathers over the live functions give, bit for bit, the sums over every
@@ -638,10 +708,11 @@ mod tests {
         let (ne, n) = (basis.num_elements(), basis.num_functions());
         let stride = basis.max_functions_per_element();
         let mut gather = Gather::new(&basis, &pattern, stride);
-        let mut local = Local::<f64, 2>::new(ne, stride);
+        let mut local = Local::<f64, 2>::new(ne, stride).with_coverage();
         let mut bins = Bins::new(ne, 6);
         let mut values = vec![0.0; pattern.nnz()];
         let mut out = vec![vec![0.0; n]; 2];
+        let mut coverage = [vec![0.0; n], vec![0.0; n]];
         for (r, elements) in [
             [0, 0, 1, 5, 5, 7],
             [5, 9, 9, 30, 31, 31],
@@ -659,6 +730,7 @@ mod tests {
                 r as f64,
                 &mut values,
                 &mut out,
+                coverage.each_mut().map(|c| &mut c[..]),
             );
             // The full sums, from the blocks of the occupied elements alone.
             let occupied = |s: usize, per: usize| bins.occupied(s / per);
@@ -687,10 +759,26 @@ mod tests {
                     assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, function {i}");
                 }
             }
+            for (k, o) in coverage.iter().enumerate() {
+                for (i, v) in o.iter().enumerate() {
+                    let mut sum = 0.0;
+                    for &s in &gather.function_source
+                        [gather.function_start[i] as usize..gather.function_start[i + 1] as usize]
+                    {
+                        if occupied(s as usize, stride) {
+                            sum += local.coverage[s as usize * 2 + k];
+                        }
+                    }
+                    assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, coverage {k} of {i}");
+                }
+            }
             assert!(values.iter().any(|&v| v != 0.0));
         }
         // The blocks of the elements emptied in the last round are zero.
         for e in [0, 1, 5, 7, 9, 30, 31] {
+            assert!(local.coverage[e * 2 * stride..(e + 1) * 2 * stride]
+                .iter()
+                .all(|&v| v == 0.0));
             assert!(
                 local.matrix[e * packed_len(stride)..(e + 1) * packed_len(stride)]
                     .iter()

@@ -76,6 +76,11 @@ struct StrategyInputs {
     /// when a decision depends on which elements hold particles (empty elements,
     /// live functions, the affine-preserving lumping); refilled every step.
     touching: Option<phases::Touching>,
+    /// `touching` holds this step's particles. Left stale in a step in which
+    /// every element holds a particle: the live functions and the empty elements
+    /// read it only for the elements without one, so only the affine-preserving
+    /// lumping needs it then, and fills it ([`StrategyInputs::fill_touching`]).
+    touching_current: bool,
     /// `live[i]`: an element holding a particle, or with one on its closure, has
     /// function `i` (with `touching`; else the gather's live functions serve).
     live: Vec<bool>,
@@ -92,12 +97,18 @@ impl StrategyInputs {
         bins: &Bins,
         gather: &Gather,
     ) {
-        let Some(touching) = self.touching.as_mut() else {
+        self.touching_current = false;
+        if self.touching.is_none() {
             return;
-        };
-        touching.fill(basis, &particles.x, &particles.element);
+        }
         self.live.clear();
         self.live.extend_from_slice(gather.live());
+        // Every element holds a particle: nothing more is live, nothing empty.
+        if (0..basis.num_elements()).all(|e| bins.occupied(e)) {
+            return;
+        }
+        self.fill_touching(basis, particles);
+        let touching = self.touching.as_ref().expect("checked above");
         if touching.is_empty() {
             return;
         }
@@ -106,6 +117,21 @@ impl StrategyInputs {
                 for &i in basis.element_functions(e) {
                     self.live[i] = true;
                 }
+            }
+        }
+    }
+
+    /// Fills `touching` for this step's particles, unless it holds them already
+    /// (once per step at most; nothing without `touching`).
+    fn fill_touching<T: Scalar, const D: usize, B: Basis<T, D>>(
+        &mut self,
+        basis: &B,
+        particles: &Particles<T, D>,
+    ) {
+        if let Some(touching) = self.touching.as_mut() {
+            if !self.touching_current {
+                touching.fill(basis, &particles.x, &particles.element);
+                self.touching_current = true;
             }
         }
     }
@@ -295,6 +321,7 @@ where
                 || needs.coverage
                 || needs.correction == Correction::InMass)
                 .then(phases::Touching::default),
+            touching_current: false,
             live: Vec::new(),
             element_affine: if needs.correction == Correction::InMass {
                 vec![false; basis.num_elements()]
@@ -324,7 +351,11 @@ where
                 .collect(),
             evals: Evaluations::for_basis(&basis, np),
             bins: Bins::new(basis.num_elements(), np),
-            local: Local::new(basis.num_elements(), stride),
+            local: if needs.coverage {
+                Local::new(basis.num_elements(), stride).with_coverage()
+            } else {
+                Local::new(basis.num_elements(), stride)
+            },
             gather: Gather::new(&basis, &pattern, stride),
             values: vec![T::zero(); pattern.nnz()],
             rhs: vec![vec![T::zero(); n]; D],
@@ -525,6 +556,10 @@ where
             },
             &mut self.values,
             &mut self.rhs,
+            self.inputs.needs.coverage.then_some((
+                &mut self.inputs.particle_volume[..],
+                &mut self.inputs.particle_count[..],
+            )),
         );
         if self.inputs.needs.empty_elements {
             phases::mark_empty_elements(
@@ -536,39 +571,6 @@ where
                     .unwrap_or(&phases::Touching::default()),
                 &mut self.inputs.touches_empty,
             );
-        }
-        if self.inputs.needs.coverage {
-            let inputs = &mut self.inputs;
-            let weights = [
-                phases::Weight::Each(&self.particles.volume[..]),
-                phases::Weight::One,
-            ];
-            let mut out = [
-                &mut inputs.particle_volume[..],
-                &mut inputs.particle_count[..],
-            ];
-            if D >= 2 {
-                // Both in one pass over the basis data.
-                phases::particle_sums_by_elements(
-                    &self.evals,
-                    &self.bins,
-                    &self.gather,
-                    &mut self.local,
-                    &weights,
-                    &mut out,
-                );
-            } else {
-                for (w, o) in weights.iter().zip(out.iter_mut()) {
-                    phases::particle_sums_by_elements(
-                        &self.evals,
-                        &self.bins,
-                        &self.gather,
-                        &mut self.local,
-                        &[*w],
-                        &mut [o],
-                    );
-                }
-            }
         }
         if self.inputs.needs.correction == Correction::InMass {
             let context = StepContext {
@@ -584,6 +586,7 @@ where
                 diagonal_only: self.inputs.needs.row_sums_only,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
+                self.inputs.fill_touching(&self.basis, &self.particles);
                 phases::add_affine_lumping(
                     &self.evals,
                     &self.bins,

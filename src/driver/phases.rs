@@ -29,7 +29,7 @@ use psmpm_basis::{Basis, BasisEval};
 use rayon::prelude::*;
 
 pub use super::binning::{chunks, scatter_by_elements, Bins, Gather, Local, Touching};
-use super::binning::{packed, ENTRY_CHUNK};
+use super::binning::{packed, ElementBlocks};
 
 /// Particles per parallel task of the per-particle phases: fixed, so that the
 /// split (and with it every result) does not depend on the number of threads.
@@ -209,7 +209,11 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
 /// 3) as fixed-size copies: a copy of a runtime length calls the C library's
 /// `memmove` (2 % of a PS step in the profile); phase 1 for PS is about 1.5 %
 /// faster (`cargo bench --bench kernels -- eval`, `ps_phase` fastest of 20:
-/// 6.03 and 6.10 ms against 6.12 and 6.19 ms, two alternating rounds).
+/// 6.03 and 6.10 ms against 6.12 and 6.19 ms, two alternating rounds). The nine
+/// PS gradients (144 bytes) are copied in two halves: in one, the compiler still
+/// called `memmove` for them (a fixed copy of more than 128 bytes on the baseline
+/// x86-64 target); in halves, `ps_phase` 8.36–8.77 ms against 9.65–9.72 ms
+/// (fastest of 20, four alternating rounds, `docs/performance.md`).
 #[inline(always)]
 fn copy_entries<E: Copy>(source: &[E], out: &mut [E]) {
     fn fixed<E: Copy, const N: usize>(source: &[E], out: &mut [E]) {
@@ -218,7 +222,11 @@ fn copy_entries<E: Copy>(source: &[E], out: &mut [E]) {
         *out = *source;
     }
     match out.len() {
-        9 => fixed::<E, 9>(source, out),
+        // In two halves, each copied inline (see above).
+        9 => {
+            fixed::<E, 4>(source, &mut out[..4]);
+            fixed::<E, 5>(&source[4..], &mut out[4..]);
+        }
         3 => fixed::<E, 3>(source, out),
         m => out.copy_from_slice(&source[..m]),
     }
@@ -233,6 +241,12 @@ fn copy_entries<E: Copy>(source: &[E], out: &mut [E]) {
 /// row sums `Σ_j M_ij = Σ_p m_p phi_i(x_p)` (the basis is a partition of unity,
 /// `Σ_j phi_j = 1`), and every other entry is zero: what the lumped mass reads,
 /// at one product per function and particle instead of one per pair.
+///
+/// With `coverage = Some((volume, count))` (and `local` built
+/// [`Local::with_coverage`]) the same pass over the particles' basis data also
+/// sums what the coverage of each function reads, `volume_i = Σ_p V_p phi_i(x_p)`
+/// and `count_i = Σ_p phi_i(x_p)` (in `f64`, `0` for a function that is not live):
+/// the sums [`particle_volume`] gives, element by element.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     particles: &Particles<T, D>,
@@ -243,32 +257,56 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
     matrix: MassMatrix,
     values: &mut [T],
     force: &mut [Vec<T>],
+    coverage: Option<(&mut [f64], &mut [f64])>,
 ) {
     let stride = local.stride;
     let full = matrix == MassMatrix::Full;
-    local.par_elements(bins).for_each(|(e, (lm, lv))| {
-        let inside = bins.particles(e);
-        // Every particle of an element has the element's functions; with as many
-        // as the stride (every PS and PL element) the block is summed in a
-        // fixed-size array, in the same order (the same bits).
-        let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
-        match (m == stride, m) {
-            (true, 9) => {
-                return element_block::<T, D, 9, 45>(inside, particles, evals, full, lm, lv)
+    let sums = coverage.is_some();
+    assert!(
+        !sums || !local.coverage.is_empty(),
+        "coverage sums need Local::with_coverage"
+    );
+    let block = Block {
+        full,
+        coverage: sums,
+    };
+    local
+        .par_elements_with_coverage(bins)
+        .for_each(|(e, (lm, lv, lc))| {
+            let inside = bins.particles(e);
+            // Every particle of an element has the element's functions; with as many
+            // as the stride (every PS and PL element) the block is summed in a
+            // fixed-size array, in the same order (the same bits).
+            let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
+            let out = (lm, lv, lc);
+            match (m == stride, m) {
+                (true, 9) => {
+                    return element_block::<T, D, 9, 45>(inside, particles, evals, block, out)
+                }
+                (true, 3) => {
+                    return element_block::<T, D, 3, 6>(inside, particles, evals, block, out)
+                }
+                (true, 2) => {
+                    return element_block::<T, D, 2, 3>(inside, particles, evals, block, out)
+                }
+                _ => {}
             }
-            (true, 3) => {
-                return element_block::<T, D, 3, 6>(inside, particles, evals, full, lm, lv)
-            }
-            (true, 2) => {
-                return element_block::<T, D, 2, 3>(inside, particles, evals, full, lm, lv)
-            }
-            _ => {}
-        }
-        element_block_any(inside, particles, evals, stride, full, lm, lv);
-    });
+            element_block_any(inside, particles, evals, stride, block, out);
+        });
     gather.matrix_assign(local, values);
     zero(force);
     gather.functions(local, true, force);
+    if let Some((volume, count)) = coverage {
+        gather.coverage(local, volume, count);
+    }
+}
+
+/// What phase 2a sums on an element: the whole mass block or its row sums, and
+/// the coverage sums or not.
+#[derive(Clone, Copy)]
+struct Block {
+    full: bool,
+    coverage: bool,
 }
 
 /// Phase 2a on one element, any number of functions per particle (up to
@@ -279,16 +317,22 @@ fn element_block_any<T: Scalar, const D: usize>(
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
     stride: usize,
-    full: bool,
-    lm: &mut [T],
-    lv: &mut [T],
+    Block { full, coverage }: Block,
+    (lm, lv, lc): ElementBlocks<'_, T>,
 ) {
+    if coverage {
+        lc.iter_mut().for_each(|v| *v = T::zero());
+    }
     for &p in inside {
         let p = p as usize;
         let range = evals.range(p);
         let (base, m) = (range.start, range.len());
         let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
         for a in 0..m {
+            if coverage {
+                lc[2 * a] += vol * evals.phi[base + a];
+                lc[2 * a + 1] += evals.phi[base + a];
+            }
             let w = mass * evals.phi[base + a];
             if full {
                 for b in a..m {
@@ -314,15 +358,16 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
     inside: &[u32],
     particles: &Particles<T, D>,
     evals: &Evaluations<T, D>,
-    full: bool,
-    lm: &mut [T],
-    lv: &mut [T],
+    Block { full, coverage }: Block,
+    (lm, lv, lc): ElementBlocks<'_, T>,
 ) {
     debug_assert_eq!(P, M * (M + 1) / 2);
     // The whole square (vectorised rows); the upper triangle is kept.
     let mut square = [[T::zero(); M]; M];
     let mut diagonal = [T::zero(); M];
     let mut vector = [SVector::<T, D>::zeros(); M];
+    let mut volume = [T::zero(); M];
+    let mut count = [T::zero(); M];
     for &p in inside {
         let p = p as usize;
         let base = evals.range(p).start;
@@ -331,6 +376,12 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
             .try_into()
             .expect("M functions");
         let (mass, vol, sigma) = (particles.mass[p], particles.volume[p], &particles.sigma[p]);
+        if coverage {
+            for a in 0..M {
+                volume[a] += vol * phi[a];
+                count[a] += phi[a];
+            }
+        }
         for a in 0..M {
             let w = mass * phi[a];
             if full {
@@ -355,6 +406,12 @@ fn element_block<T: Scalar, const D: usize, const M: usize, const P: usize>(
     }
     for (a, f) in vector.iter().enumerate() {
         lv[a * D..(a + 1) * D].copy_from_slice(f.as_slice());
+    }
+    if coverage {
+        for a in 0..M {
+            lc[2 * a] = volume[a];
+            lc[2 * a + 1] = count[a];
+        }
     }
 }
 
@@ -877,64 +934,6 @@ pub fn mark_empty_elements<T: Scalar, const D: usize, B: Basis<T, D>>(
     }
 }
 
-/// A per-particle weight of [`particle_sums_by_elements`].
-#[derive(Clone, Copy)]
-pub enum Weight<'a, T> {
-    /// `w_p`, one per particle.
-    Each(&'a [T]),
-    /// `w_p = 1` (the particle count), without an array of ones (`1 · phi` is
-    /// `phi` exactly).
-    One,
-}
-
-/// [`particle_volume`] summed element by element (the step's version; see the
-/// module's notes on threads), for several per-particle weights at once
-/// (`weights.len() ≤ D`, one component of the local vectors each: the volumes and
-/// the particle counts of the coverage in one pass over the particles' basis data),
-/// the same sums in the same order as one weight at a time.
-pub fn particle_sums_by_elements<T: Scalar, const D: usize>(
-    evals: &Evaluations<T, D>,
-    bins: &Bins,
-    gather: &Gather,
-    local: &mut Local<T, D>,
-    weights: &[Weight<'_, T>],
-    out: &mut [&mut [f64]],
-) {
-    assert!(weights.len() <= D && weights.len() == out.len());
-    local.par_vectors(bins).for_each(|(e, lv)| {
-        for &p in bins.particles(e) {
-            let p = p as usize;
-            for (a, s) in evals.range(p).enumerate() {
-                for (k, w) in weights.iter().enumerate() {
-                    lv[a * D + k] += match w {
-                        Weight::Each(w) => w[p] * evals.phi[s],
-                        Weight::One => evals.phi[s],
-                    };
-                }
-            }
-        }
-    });
-    for (k, out) in out.iter_mut().enumerate() {
-        out.par_iter_mut()
-            .with_min_len(ENTRY_CHUNK)
-            .enumerate()
-            .for_each(|(i, o)| {
-                // A function that is not live sums `+0`.
-                if !gather.is_live(i) {
-                    *o = 0.0;
-                    return;
-                }
-                let mut sum = 0.0;
-                let sources =
-                    gather.function_start[i] as usize..gather.function_start[i + 1] as usize;
-                for &s in &gather.function_source[sources] {
-                    sum += local.vector[s as usize * D + k].to_f64();
-                }
-                *o = sum;
-            });
-    }
-}
-
 /// `Σ_p V_p phi_i(x_p)`: the particle volume each function sees (its coverage
 /// numerator).
 pub fn particle_volume<T: Scalar, const D: usize>(
@@ -983,7 +982,8 @@ mod tests {
     use nalgebra::{Matrix2, Vector2};
 
     /// The fixed-size element block gives the general loop's sums to the last bit,
-    /// for the full matrix and for the row sums (PS: 9 functions, PL: 3).
+    /// for the full matrix and for the row sums, and the coverage sums (PS: 9
+    /// functions, PL: 3).
     #[test]
     fn element_blocks_equal_the_general_loop_bit_for_bit() {
         let mut seed = 12345u64;
@@ -1010,15 +1010,34 @@ mod tests {
                 .iter_mut()
                 .for_each(|g| *g = Vector2::new(next() - 0.5, next() - 0.5));
             let inside: Vec<u32> = vec![3, 0, 6, 1, 5, 2, 4];
-            for full in [true, false] {
-                let (mut lm, mut lv) = (vec![0.0; P], vec![0.0; M * 2]);
-                element_block::<f64, 2, M, P>(&inside, &particles, &evals, full, &mut lm, &mut lv);
-                let (mut rm, mut rv) = (vec![0.0; P], vec![0.0; M * 2]);
-                element_block_any(&inside, &particles, &evals, M, full, &mut rm, &mut rv);
+            for (full, coverage) in [(true, false), (false, false), (true, true)] {
+                let block = Block { full, coverage };
+                let [mut lm, mut rm] = [0, 1].map(|_| vec![0.0; P]);
+                let [mut lv, mut rv] = [0, 1].map(|_| vec![0.0; M * 2]);
+                // Stale values in the coverage blocks: the element's sums overwrite them.
+                let [mut lc, mut rc] = [0, 1].map(|_| vec![0.25; M * 2]);
+                let out = (&mut lm[..], &mut lv[..], &mut lc[..]);
+                element_block::<f64, 2, M, P>(&inside, &particles, &evals, block, out);
+                let out = (&mut rm[..], &mut rv[..], &mut rc[..]);
+                element_block_any(&inside, &particles, &evals, M, block, out);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&lm), bits(&rm), "M = {M}, full = {full}");
                 assert_eq!(bits(&lv), bits(&rv), "M = {M}, full = {full}");
+                assert_eq!(bits(&lc), bits(&rc), "M = {M}, coverage = {coverage}");
                 assert!(rm.iter().any(|&x| x != 0.0));
+                if coverage {
+                    // The volume and the count each function sees, in particle order.
+                    for a in 0..M {
+                        let (mut volume, mut count) = (0.0, 0.0);
+                        for &p in &inside {
+                            let phi = evals.phi[evals.range(p as usize).start + a];
+                            volume += particles.volume[p as usize] * phi;
+                            count += phi;
+                        }
+                        assert_eq!(lc[2 * a].to_bits(), volume.to_bits());
+                        assert_eq!(lc[2 * a + 1].to_bits(), count.to_bits());
+                    }
+                }
             }
         }
         check::<9, 45>(&mut next);

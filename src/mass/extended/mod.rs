@@ -471,7 +471,10 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         context: StepContext,
     ) -> Result<MassReport, MassError> {
         let n = pattern.dim();
-        self.values.copy_from_slice(values);
+        // `self.values` holds the solved matrix once `copied`: the lumped rows of
+        // the hybrid written here, else a copy of `values` made only where the
+        // reduced system needs it (nothing is copied in a step solved directly).
+        let mut copied = false;
         let mut report = match self.classified.take() {
             // The driver added the affine-preserving lumping term to `values`.
             Some(report) => report,
@@ -489,6 +492,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                         &mut self.diagonal_add,
                         &mut self.values,
                     );
+                    copied = true;
                 }
                 report
             }
@@ -509,20 +513,6 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 }
             }
         }
-        // The solves touch only the active entries; the others stay zero.
-        let s = &mut self.scratch;
-        for v in [
-            &mut s.x,
-            &mut s.r,
-            &mut s.z,
-            &mut s.p,
-            &mut s.q,
-            &mut s.u,
-            &mut s.w,
-            &mut self.rhs,
-        ] {
-            v.iter_mut().for_each(|a| *a = T::zero());
-        }
         // Nothing extended: `E = I`, the consistent system, solved as the
         // consistent strategy solves it (bit for bit).
         self.direct = false;
@@ -531,13 +521,30 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 self.cholesky.inactive[i] = matches!(self.role[i], Role::Inactive | Role::Ghost);
                 self.cholesky.lumped[i] = false;
             }
-            // `self.values` holds the lumped rows of the hybrid (else `values`).
-            self.direct = self.cholesky.factorize(pattern, &self.values).is_ok();
+            let solved = if copied { &self.values[..] } else { values };
+            self.direct = self.cholesky.factorize(pattern, solved).is_ok();
         }
         // `Eᵀ M E` factorised per fixed set; where that fails (a pivot lost to
         // rounding), the conjugate gradients with the Jacobi preconditioner
         // `M_ii + Σ_j e_ji² M_jj`.
         if !self.direct {
+            if !copied {
+                self.values.copy_from_slice(values);
+            }
+            // The solves touch only the active entries; the others stay zero.
+            let s = &mut self.scratch;
+            for v in [
+                &mut s.x,
+                &mut s.r,
+                &mut s.z,
+                &mut s.p,
+                &mut s.q,
+                &mut s.u,
+                &mut s.w,
+                &mut self.rhs,
+            ] {
+                v.iter_mut().for_each(|a| *a = T::zero());
+            }
             for s in 0..self.fixed.len() {
                 let mut factor = std::mem::take(&mut self.reduced_factor[s]);
                 let factorised = factor
