@@ -231,8 +231,50 @@ pub(super) fn field_offset(text: &str, path: &str) -> usize {
 /// about (when it is about a key or a value, not about the syntax between them) and
 /// its message, prefixed with that field.
 pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<String>, String) {
-    let mut at = e.span().map_or(0, |s| s.start);
-    let mut message = e.message().trim().to_string();
+    let at = e.span().map_or(0, |s| s.start);
+    let message = e.message().trim().to_string();
+    let at = if message.starts_with("missing field") {
+        failing_effect(text, &message).unwrap_or(at)
+    } else {
+        at
+    };
+    located(text, at, message)
+}
+
+/// A missing field of a tagged table is reported by the parser at the header of the
+/// first `[[effect]]`, whichever effect lacks it: the header of the first effect
+/// that fails alone with the same message.
+fn failing_effect(text: &str, message: &str) -> Option<usize> {
+    let table: toml::Table = text.parse().ok()?;
+    let effects = table.get("effect")?.as_array()?;
+    let k = effects.iter().position(|effect| {
+        effect
+            .clone()
+            .try_into::<super::EffectSpec>()
+            .is_err_and(|e| e.message().trim() == message)
+    })?;
+    let mut offset = 0;
+    let mut seen = 0;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim_start();
+        if trimmed.starts_with("[[") && trimmed[2..].trim_start().starts_with("effect") && {
+            let name = trimmed[2..].trim_start()["effect".len()..].trim_start();
+            name.starts_with("]]")
+        } {
+            if seen == k {
+                return Some(offset + (line.len() - trimmed.len()));
+            }
+            seen += 1;
+        }
+        offset += line.len();
+    }
+    None
+}
+
+/// [`parse_error`] from the position and message of the error.
+fn located(text: &str, at: usize, message: String) -> (usize, Option<String>, String) {
+    let mut at = at;
+    let mut message = message;
     // An integer beyond 64 bits: say so instead of the parser's internal type.
     if let Some(value) = message
         .strip_prefix("invalid type: integer `")

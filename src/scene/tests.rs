@@ -57,6 +57,27 @@ fn errors_name_line_column_and_field() {
     assert!(e.message.starts_with("time.t_end: must be positive"), "{e}");
 }
 
+/// A field missing from the last of several `[[effect]]` is named there, not at the first
+/// effect (the parser reports every tagged table's missing field at the first).
+#[test]
+fn a_missing_field_of_a_later_effect_names_that_effect() {
+    let text = Scene::builtin("column-small").unwrap().to_toml();
+    let broken = format!(
+        "{text}\n[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n\n[[effect]]\nkind = \"damping\"\nalpha = 0.1\n\n[[effect]]\nkind = \"gravity\"\n"
+    );
+    let e = Scene::from_toml(&broken, "e.toml").unwrap_err();
+    let headers: Vec<usize> = broken
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.trim() == "[[effect]]")
+        .map(|(i, _)| i + 1)
+        .collect();
+    assert!(headers.len() >= 3);
+    assert_eq!(e.line, *headers.last().unwrap(), "{e}");
+    let field = format!("effect[{}].g", headers.len() - 1);
+    assert_eq!(e.field.as_deref(), Some(field.as_str()), "{e}");
+}
+
 #[test]
 fn errors_are_typed_values_with_field_and_kind() {
     let text = Scene::builtin("column-small").unwrap().to_toml();
