@@ -314,6 +314,13 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
                     "{}: a scene file must end in `.toml`",
                     psmpm::scene::limits::echo(name)
                 ))
+            } else if name.contains(['/', '\\']) || path.extension().is_some() {
+                // A path to a file that is not there, not a scene's name.
+                let known = unknown.split_once(" (known: ").map_or("", |(_, k)| k);
+                CliError::Input(format!(
+                    "{}: no such file; give a scene file FILE.toml or a built-in scene (known: {known}",
+                    psmpm::scene::limits::echo(name)
+                ))
             } else {
                 CliError::Input(unknown)
             }

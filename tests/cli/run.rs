@@ -491,8 +491,8 @@ fn a_tracked_point_outside_every_body_is_warned_about() {
     std::fs::remove_dir_all(path.parent().unwrap()).ok();
 }
 
-/// A directory, or a file that is not `.toml`, given as the scene says what it is,
-/// not only that no built-in scene has that name.
+/// A directory, a file that is not `.toml`, or a path to no file, given as the
+/// scene says what it is, not only that no built-in scene has that name.
 #[test]
 fn a_directory_or_a_file_without_toml_is_named_as_such() {
     let dir = std::env::temp_dir().join(format!("psmpm-scene-dir-{}", std::process::id()));
@@ -502,6 +502,10 @@ fn a_directory_or_a_file_without_toml_is_named_as_such() {
     for (path, message) in [
         (dir.clone(), "is a directory; give a scene file FILE.toml"),
         (text, "a scene file must end in `.toml`"),
+        (
+            dir.join("missing.toml.txt"),
+            "missing.toml.txt: no such file",
+        ),
     ] {
         let out = cli().arg("run").arg(&path).output().unwrap();
         assert_eq!(out.status.code(), Some(2));
