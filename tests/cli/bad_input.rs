@@ -1293,10 +1293,11 @@ fn an_unknown_scene_lists_the_known_ones() {
             known.join(", ")
         )
     );
-    // A file name must end in `.toml` to be read as a file.
+    // A name with an extension is a path: to no file here (a file name must end
+    // in `.toml` to be read as a file), with the built-in scenes beside.
     let stderr = input_error(&["run", "scene.TOML"]).unwrap();
     assert!(
-        stderr.starts_with("error: unknown scene `scene.TOML` (known: vibrating-bar, "),
+        stderr.starts_with("error: scene.TOML: no such file; give a scene file FILE.toml or a built-in scene (known: vibrating-bar, "),
         "{stderr}"
     );
 }
