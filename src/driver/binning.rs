@@ -746,29 +746,28 @@ mod tests {
                 }
                 assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, entry {j}");
             }
+            // Component `k` of function `i` summed over the occupied elements'
+            // blocks of `blocks` (two entries per local function).
+            let function_sum = |blocks: &[f64], i: usize, k: usize| {
+                let mut sum = 0.0;
+                for &s in &gather.function_source
+                    [gather.function_start[i] as usize..gather.function_start[i + 1] as usize]
+                {
+                    if occupied(s as usize, stride) {
+                        sum += blocks[s as usize * 2 + k];
+                    }
+                }
+                sum
+            };
             for (k, o) in out.iter().enumerate() {
                 for (i, v) in o.iter().enumerate() {
-                    let mut sum = 0.0;
-                    for &s in &gather.function_source
-                        [gather.function_start[i] as usize..gather.function_start[i + 1] as usize]
-                    {
-                        if occupied(s as usize, stride) {
-                            sum += local.vector[s as usize * 2 + k];
-                        }
-                    }
+                    let sum = function_sum(&local.vector, i, k);
                     assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, function {i}");
                 }
             }
             for (k, o) in coverage.iter().enumerate() {
                 for (i, v) in o.iter().enumerate() {
-                    let mut sum = 0.0;
-                    for &s in &gather.function_source
-                        [gather.function_start[i] as usize..gather.function_start[i + 1] as usize]
-                    {
-                        if occupied(s as usize, stride) {
-                            sum += local.coverage[s as usize * 2 + k];
-                        }
-                    }
+                    let sum = function_sum(&local.coverage, i, k);
                     assert_eq!(v.to_bits(), sum.to_bits(), "round {r}, coverage {k} of {i}");
                 }
             }

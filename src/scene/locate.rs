@@ -253,22 +253,7 @@ fn failing_effect(text: &str, message: &str) -> Option<usize> {
             .try_into::<super::EffectSpec>()
             .is_err_and(|e| e.message().trim() == message)
     })?;
-    let mut offset = 0;
-    let mut seen = 0;
-    for line in text.split_inclusive('\n') {
-        let trimmed = line.trim_start();
-        if trimmed.starts_with("[[") && trimmed[2..].trim_start().starts_with("effect") && {
-            let name = trimmed[2..].trim_start()["effect".len()..].trim_start();
-            name.starts_with("]]")
-        } {
-            if seen == k {
-                return Some(offset + (line.len() - trimmed.len()));
-            }
-            seen += 1;
-        }
-        offset += line.len();
-    }
-    None
+    Some(field_offset(text, &format!("effect[{k}]")))
 }
 
 /// [`parse_error`] from the position and message of the error.
