@@ -62,8 +62,10 @@ fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
     None
 }
 
-/// The table (`mesh`, `effect[1]`; `None` at the top level) of the line of byte
-/// offset `at`, a header line naming its own table, and that line.
+/// The table (`mesh`, `effect[1]`, `body[1].initial_velocity`; `None` at the top
+/// level) of the line of byte offset `at`, a header line naming its own table, and
+/// that line. A sub-table of an array of tables (`[body.initial_velocity]`) belongs
+/// to the array's last element.
 fn table_at(text: &str, at: usize) -> Option<(Option<String>, &str)> {
     let mut table: Option<String> = None;
     let mut counts = std::collections::HashMap::<String, usize>::new();
@@ -76,7 +78,12 @@ fn table_at(text: &str, at: usize) -> Option<(Option<String>, &str)> {
             table = Some(format!("{name}[{count}]"));
             *count += 1;
         } else if let Some(name) = trimmed.strip_prefix('[').and_then(|r| r.split_once(']')) {
-            table = Some(name.0.trim().to_string());
+            let name = name.0.trim();
+            let element = name.split_once('.').and_then(|(array, rest)| {
+                let count = counts.get(array.trim())?;
+                Some(format!("{}[{}].{}", array.trim(), count - 1, rest.trim()))
+            });
+            table = Some(element.unwrap_or_else(|| name.to_string()));
         }
         if at < offset + line.len() {
             return Some((table, line));

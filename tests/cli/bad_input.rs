@@ -521,6 +521,13 @@ fn unknown_name_cases() -> Vec<Case> {
         case("unknown-reference-kind", BAR)
             .edit("kind = \"vibrating-bar\"", "kind = @@\"pendulum\"")
             .expect("reference.kind: unknown variant `pendulum`, expected one of `vibrating-bar`, `column-self-weight`, `axis-aligned`, `column-equilibrium`"),
+        // In a body's own table, the body is named with its index (the second's).
+        case("unknown-velocity-kind-of-the-second-body", BAR)
+            .edit("[initial_velocity]", "[[body]]\nmin = [1.0, 0.0]\nmax = [2.0, 1.0]\ncount = [2, 2]\n\n[body.initial_velocity]\nkind = @@\"spin\"\n\n[initial_velocity]")
+            .expect("body[1].initial_velocity.kind: unknown variant `spin`, expected one of `rest`, `uniform`, `sine-mode`, `exact`, `rigid-rotation`, `linear`"),
+        case("string-omega-of-the-second-body", BAR)
+            .edit("[initial_velocity]", "[[body]]\nmin = [1.0, 0.0]\nmax = [2.0, 1.0]\ncount = [2, 2]\n\n[body.initial_velocity]\nkind = \"rigid-rotation\"\nomega = @@\"fast\"\ncentre = [1.5, 0.5]\n\n[initial_velocity]")
+            .expect("body[1].initial_velocity.omega: invalid type: string \"fast\", expected a number"),
         case("unknown-initial-velocity-kind", BAR)
             .edit("kind = \"exact\"", "kind = @@\"spinning\"")
             .expect("initial_velocity.kind: unknown variant `spinning`, expected one of `rest`, `uniform`, `sine-mode`, `exact`, `rigid-rotation`, `linear`"),
@@ -764,6 +771,10 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("[reference]\nkind = \"vibrating-bar\"\nv0 = 0.1\n", "")
             .edit("kind = \"exact\"", "kind = @@\"exact\"")
             .expect("initial_velocity.kind: `exact` needs a [reference] solution"),
+        // A body's own initial velocity is named with the body's index.
+        case("body-velocity-with-one-entry", BAR)
+            .edit("per_block = [4, 4]\n", "per_block = [4, 4]\n\n[body.initial_velocity]\nkind = \"uniform\"\nvalue = @@[1.0]\n")
+            .expect("body[0].initial_velocity.value: needs 2 entries, got 1"),
         case("uniform-velocity-with-one-entry", BAR)
             .edit("kind = \"exact\"", "kind = \"uniform\"\nvalue = @@[1.0]")
             .expect("initial_velocity.value: needs 2 entries, got 1"),
@@ -857,6 +868,9 @@ fn inconsistent_cases() -> Vec<Case> {
 
 fn missing_cases() -> Vec<Case> {
     vec![
+        case("missing-value-of-a-body-velocity", BAR)
+            .edit("per_block = [4, 4]\n", "per_block = [4, 4]\n\n@@[body.initial_velocity]\nkind = \"uniform\"\n")
+            .expect("body[0].initial_velocity.value: missing field `value`"),
         case("missing-name", BAR)
             .edit("# A small", "@@# A small")
             .edit("name = \"bar\"\n", "")
