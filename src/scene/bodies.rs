@@ -329,11 +329,36 @@ impl Scene {
                     ));
                 }
             }
-            _ => {
-                return Err(conflict(
-                    field("per_block"),
-                    "give exactly one of `per_block`, `count` and `spacing`",
-                ))
+            (per_block, count, spacing) => {
+                let given: Vec<&str> = [
+                    ("per_block", per_block.is_some()),
+                    ("count", count.is_some()),
+                    ("spacing", spacing.is_some()),
+                ]
+                .into_iter()
+                .filter_map(|(name, given)| given.then_some(name))
+                .collect();
+                return Err(match given.as_slice() {
+                    [] => bad(
+                        format!("body[{b}]"),
+                        format!(
+                            "a `{}` body needs a particle lattice and gives none: give one of `per_block` (particles per mesh block along each axis), `count` (particles along each axis of the body) and `spacing` (the lattice spacing along each axis)",
+                            body.shape.name()
+                        ),
+                    ),
+                    [.., last] => {
+                        let names: Vec<String> = given.iter().map(|n| format!("`{n}`")).collect();
+                        let (head, tail) = names.split_at(names.len() - 1);
+                        conflict(
+                            field(last),
+                            format!(
+                                "{} and {} are given together, but each sets the particle lattice alone: give one of them",
+                                head.join(", "),
+                                tail[0]
+                            ),
+                        )
+                    }
+                });
             }
         }
         Ok(())

@@ -723,13 +723,20 @@ fn inconsistent_cases() -> Vec<Case> {
         case("second-body-min-not-below-max", BAR)
             .edit("[initial_velocity]", "[[body]]\nmin = [1.0, 1.0]\nmax = @@[2.0, 1.0]\ncount = [2, 2]\n\n[initial_velocity]")
             .expect("body[1].max: needs min < max on every axis, got min = [1.0, 1.0], max = [2.0, 1.0]"),
+        // Two lattice fields: the message names those given, at the later one.
         case("per-block-and-count", BAR)
-            .edit("per_block = [4, 4]", "per_block = @@[4, 4]\ncount = [8, 2]")
-            .expect("body[0].per_block: give exactly one of `per_block`, `count` and `spacing`"),
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\ncount = @@[8, 2]")
+            .expect("body[0].count: `per_block` and `count` are given together, but each sets the particle lattice alone: give one of them"),
+        case("count-and-spacing", BAR)
+            .edit("per_block = [4, 4]", "count = [16, 4]\nspacing = @@[0.25, 0.25]")
+            .expect("body[0].spacing: `count` and `spacing` are given together, but each sets the particle lattice alone: give one of them"),
+        case("per-block-count-and-spacing", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\ncount = [16, 4]\nspacing = @@[0.25, 0.25]")
+            .expect("body[0].spacing: `per_block`, `count` and `spacing` are given together, but each sets the particle lattice alone: give one of them"),
         case("neither-per-block-nor-count", BAR)
             .edit("[[body]]", "@@[[body]]")
             .edit("per_block = [4, 4]\n", "")
-            .expect("body[0].per_block: give exactly one of `per_block`, `count` and `spacing`"),
+            .expect("body[0]: a `box` body needs a particle lattice and gives none: give one of `per_block` (particles per mesh block along each axis), `count` (particles along each axis of the body) and `spacing` (the lattice spacing along each axis)"),
         case("per-block-on-a-polygon-mesh", SQUARE)
             .edit("count = [16, 16]", "per_block = @@[2, 2]")
             .expect("body[0].per_block: needs a `blocks` or `interval` mesh; use `count` or `spacing` on other meshes"),
