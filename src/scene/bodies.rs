@@ -164,7 +164,17 @@ impl Scene {
         };
         match shape {
             BodyShape::Box => {
-                for (name, v) in [("min", &body.min), ("max", &body.max)] {
+                for (name, v, corner) in [("min", &body.min, "lower"), ("max", &body.max, "upper")]
+                {
+                    if v.is_empty() {
+                        return Err(bad(
+                            field(name),
+                            format!(
+                                "is missing (or empty): a `box` body (the default shape) needs `{name}`, its {corner} corner ({d} {})",
+                                if d == 1 { "number" } else { "numbers" }
+                            ),
+                        ));
+                    }
                     if v.len() != d {
                         return Err(bad(
                             field(name),

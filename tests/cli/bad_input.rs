@@ -875,6 +875,14 @@ fn inconsistent_cases() -> Vec<Case> {
 
 fn missing_cases() -> Vec<Case> {
     vec![
+        case("box-without-max", BAR)
+            .edit("[[body]]", "@@[[body]]")
+            .edit("max = [4.0, 1.0]\n", "")
+            .expect("body[0].max: is missing (or empty): a `box` body (the default shape) needs `max`, its upper corner (2 numbers)"),
+        case("box-without-min-in-1d", BAR_1D)
+            .edit("[[body]]", "@@[[body]]")
+            .edit("min = [0.0]\n", "")
+            .expect("body[0].min: is missing (or empty): a `box` body (the default shape) needs `min`, its lower corner (1 number)"),
         case("missing-value-of-a-body-velocity", BAR)
             .edit("per_block = [4, 4]\n", "per_block = [4, 4]\n\n@@[body.initial_velocity]\nkind = \"uniform\"\n")
             .expect("body[0].initial_velocity.value: missing field `value`"),
