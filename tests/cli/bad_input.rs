@@ -442,7 +442,7 @@ fn type_cases() -> Vec<Case> {
     vec![
         case("string-for-integer", BAR)
             .edit("dim = 2", "dim = @@\"two\"")
-            .expect("dim: invalid type: string \"two\", expected a whole number, 0 or more"),
+            .expect("dim: invalid type: string \"two\", expected 1 or 2"),
         case("bare-word-for-integer", BAR)
             .edit("dim = 2", "dim = @@two")
             .expect("dim: invalid boolean, expected `true`"),
@@ -466,14 +466,27 @@ fn type_cases() -> Vec<Case> {
             .expect("boundary[0].fix: invalid type: string \"x\", expected a sequence"),
         case("negative-count", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, @@-2]")
-            .expect("body[0].per_block: invalid value: integer `-2`, expected a whole number, 0 or more"),
+            .expect("body[0].per_block: invalid value: integer `-2`, expected a whole number in 1..=1000 along each axis"),
         case("table-for-array-of-tables", BAR)
             .edit("[[body]]", "@@[body]")
             .expect("invalid type: map, expected a sequence"),
         case("float-for-block-count", BAR)
             .edit("[mesh]", "@@[mesh]")
             .edit("blocks = [4, 1]", "blocks = [4.5, 1]")
-            .at(13, 11).expect("mesh.blocks: invalid type: floating point `4.5`, expected a whole number, 0 or more"),
+            .at(13, 11).expect("mesh.blocks: invalid type: floating point `4.5`, expected a whole number in 1..=4096 along each axis"),
+        // An integer's range is the field's, not its type's: no block count of 0.
+        case("negative-block-count", BAR)
+            .edit("blocks = [4, 1]", "blocks = [4, @@-1]")
+            .expect("mesh.blocks: invalid value: integer `-1`, expected a whole number in 1..=4096 along each axis"),
+        case("negative-resolution-block-count", BAR)
+            .edit("blocks = [8, 1]", "blocks = [@@-8, 1]")
+            .expect("resolution[0].blocks: invalid value: integer `-8`, expected a whole number, 1 or more, along each axis (as `mesh.blocks`)"),
+        case("negative-element-count", BAR_1D)
+            .edit("elements = 4", "elements = @@-4")
+            .expect("mesh.elements: invalid value: integer `-4`, expected a whole number in 1..=1000000"),
+        case("negative-count-of-a-body", SQUARE)
+            .edit("count = [16, 16]", "count = [16, @@-16]")
+            .expect("body[0].count: invalid value: integer `-16`, expected a whole number in 1..=100000 along each axis"),
         case("three-block-counts", BAR)
             .edit("blocks = [4, 1]", "@@blocks = [4, 1, 1]")
             .expect("mesh.blocks: invalid length 3, expected 2 elements in sequence"),
