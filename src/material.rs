@@ -452,6 +452,21 @@ pub fn rotation_warning(max_rotation: f64) -> Option<String> {
     })
 }
 
+/// The cause to name first when a particle of the paper's non-objective law
+/// inverted in a body whose particles of that law rotated by about `rotation`
+/// radians (their median): `Some` above [`ROTATION_WARNING`] (where the run warns).
+/// A rigid rotation by `θ` alone gives this law the strain `(cos θ − 1) I` (−0.46
+/// at 1 rad), a compression that no motion of the body explains: a body spinning
+/// at a few rad/s crushes itself.
+pub fn non_objective_cause(rotation: f64) -> Option<String> {
+    (rotation > ROTATION_WARNING).then(|| {
+        format!(
+            "its law, `linear-elastic` (the paper's law on sym(F) − I), is not objective and the body turned by about {rotation:.2} rad (the median over its particles): a rotation θ alone gives it the spurious strain cos θ − 1 (here {:.2}) in every direction, which can invert or crush a spinning or turning body; use `model = \"corotational\"` (the default, objective) or `\"neo-hookean\"`",
+            rotation.min(std::f64::consts::PI).cos() - 1.0
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

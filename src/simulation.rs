@@ -803,8 +803,9 @@ fn error<const D: usize, B: Basis<f64, D>>(
 /// What a growth of the time-centred total above [`STABLE_ENERGY_GROWTH`],
 /// with no failed step, says and what to do about it: when it
 /// crossed the bound (`crossed`, step and time, of `steps`), the Courant number
-/// `dt / dt_critical` and the particles per occupied element against the functions
-/// per element. Such a growth builds up over many steps or impacts: it is the time
+/// `dt / dt_critical` and what to lower (`time.courant` when the step came from it,
+/// `from_courant`, else the scene's `time.dt`), and the particles per occupied
+/// element against the functions per element. Such a growth builds up over many steps or impacts: it is the time
 /// integration's error on the motion, and it falls with the step (on a jittered soft
 /// plate dropped on a slip floor the centred growth is 6.9e-2 at `courant` 0.5 and
 /// 2.8e-2 at 0.25; a disk thrown at a no-slip post 7.7e-2, 3.0e-2, 1.1e-2 at 0.4,
@@ -816,6 +817,7 @@ pub fn energy_growth_hint(
     steps: usize,
     dt: f64,
     dt_critical: Option<f64>,
+    from_courant: bool,
     particles_per_element: f64,
     functions_per_element: usize,
 ) -> String {
@@ -825,15 +827,23 @@ pub fn energy_growth_hint(
         }
         None => String::new(),
     };
-    let courant = dt_critical
-        .filter(|c| c.is_finite() && *c > 0.0)
-        .map(|c| dt / c);
-    let step = match courant {
-        Some(c) => format!(
-            "the time step is {c:.2} of the critical step estimated at the start: lower `time.courant` (to {:.2}, say; `--courant` on the command line) or `time.dt`",
-            c / 2.0
+    let critical = dt_critical.filter(|c| c.is_finite() && *c > 0.0);
+    let step = match (critical, from_courant) {
+        (Some(critical), true) => format!(
+            "the time step is {:.2} of the critical step estimated at the start: lower `time.courant` (to {:.2}, say; `--courant` on the command line) or `time.dt`",
+            dt / critical,
+            dt / critical / 2.0
         ),
-        None => "lower `time.dt`".to_string(),
+        (Some(critical), false) => format!(
+            "the time step `time.dt` = {dt:.3e} is {:.2} of the critical step {critical:.3e} estimated at the start: lower `time.dt` (to {:.3e}, say, half of it; `--dt` on the command line)",
+            dt / critical,
+            dt / 2.0
+        ),
+        (None, true) => "lower `time.courant` (`--courant` on the command line)".to_string(),
+        (None, false) => format!(
+            "lower `time.dt` (now {dt:.3e}; to {:.3e}, say, half of it; `--dt` on the command line)",
+            dt / 2.0
+        ),
     };
     let sampling = if particles_per_element < functions_per_element as f64 {
         format!(
@@ -892,6 +902,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 run.driver.steps(),
                 run.dt,
                 run.dt_critical,
+                scene.time.courant.is_some(),
                 run.driver.particles_per_occupied_element(),
                 run.driver.functions_per_element(),
             )
@@ -1031,10 +1042,11 @@ mod tests {
 
     /// The hint of an energy growth says when the bound was crossed, the Courant
     /// number and half of it, and asks for more particles only where an element
-    /// holds fewer than its functions.
+    /// holds fewer than its functions. A scene with a fixed `dt` is told to lower
+    /// `dt`, not `courant`, which it does not give.
     #[test]
     fn the_energy_growth_hint_fits_the_step_and_the_sampling() {
-        let sparse = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), 4.5, 9);
+        let sparse = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), true, 4.5, 9);
         for part in [
             "it reached the bound at t = 0.2500 (step 120 of 400)",
             "the time step is 0.50 of the critical step",
@@ -1043,12 +1055,22 @@ mod tests {
         ] {
             assert!(sparse.contains(part), "`{part}` not in: {sparse}");
         }
-        let dense = energy_growth_hint(None, 400, 1e-3, None, 12.0, 3);
+        let dense = energy_growth_hint(None, 400, 1e-3, None, false, 12.0, 3);
         assert!(!dense.contains("per occupied element"), "{dense}");
         assert!(
-            dense.contains("lower `time.dt`") && !dense.contains("reached"),
+            dense.contains("lower `time.dt` (now 1.000e-3; to 5.000e-4, say, half of it; `--dt`")
+                && !dense.contains("reached")
+                && !dense.contains("courant"),
             "{dense}"
         );
+        let fixed = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), false, 12.0, 3);
+        for part in [
+            "the time step `time.dt` = 1.000e-3 is 0.50 of the critical step 2.000e-3",
+            "lower `time.dt` (to 5.000e-4, say, half of it; `--dt` on the command line)",
+        ] {
+            assert!(fixed.contains(part), "`{part}` not in: {fixed}");
+        }
+        assert!(!fixed.contains("courant"), "{fixed}");
     }
 
     /// A lattice is one piece, stretched by half its spacing too; torn in two it is

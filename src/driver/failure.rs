@@ -146,67 +146,25 @@ where
                 );
             }
         }
-        // The worst-covered function among those the particle sees (the coverage
-        // is measured here if the strategy did not need it).
-        let coverage = self.coverage();
-        let worst = self
-            .evals
-            .functions(particle)
-            .iter()
-            .map(|&i| i as usize)
-            .map(|i| (i, coverage[i].unwrap_or(0.0)))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        // The default strategy is the fix only where it is not already in use.
-        let extends = self.mass.spec().starts_with("extended");
-        if let Some((i, c)) = worst.filter(|&(_, c)| {
-            c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0 && !extends
-        }) {
-            return format!(
-                "the particle sits in the support of function {i} at {}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
-                point(&to_f64_point(&self.basis.function_point(i))),
-                c,
-                self.mass.spec()
-            );
+        // A spinning or turning body of the paper's non-objective law: that law
+        // first, then what else the driver sees.
+        let rotated = self.non_objective_rotation(particle);
+        if let Some(cause) = crate::material::non_objective_cause(rotated) {
+            let speed = self.particles.v[particle].norm().to_f64();
+            let lead = format!("the element around it inverted (speed {speed:.3e})");
+            let also = match self.sampling_cause(particle) {
+                Some(other) => format!(
+                    "; if it still fails with an objective law: {}",
+                    other.strip_prefix(&format!("{lead}; ")).unwrap_or(&other)
+                ),
+                None => String::new(),
+            };
+            return format!("{lead}; {cause}{also}");
         }
-        if let Some((i, c)) = self.last_report.worst_coverage {
-            if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 && !extends {
-                return format!(
-                    "function {i} at {} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended-hybrid`)",
-                    point(&to_f64_point(&self.basis.function_point(i))),
-                    self.mass.spec()
-                );
-            }
+        if let Some(cause) = self.sampling_cause(particle) {
+            return cause;
         }
         let speed = self.particles.v[particle].norm().to_f64();
-        let element = self.particles.element[particle];
-        let (inside, functions) = (
-            self.bins.particles(element).len(),
-            self.basis.element_functions(element).len(),
-        );
-        if let Some(aspect) = self.sliver_aspect(element) {
-            return format!(
-                "the element around it inverted (speed {speed:.3e}); it is a sliver (its pieces' longest edge is {aspect:.0} times their height), whose stiffness the critical step estimated at the start did not see if the body was not in it yet: lower `time.courant` or `time.dt` by about that factor, or mesh without slivers (Gmsh: `Mesh.OptimizeNetgen`, or a larger smallest edge)"
-            );
-        }
-        if inside < functions {
-            let held = if inside == 1 {
-                "1 particle".to_string()
-            } else {
-                format!("{inside} particles")
-            };
-            // At an impact with a long step, more particles alone does not help
-            // (a user's block at `courant = 0.5` failed sooner with more).
-            let step = match self.dt_critical {
-                Some(c) if c > 0.0 && self.dt.to_f64() > 0.3 * c => format!(
-                    "; if it inverted at an impact, lower `time.courant` too (the step is {:.2} of the critical one; impacts want 0.25 or less)",
-                    self.dt.to_f64() / c
-                ),
-                _ => String::new(),
-            };
-            return format!(
-                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`{step}"
-            );
-        }
         if let Some(critical) = self.dt_critical {
             let dt = self.dt.to_f64();
             // In 1D nothing rotates: objectivity is not a cause there.
@@ -228,6 +186,100 @@ where
             "the element around it inverted (speed {speed:.3e}, Δt = {:.3e}): the time step is likely above the critical one for this material and mesh, lower `time.dt` or `time.courant`{rotation}",
             self.dt.to_f64()
         )
+    }
+
+    /// The median rotation angle of the particles of a non-objective law other than
+    /// `particle` whose `det F` is still positive (an inverted `F` has no rotation
+    /// to speak of); 0 when there are none, and in 1D. The median, not the largest:
+    /// a body that spins turns as a whole, while the few particles around a failing
+    /// one turn by any angle as it fails.
+    fn non_objective_rotation(&self, particle: usize) -> f64 {
+        let mut angles: Vec<f64> = self
+            .particles
+            .f
+            .iter()
+            .enumerate()
+            .filter(|&(q, f)| {
+                q != particle
+                    && !self.material.is_objective(q)
+                    && crate::material::det(f).to_f64() > 0.0
+            })
+            .map(|(_, f)| crate::material::rotation_angle(f))
+            .filter(|a| a.is_finite())
+            .collect();
+        if angles.is_empty() {
+            return 0.0;
+        }
+        let middle = angles.len() / 2;
+        *angles.select_nth_unstable_by(middle, f64::total_cmp).1
+    }
+
+    /// Why the element around a failing particle inverted, when the driver sees it
+    /// in the sampling or the mesh: a function with almost no particle support that
+    /// the strategy solves for, a sliver, fewer particles than functions.
+    fn sampling_cause(&self, particle: usize) -> Option<String> {
+        // The worst-covered function among those the particle sees (the coverage
+        // is measured here if the strategy did not need it).
+        let coverage = self.coverage();
+        let worst = self
+            .evals
+            .functions(particle)
+            .iter()
+            .map(|&i| i as usize)
+            .map(|i| (i, coverage[i].unwrap_or(0.0)))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        // The default strategy is the fix only where it is not already in use.
+        let extends = self.mass.spec().starts_with("extended");
+        if let Some((i, c)) = worst.filter(|&(_, c)| {
+            c < UNDER_SUPPORTED_COVERAGE && self.last_report.extended == 0 && !extends
+        }) {
+            return Some(format!(
+                "the particle sits in the support of function {i} at {}, which particles cover to only {:.1e} of its support, and the mass strategy `{}` solves for it: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
+                point(&to_f64_point(&self.basis.function_point(i))),
+                c,
+                self.mass.spec()
+            ));
+        }
+        if let Some((i, c)) = self.last_report.worst_coverage {
+            if c < UNDER_SUPPORTED_COVERAGE && self.last_report.treated() == 0 && !extends {
+                return Some(format!(
+                    "function {i} at {} is covered to only {c:.1e} and the mass strategy `{}` treats nothing: use the default mass strategy (`extended-hybrid`)",
+                    point(&to_f64_point(&self.basis.function_point(i))),
+                    self.mass.spec()
+                ));
+            }
+        }
+        let speed = self.particles.v[particle].norm().to_f64();
+        let element = self.particles.element[particle];
+        let (inside, functions) = (
+            self.bins.particles(element).len(),
+            self.basis.element_functions(element).len(),
+        );
+        if let Some(aspect) = self.sliver_aspect(element) {
+            return Some(format!(
+                "the element around it inverted (speed {speed:.3e}); it is a sliver (its pieces' longest edge is {aspect:.0} times their height), whose stiffness the critical step estimated at the start did not see if the body was not in it yet: lower `time.courant` or `time.dt` by about that factor, or mesh without slivers (Gmsh: `Mesh.OptimizeNetgen`, or a larger smallest edge)"
+            ));
+        }
+        if inside < functions {
+            let held = if inside == 1 {
+                "1 particle".to_string()
+            } else {
+                format!("{inside} particles")
+            };
+            // At an impact with a long step, more particles alone does not help
+            // (a user's block at `courant = 0.5` failed sooner with more).
+            let step = match self.dt_critical {
+                Some(c) if c > 0.0 && self.dt.to_f64() > 0.3 * c => format!(
+                    "; if it inverted at an impact, lower `time.courant` too (the step is {:.2} of the critical one; impacts want 0.25 or less)",
+                    self.dt.to_f64() / c
+                ),
+                _ => String::new(),
+            };
+            return Some(format!(
+                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`{step}"
+            ));
+        }
+        None
     }
 
     /// In 2D, the largest aspect ratio (longest edge over the height on it) of the

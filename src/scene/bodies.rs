@@ -164,7 +164,17 @@ impl Scene {
         };
         match shape {
             BodyShape::Box => {
-                for (name, v) in [("min", &body.min), ("max", &body.max)] {
+                for (name, v, corner) in [("min", &body.min, "lower"), ("max", &body.max, "upper")]
+                {
+                    if v.is_empty() {
+                        return Err(bad(
+                            field(name),
+                            format!(
+                                "is missing (or empty): a `box` body (the default shape) needs `{name}`, its {corner} corner ({d} {})",
+                                if d == 1 { "number" } else { "numbers" }
+                            ),
+                        ));
+                    }
                     if v.len() != d {
                         return Err(bad(
                             field(name),
@@ -329,11 +339,36 @@ impl Scene {
                     ));
                 }
             }
-            _ => {
-                return Err(conflict(
-                    field("per_block"),
-                    "give exactly one of `per_block`, `count` and `spacing`",
-                ))
+            (per_block, count, spacing) => {
+                let given: Vec<&str> = [
+                    ("per_block", per_block.is_some()),
+                    ("count", count.is_some()),
+                    ("spacing", spacing.is_some()),
+                ]
+                .into_iter()
+                .filter_map(|(name, given)| given.then_some(name))
+                .collect();
+                return Err(match given.as_slice() {
+                    [] => bad(
+                        format!("body[{b}]"),
+                        format!(
+                            "a `{}` body needs a particle lattice and gives none: give one of `per_block` (particles per mesh block along each axis), `count` (particles along each axis of the body) and `spacing` (the lattice spacing along each axis)",
+                            body.shape.name()
+                        ),
+                    ),
+                    [.., last] => {
+                        let names: Vec<String> = given.iter().map(|n| format!("`{n}`")).collect();
+                        let (head, tail) = names.split_at(names.len() - 1);
+                        conflict(
+                            field(last),
+                            format!(
+                                "{} and {} are given together, but each sets the particle lattice alone: give one of them",
+                                head.join(", "),
+                                tail[0]
+                            ),
+                        )
+                    }
+                });
             }
         }
         Ok(())

@@ -62,8 +62,10 @@ fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
     None
 }
 
-/// The table (`mesh`, `effect[1]`; `None` at the top level) of the line of byte
-/// offset `at`, a header line naming its own table, and that line.
+/// The table (`mesh`, `effect[1]`, `body[1].initial_velocity`; `None` at the top
+/// level) of the line of byte offset `at`, a header line naming its own table, and
+/// that line. A sub-table of an array of tables (`[body.initial_velocity]`) belongs
+/// to the array's last element.
 fn table_at(text: &str, at: usize) -> Option<(Option<String>, &str)> {
     let mut table: Option<String> = None;
     let mut counts = std::collections::HashMap::<String, usize>::new();
@@ -76,7 +78,12 @@ fn table_at(text: &str, at: usize) -> Option<(Option<String>, &str)> {
             table = Some(format!("{name}[{count}]"));
             *count += 1;
         } else if let Some(name) = trimmed.strip_prefix('[').and_then(|r| r.split_once(']')) {
-            table = Some(name.0.trim().to_string());
+            let name = name.0.trim();
+            let element = name.split_once('.').and_then(|(array, rest)| {
+                let count = counts.get(array.trim())?;
+                Some(format!("{}[{}].{}", array.trim(), count - 1, rest.trim()))
+            });
+            table = Some(element.unwrap_or_else(|| name.to_string()));
         }
         if at < offset + line.len() {
             return Some((table, line));
@@ -238,7 +245,36 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
     } else {
         at
     };
-    located(text, at, message)
+    let (at, field, message) = located(text, at, message);
+    // The type's lower bound is not the field's: say the field's range.
+    let message = match field.as_deref().and_then(whole_number_rule) {
+        Some(rule) => message.replace(WHOLE_NUMBER, &rule),
+        None => message,
+    };
+    (at, field, message)
+}
+
+/// How the parser's message words an unsigned integer (the type's range).
+const WHOLE_NUMBER: &str = "a whole number, 0 or more";
+
+/// What the integer field `field` takes, in place of [`WHOLE_NUMBER`], when it is
+/// not every whole number (`mesh.blocks`: each in 1..=4096, not 0).
+fn whole_number_rule(field: &str) -> Option<String> {
+    use super::limits::{MAX_BLOCKS_PER_AXIS, MAX_ELEMENTS_1D};
+    let key = field.rsplit('.').next().unwrap_or(field);
+    Some(match key {
+        "dim" if field == "dim" => "1 or 2".to_string(),
+        "blocks" if field == "mesh.blocks" => {
+            format!("a whole number in 1..={MAX_BLOCKS_PER_AXIS} along each axis")
+        }
+        "blocks" => "a whole number, 1 or more, along each axis (as `mesh.blocks`)".to_string(),
+        "elements" => format!("a whole number in 1..={MAX_ELEMENTS_1D}"),
+        "per_block" => "a whole number in 1..=1000 along each axis".to_string(),
+        "count" => "a whole number in 1..=100000 along each axis".to_string(),
+        "per_triangle" => "1 or 3".to_string(),
+        "subdivide" => format!("a whole number in 0..={}", super::bodies::MAX_SUBDIVIDE),
+        _ => return None,
+    })
 }
 
 /// A missing field of a tagged table is reported by the parser at the header of the

@@ -402,6 +402,25 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
                 .contains("lower `time.courant` (to 0.25, say; `--courant` on the command line)"),
         "{stdout}"
     );
+    // With a fixed step (`--dt`, as a scene's `time.dt`: the same step as
+    // `courant = 0.5` here) the hint lowers `dt`, not the `courant` the run does
+    // not use.
+    let out = cli()
+        .args(["run"])
+        .arg(&path)
+        .args(["--dt", "6.3e-4"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for part in [
+        "the run is UNSTABLE: energy growth",
+        "the time step `time.dt` = 6.300e-4 is 0.50 of the critical step 1.261e-3",
+        "lower `time.dt` (to 3.150e-4, say, half of it; `--dt` on the command line)",
+    ] {
+        assert!(stderr.contains(part), "`{part}` not in: {stderr}");
+    }
+    assert!(!stderr.contains("courant"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
