@@ -186,6 +186,7 @@ impl WallGeometry {
 
     /// `true` if a wall item is listed for `element` (within [`Self::reach`]).
     pub fn near(&self, element: usize) -> bool {
+        let element = element % (self.element_start.len() - 1).max(1);
         self.element_start
             .get(element)
             .zip(self.element_start.get(element + 1))
@@ -211,6 +212,9 @@ impl WallGeometry {
     /// `d` to the ramp, and the end pushed them back.
     #[inline]
     fn contacts(&self, element: usize, x: Vec2, d: f64, mut contact: impl FnMut(f64, Vec2)) {
+        // An element of a body's copy of the basis (`body_contact::PerBody`) is that
+        // element of the mesh.
+        let element = element % (self.element_start.len() - 1).max(1);
         let Some(range) = self
             .element_start
             .get(element)

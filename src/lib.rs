@@ -60,6 +60,7 @@
 pub use psmpm_basis as basis;
 
 pub mod bases;
+pub mod body_contact;
 pub mod contact;
 pub mod diagnostics;
 pub mod driver;

@@ -19,6 +19,7 @@
 //! body force does not change the verdict: [`crate::diagnostics::Verdict`]), and
 //! every condition estimate (when requested) stays below [`STABLE_CONDITION`].
 
+use crate::body_contact::PerBody;
 use crate::diagnostics::Verdict;
 use crate::driver::{PhaseTimes, StepError, StepReport};
 use crate::particles::Particles;
@@ -278,9 +279,18 @@ fn run_2d_observed(
     stop: Option<&AtomicBool>,
 ) -> Result<Outcome<2>, RunError> {
     let (basis, domain) = setup::domain_2d(scene)?.take_basis();
-    match basis {
-        Basis2d::Ps(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
-        Basis2d::Linear(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
+    let bodies = scene.bodies.len();
+    match (basis, scene.body_contact()) {
+        (Basis2d::Ps(basis), false) => run_with(scene, domain.with_basis(basis), on_step, stop),
+        (Basis2d::Linear(basis), false) => run_with(scene, domain.with_basis(basis), on_step, stop),
+        (Basis2d::Ps(basis), true) => {
+            let basis = PerBody::new(basis, bodies);
+            run_with(scene, domain.with_basis(basis), on_step, stop)
+        }
+        (Basis2d::Linear(basis), true) => {
+            let basis = PerBody::new(basis, bodies);
+            run_with(scene, domain.with_basis(basis), on_step, stop)
+        }
     }
 }
 
@@ -290,9 +300,20 @@ fn run_1d_observed(
     stop: Option<&AtomicBool>,
 ) -> Result<Outcome<1>, RunError> {
     let (basis, domain) = setup::domain_1d(scene)?.take_basis();
-    match basis {
-        Basis1d::Bspline(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
-        Basis1d::Linear(basis) => run_with(scene, domain.with_basis(basis), on_step, stop),
+    let bodies = scene.bodies.len();
+    match (basis, scene.body_contact()) {
+        (Basis1d::Bspline(basis), false) => {
+            run_with(scene, domain.with_basis(basis), on_step, stop)
+        }
+        (Basis1d::Linear(basis), false) => run_with(scene, domain.with_basis(basis), on_step, stop),
+        (Basis1d::Bspline(basis), true) => {
+            let basis = PerBody::new(basis, bodies);
+            run_with(scene, domain.with_basis(basis), on_step, stop)
+        }
+        (Basis1d::Linear(basis), true) => {
+            let basis = PerBody::new(basis, bodies);
+            run_with(scene, domain.with_basis(basis), on_step, stop)
+        }
     }
 }
 

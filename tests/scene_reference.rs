@@ -111,6 +111,11 @@ const PROBES: &[(&str, bool, &str)] = &[
         "[[effect]]\nkind = \"manufactured-body-force\"\nzzz = 0",
     ),
     (
+        "### `[[effect]]` with `kind = \"body-contact\"`",
+        true,
+        "[[effect]]\nkind = \"body-contact\"\nzzz = 0",
+    ),
+    (
         "### `[[effect]]` with `kind = \"geostatic-stress\"`",
         true,
         "[[effect]]\nkind = \"geostatic-stress\"\nsurface = 1.0\nzzz = 0",

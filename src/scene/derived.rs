@@ -90,6 +90,14 @@ impl Scene {
         })
     }
 
+    /// The scene asks for contact between its bodies (a velocity field per body;
+    /// [`crate::body_contact`]).
+    pub fn body_contact(&self) -> bool {
+        self.effects
+            .iter()
+            .any(|e| matches!(e, EffectSpec::BodyContact {}))
+    }
+
     /// The time step `dt`, or with `courant` a mesh-based guess `C h / c` (P-wave
     /// speed `c`, `h` halved for PS) used to set a run up and to estimate its cost;
     /// the run itself takes `C Δt_crit` (see [`TimeSpec::courant`](super::TimeSpec::courant)).

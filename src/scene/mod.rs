@@ -600,6 +600,11 @@ pub enum EffectSpec {
         #[serde(default = "default_contact_stiffness")]
         stiffness: f64,
     },
+    /// Frictionless contact between the bodies: a velocity field per body, coupled
+    /// where two bodies approach on the functions they share
+    /// ([`crate::body_contact`]). Two or more bodies, at most
+    /// [`crate::body_contact::MAX_CONTACT_BODIES`].
+    BodyContact {},
     /// Geostatic initial stress: `σ_yy = ρ g (surface − y)`, `σ_xx = k0 σ_yy`, with
     /// the density of the material and `g` of the gravity effect.
     GeostaticStress {

@@ -282,6 +282,33 @@ impl Scene {
                         }
                     }
                 }
+                EffectSpec::BodyContact {} => {
+                    use crate::body_contact::MAX_CONTACT_BODIES;
+                    let n = self.bodies.len();
+                    if n < 2 {
+                        return Err(conflict(
+                            field("kind"),
+                            format!("contact between bodies needs two or more `[[body]]` tables, this scene has {n}: add the other body, or remove this effect"),
+                        ));
+                    }
+                    if n > MAX_CONTACT_BODIES {
+                        return Err(conflict(
+                            field("kind"),
+                            format!("contact between bodies copies the basis once per body, and this scene has {n} bodies, above the limit of {MAX_CONTACT_BODIES}: join the bodies that need no contact between them into one (a `polygon` body with holes, or one material)"),
+                        ));
+                    }
+                    if let Some(j) = self.effects[..i]
+                        .iter()
+                        .position(|e| matches!(e, EffectSpec::BodyContact {}))
+                    {
+                        return Err(conflict(
+                            field("kind"),
+                            format!(
+                                "effect[{j}] already asks for contact between bodies; keep one"
+                            ),
+                        ));
+                    }
+                }
                 EffectSpec::GeostaticStress { surface, k0 } => {
                     finite(&field("surface"), *surface)?;
                     finite(&field("k0"), *k0)?;

@@ -83,6 +83,9 @@ pub fn build_effects<const D: usize>(
                 })?;
                 effects.push(Box::new(wall));
             }
+            EffectSpec::BodyContact {} => effects.push(Box::new(
+                crate::body_contact::BodyContact::new(scene.bodies.len()),
+            )),
             // An initial state, not an effect: `particles::apply_initial_states`.
             EffectSpec::GeostaticStress { .. } => {}
         }

@@ -168,6 +168,18 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         &walls,
         &body_sizes,
     )?;
+    if scene.body_contact() {
+        // Each body's particles in its own copy of the basis (`PerBody`): the
+        // driver located them all in the first.
+        let per_body = driver.basis.num_elements() / body_sizes.len().max(1);
+        let mut first = 0;
+        for (b, &n) in body_sizes.iter().enumerate() {
+            for e in &mut driver.particles.element[first..first + n] {
+                *e += b * per_body;
+            }
+            first += n;
+        }
+    }
     let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt)?;
     if let (Some(critical), None, false) = (
         dt_critical,
