@@ -398,6 +398,21 @@ pub fn self_weight_warning<const D: usize>(
     })
 }
 
+/// The warning for contact between bodies on a piecewise-linear basis with a mass
+/// other than `lumped`: the contact forces are sized on lumped rows, and nearly
+/// consistent rows spread them further, so they can do positive work.
+pub fn body_contact_warning(scene: &Scene) -> Option<String> {
+    use crate::bases::BasisKind;
+    let linear = matches!(scene.basis, BasisKind::Pl | BasisKind::Pl1d);
+    (scene.body_contact() && linear && scene.mass != crate::mass::MassKind::Lumped).then(|| {
+        format!(
+            "contact between bodies with the `{}` basis and the `{}` mass: the contact forces are sized on lumped rows, and this mass's nearly consistent rows spread them further, so they can add energy (two slow disks gained 20 %); use `mass = \"lumped\"` (`--mass lumped`) with PL, or the PS basis (docs/scenes.md, the `body-contact` effect)",
+            scene.basis.name(),
+            scene.mass.spec()
+        )
+    })
+}
+
 /// Particles per occupied element at the start below which a run warns that its
 /// bodies are sampled by about one particle per element or fewer.
 pub const SPARSE_SAMPLING: f64 = 1.5;
@@ -989,6 +1004,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                         .then(|| ps_sampling_warning(tally.sampling))
                         .flatten(),
                 )
+                .chain(body_contact_warning(scene))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .chain(stray_warning(
                     tally.stray_at_start,

@@ -82,6 +82,12 @@ fn blocks_with_contact_part_and_without_stick() {
         assert!(summary.stable, "{basis}: {:?}", summary.energy_growth);
         // Measured: PS 0.50, PL 0.69 (docs/scenes.md, "Overlaps and contact").
         assert!(restitution > 0.4, "{basis}: {v:?}");
+        // With PL and a mass other than `lumped` the run says to lump.
+        let warned = summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("`--mass lumped`"));
+        assert_eq!(warned, basis == "pl", "{:?}", summary.warnings);
         if basis == "ps" {
             let (v, _, _) = outcome(&block_strikes_block(basis, false));
             assert!(((v[1] - v[0]) / 2.0).abs() < 0.05, "{basis} without: {v:?}");
