@@ -530,7 +530,10 @@ fn unknown_name_cases() -> Vec<Case> {
             .expect("mesh.kind: unknown variant `grid`, expected one of `blocks`, `polygon`, `gmsh`, `interval`"),
         case("unknown-effect-kind", COLUMN)
             .edit("kind = \"damping\"", "kind = @@\"magnetism\"")
-            .expect("effect[1].kind: unknown variant `magnetism`, expected one of `gravity`, `damping`, `traction`, `body-force`, `manufactured-body-force`, `contact-wall`, `geostatic-stress`"),
+            .expect("effect[1].kind: unknown variant `magnetism`, expected one of `gravity`, `damping`, `traction`, `body-force`, `manufactured-body-force`, `contact-wall`, `body-contact`, `geostatic-stress`"),
+        case("body-contact-with-one-body", COLUMN)
+            .edit("kind = \"damping\"\nalpha = 0.1", "kind = @@\"body-contact\"")
+            .expect("effect[1].kind: contact between bodies needs two or more `[[body]]` tables, this scene has 1: add the other body, or remove this effect"),
         case("unknown-reference-kind", BAR)
             .edit("kind = \"vibrating-bar\"", "kind = @@\"pendulum\"")
             .expect("reference.kind: unknown variant `pendulum`, expected one of `vibrating-bar`, `column-self-weight`, `axis-aligned`, `column-equilibrium`"),
