@@ -38,6 +38,18 @@ impl<T: Scalar, const D: usize> ParticleBasis<'_, T, D> {
         self.evals.entries(p).map(|(s, i)| (i, self.evals.phi[s]))
     }
 
+    /// The functions `i` non-zero at particle `p` with `phi_i(x_p)` and
+    /// `grad phi_i(x_p)`.
+    #[inline]
+    pub fn functions_with_gradients(
+        &self,
+        p: usize,
+    ) -> impl Iterator<Item = (usize, T, SVector<T, D>)> + '_ {
+        self.evals
+            .entries(p)
+            .map(|(s, i)| (i, self.evals.phi[s], self.evals.grad_phi[s]))
+    }
+
     /// Adds `phi_i(x_p) f` to `forces[k][i]` for the functions of particle `p`.
     #[inline]
     pub fn scatter(&self, p: usize, f: &SVector<T, D>, forces: &mut [Vec<T>]) {

@@ -406,7 +406,7 @@ pub fn body_contact_warning(scene: &Scene) -> Option<String> {
     let linear = matches!(scene.basis, BasisKind::Pl | BasisKind::Pl1d);
     (scene.body_contact() && linear && scene.mass != crate::mass::MassKind::Lumped).then(|| {
         format!(
-            "contact between bodies with the `{}` basis and the `{}` mass: the contact forces are sized on lumped rows, and this mass's nearly consistent rows spread them further, so they can add energy (two slow disks gained 20 %); use `mass = \"lumped\"` (`--mass lumped`) with PL, or the PS basis (docs/scenes.md, the `body-contact` effect)",
+            "contact between bodies with the `{}` basis and the `{}` mass: the contact forces are sized on lumped rows, and this mass's nearly consistent rows spread them further, so they can add energy (two slow disks gained 26 %); use the PS basis, or `mass = \"lumped\"` (`--mass lumped`) with PL (docs/scenes.md, the `body-contact` effect)",
             scene.basis.name(),
             scene.mass.spec()
         )
