@@ -770,18 +770,32 @@ fn error<const D: usize, B: Basis<f64, D>>(
             density,
             gravity,
             young,
+            geostatic,
         } => {
             let sigma_base = (height * density * gravity).abs();
             let worst = (0..parts.len())
                 .map(|p| {
-                    let y = parts.x[p][D - 1] - origin[D - 1];
-                    let exact = exact::column_equilibrium_stress_linear(
-                        y,
-                        height,
-                        density,
-                        gravity.abs(),
-                        young,
-                    );
+                    let exact = if geostatic {
+                        // Started from the geostatic state: its particles carry
+                        // `σ⁰`, so the law alone does not give the settled height
+                        // of a point; the weight above its reference height does.
+                        let y0 = parts.x0[p][D - 1] - origin[D - 1];
+                        exact::column_equilibrium_stress_at_reference(
+                            y0,
+                            height,
+                            density,
+                            gravity.abs(),
+                        )
+                    } else {
+                        let y = parts.x[p][D - 1] - origin[D - 1];
+                        exact::column_equilibrium_stress_linear(
+                            y,
+                            height,
+                            density,
+                            gravity.abs(),
+                            young,
+                        )
+                    };
                     (parts.sigma[p][(D - 1, D - 1)] - exact).abs() / sigma_base
                 })
                 .fold(0.0, f64::max);

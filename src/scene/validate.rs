@@ -362,6 +362,22 @@ impl Scene {
                     "a column reference needs a gravity effect",
                 ));
             }
+            Some(Reference::ColumnSelfWeight {}) => {
+                // The settling motion starts stress-free; a geostatic initial stress
+                // holds the column at rest instead.
+                if let Some(k) = self
+                    .effects
+                    .iter()
+                    .position(|e| matches!(e, EffectSpec::GeostaticStress { .. }))
+                {
+                    return Err(conflict(
+                        "reference.kind",
+                        format!(
+                            "`column-self-weight` is the column settling from a stress-free start, but effect[{k}] gives it a geostatic initial stress, which holds it at rest: use `column-equilibrium` (whose error is then measured against the geostatic profile), or leave out the geostatic stress"
+                        ),
+                    ));
+                }
+            }
             Some(Reference::AxisAligned { u0 }) => {
                 finite("reference.u0", u0)?;
                 if d != 2

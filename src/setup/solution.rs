@@ -1,7 +1,7 @@
 //! The scene's reference solution, resolved from its parameters, in the scene's
 //! dimension.
 
-use crate::scene::{Reference, Scene};
+use crate::scene::{EffectSpec, Reference, Scene};
 use crate::studies::exact;
 
 /// The scene's reference solution with its parameters resolved.
@@ -10,11 +10,16 @@ pub(crate) enum Solution {
     Bar(exact::VibratingBar),
     Column(exact::ColumnSelfWeight),
     AxisAligned(exact::AxisAligned),
+    /// The column at rest under its weight: a static state, with no time history.
     Equilibrium {
         height: f64,
         density: f64,
         gravity: f64,
         young: f64,
+        /// The column starts from a `geostatic-stress` initial state, so its
+        /// equilibrium is measured at the particles' reference heights (see
+        /// [`exact::column_equilibrium_stress_at_reference`]).
+        geostatic: bool,
     },
 }
 
@@ -49,6 +54,10 @@ impl Solution {
                 density: m.density,
                 gravity,
                 young: m.young,
+                geostatic: scene
+                    .effects
+                    .iter()
+                    .any(|e| matches!(e, EffectSpec::GeostaticStress { .. })),
             },
         })
     }

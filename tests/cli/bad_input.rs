@@ -766,6 +766,10 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n\n", "")
             .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
             .expect("reference.kind: a column reference needs a gravity effect"),
+        case("column-self-weight-from-a-geostatic-state", COLUMN)
+            .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = \"geostatic-stress\"\nsurface = 4.0\n\n[[effect]]\nkind = \"traction\"")
+            .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
+            .expect("reference.kind: `column-self-weight` is the column settling from a stress-free start, but effect[2] gives it a geostatic initial stress, which holds it at rest: use `column-equilibrium` (whose error is then measured against the geostatic profile), or leave out the geostatic stress"),
         case("geostatic-stress-without-gravity", BAR)
             .edit("[time]", "[[effect]]\nkind = @@\"geostatic-stress\"\nsurface = 1.0\n\n[time]")
             .expect("effect[0].kind: geostatic stress needs a gravity effect"),
