@@ -555,6 +555,11 @@ pub fn ps_sampling_warning(sampling: f64) -> Option<String> {
 fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>) -> Vec<Tracked> {
     // The initial positions: the particles' reference positions.
     let (positions, steps) = (&run.driver.particles.x0, run.steps);
+    let exact = if run.solution.is_some_and(|s| s.has_history()) {
+        steps
+    } else {
+        0
+    };
     scene
         .output
         .tracked
@@ -574,12 +579,8 @@ fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>
                 time: Vec::with_capacity(steps),
                 velocity: Vec::with_capacity(steps),
                 displacement: Vec::with_capacity(steps),
-                exact_displacement: Vec::with_capacity(if run.solution.is_some() {
-                    steps
-                } else {
-                    0
-                }),
-                exact_velocity: Vec::with_capacity(if run.solution.is_some() { steps } else { 0 }),
+                exact_displacement: Vec::with_capacity(exact),
+                exact_velocity: Vec::with_capacity(exact),
             }
         })
         .collect()
@@ -670,7 +671,7 @@ where
             t.velocity.push(from_vec(&driver.particles.v[t.particle]));
             t.displacement
                 .push(from_vec(&driver.particles.u[t.particle]));
-            if let Some(s) = solution {
+            if let Some(s) = solution.filter(|s| s.has_history()) {
                 t.exact_displacement
                     .push(s.displacement(t.x0, origin, D, r.time));
                 t.exact_velocity.push(s.velocity(t.x0, origin, D, r.time));

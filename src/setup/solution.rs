@@ -62,6 +62,14 @@ impl Solution {
         })
     }
 
+    /// Whether the solution is a motion in time, whose displacement and velocity
+    /// the tracked particles are compared with (`tracked.csv`'s exact columns). The
+    /// column's equilibrium is the state it settles to, not the motion on the way:
+    /// it has none.
+    pub(crate) fn has_history(&self) -> bool {
+        !matches!(self, Solution::Equilibrium { .. })
+    }
+
     /// Exact displacement at reference position `x0` (relative to the body's
     /// lower corner `origin`) and time `t`, in the scene's dimension.
     pub(crate) fn displacement(
