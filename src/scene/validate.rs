@@ -212,6 +212,32 @@ impl Scene {
         let gravity = self.gravity();
         for (i, effect) in self.effects.iter().enumerate() {
             let field = |f: &str| format!("effect[{i}].{f}");
+            // The physics sums two gravity (or damping) effects, but the references
+            // and the geostatic stress take the first gravity alone, and two dampings
+            // may add up to α ≥ 1, which pushes along the velocity: one of each.
+            let once = match effect {
+                EffectSpec::Gravity { .. } => Some((
+                    "gravity",
+                    "`g` (the references and the geostatic stress use the first gravity alone)",
+                )),
+                EffectSpec::Damping { .. } => Some((
+                    "damping",
+                    "`alpha`, below 1 (the damping of two is that of their sum, and from 1 on it pushes along the velocity)",
+                )),
+                _ => None,
+            };
+            if let Some((kind, what)) = once {
+                let same =
+                    |e: &EffectSpec| std::mem::discriminant(e) == std::mem::discriminant(effect);
+                if let Some(j) = self.effects[..i].iter().position(same) {
+                    return Err(conflict(
+                        field("kind"),
+                        format!(
+                            "`{kind}` is already declared by effect[{j}]; give one `{kind}` effect with the sum of their {what}"
+                        ),
+                    ));
+                }
+            }
             match effect {
                 EffectSpec::Gravity { g } => vector(&field("g"), g)?,
                 EffectSpec::Damping { alpha } => {

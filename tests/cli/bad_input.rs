@@ -766,6 +766,14 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n\n", "")
             .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
             .expect("reference.kind: a column reference needs a gravity effect"),
+        // The physics would sum them, but the references and the geostatic stress
+        // take the first gravity, and two dampings may add up to α ≥ 1.
+        case("two-gravity-effects", COLUMN)
+            .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = @@\"gravity\"\ng = [0.0, -1.0]\n\n[[effect]]\nkind = \"traction\"")
+            .expect("effect[2].kind: `gravity` is already declared by effect[0]; give one `gravity` effect with the sum of their `g` (the references and the geostatic stress use the first gravity alone)"),
+        case("two-damping-effects", COLUMN)
+            .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = @@\"damping\"\nalpha = 0.6\n\n[[effect]]\nkind = \"traction\"")
+            .expect("effect[2].kind: `damping` is already declared by effect[1]; give one `damping` effect with the sum of their `alpha`, below 1 (the damping of two is that of their sum, and from 1 on it pushes along the velocity)"),
         case("column-self-weight-from-a-geostatic-state", COLUMN)
             .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = \"geostatic-stress\"\nsurface = 4.0\n\n[[effect]]\nkind = \"traction\"")
             .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
