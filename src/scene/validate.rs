@@ -1,8 +1,9 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D,
-    MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
+    check_tracked_history, echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS,
+    MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D, MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS,
+    MAX_TRACKED, MAX_TRIANGLES,
 };
 use super::{
     bad, conflict, Axis, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel,
@@ -372,8 +373,23 @@ impl Scene {
             }
         }
         self.validate_resolutions()?;
+        let tracked = self.output.tracked.len();
+        if tracked > MAX_TRACKED {
+            return Err(bad(
+                "output.tracked",
+                format!(
+                    "lists {tracked} points, above the limit of {MAX_TRACKED}: each is recorded every step; track fewer points, or write the particle frames (`run --out DIR`, every particle at every `--out-every` steps)"
+                ),
+            ));
+        }
         for (i, t) in self.output.tracked.iter().enumerate() {
             vector(&format!("output.tracked[{i}]"), t)?;
+        }
+        if let (Some(dt), true) = (self.time.dt, tracked > 0) {
+            // (With `courant` the run checks it once it knows its step.)
+            let steps = (self.time.t_end / dt).round().max(1.0) as usize;
+            check_tracked_history(tracked, steps, "t_end / dt")
+                .map_err(|m| bad("output.tracked", m))?;
         }
         match self.reference {
             Some(Reference::VibratingBar { v0 }) => {

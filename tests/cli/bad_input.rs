@@ -571,6 +571,20 @@ fn range_cases() -> Vec<Case> {
         case("tiny-t-end-in-short-form", COLUMN)
             .edit("t_end = 0.01", "t_end = @@1e-300")
             .expect("time.t_end: is shorter than one time step (t_end = 1e-300, courant = 0.5 gives dt = 1.1374681029968743e-3)"),
+        // Each tracked point is recorded every step: their count is bounded, and so
+        // is points × steps (10 000 points over 100 steps took 357 MB).
+        case("too-many-tracked-points", BAR)
+            .edit("tracked = [[2.0, 0.5]]", &format!("tracked = @@[{}]", vec!["[2.0, 0.5]"; 1001].join(", ")))
+            .expect("output.tracked: lists 1001 points, above the limit of 1000: each is recorded every step; track fewer points, or write the particle frames (`run --out DIR`, every particle at every `--out-every` steps)"),
+        case("tracked-history-too-long", BAR)
+            .edit("t_end = 0.01", "t_end = 10.001")
+            .edit("tracked = [[2.0, 0.5]]", &format!("tracked = @@[{}]", vec!["[2.0, 0.5]"; 1000].join(", ")))
+            .expect("output.tracked: 1000 tracked points over 10001 steps (t_end / dt) record 10001000 samples, above the limit of 10000000 (points × steps, each kept in memory for tracked.csv): track fewer points, or take fewer steps (a shorter `t_end` or a longer step)"),
+        // With `courant` the steps are known at the start of the run, which checks them.
+        case("tracked-history-too-long-with-courant", COLUMN)
+            .edit("t_end = 0.01", "t_end = 100.0")
+            .map(|t| format!("{t}\n[output]\ntracked = @@[{}]\n", vec!["[0.5, 2.0]"; 1000].join(", ")))
+            .expect("output.tracked: 1000 tracked points over 87915 steps (t_end / (courant × the critical step)) record 87915000 samples, above the limit of 10000000 (points × steps, each kept in memory for tracked.csv): track fewer points, or take fewer steps (a shorter `t_end` or a longer step)"),
         case("dim-3", BAR)
             .edit("dim = 2", "dim = @@3")
             .expect("dim: must be 1 or 2, got 3"),
