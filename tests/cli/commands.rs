@@ -364,6 +364,79 @@ fn converge_explains_a_falling_order_with_two_probes() {
     );
 }
 
+/// A user's damped 1D column (`converge FILE --levels 4 --blocks 4x1 --t-end 1.0`):
+/// pl1d's error jumps at level 3 (3.3e-2 to 4.7e-1, order −3.83). Half the time step
+/// lowered it × 0.52, and the study said "the time step limits the error: a smaller
+/// `courant`", but a quarter of the step gives × 0.54 (and an eighth, a sixteenth
+/// × 0.49, × 0.45): the error does not fall with the step. The study now halves the
+/// step twice before it blames the step.
+const DAMPED_COLUMN: &str = r#"name = "my-column-1d"
+dim = 1
+basis = "bspline"
+[mesh]
+kind = "interval"
+x = [0.0, 1.0]
+elements = 16
+[material]
+young = 1e6
+density = 1000.0
+[[body]]
+min = [0.0]
+max = [1.0]
+per_block = [4]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [-10.0]
+[[effect]]
+kind = "damping"
+alpha = 0.6
+[time]
+courant = 0.5
+t_end = 2.0
+[reference]
+kind = "column-equilibrium"
+"#;
+
+#[test]
+fn converge_blames_the_time_step_only_if_the_error_falls_with_it() {
+    let dir = temp_dir("converge-step");
+    let scene = dir.join("col1d.toml");
+    std::fs::write(&scene, DAMPED_COLUMN).unwrap();
+    let json = stdout(&[
+        "converge",
+        scene.to_str().unwrap(),
+        "--levels",
+        "4",
+        "--blocks",
+        "4x1",
+        "--t-end",
+        "1.0",
+        "--format",
+        "json",
+    ]);
+    let study: Value = serde_json::from_str(&json).unwrap();
+    let diagnoses = study["diagnoses"].as_array().unwrap();
+    let d = diagnoses.iter().find(|d| d["basis"] == "pl1d").unwrap();
+    assert_eq!(d["level"], 3, "{d}");
+    let (half, quarter) = (
+        d["half_dt"].as_f64().unwrap(),
+        d["quarter_dt"].as_f64().unwrap(),
+    );
+    // One halving lowers the error, the next does not.
+    assert!(half < 0.6 && quarter / half > 0.9, "{d}");
+    let verdict = d["verdict"].as_str().unwrap();
+    assert!(
+        !verdict.contains("the time step limits the error")
+            && verdict.starts_with("the error does not fall consistently with the step")
+            && verdict.contains("a smaller one will not help"),
+        "{verdict}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A scene of the user's own, without an exact solution: a block settling on a fixed
 /// floor. Levels are measured against the finest one, and the output says so.
 #[test]
