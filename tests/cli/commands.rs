@@ -535,6 +535,7 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
             "plot",
             "--function",
             "39",
+            "--overwrite",
             "--out",
             function.to_str().unwrap(),
         ])
@@ -547,6 +548,47 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
             && stderr.contains("the basis has 39 functions (indices below 39)"),
         "{stderr}"
     );
+}
+
+/// `basis plot --out FILE` replaced an existing file without a word, where `run
+/// --out` refuses a folder of an earlier run: it now refuses an existing file unless
+/// `--overwrite` is given, and a directory always, before drawing anything.
+#[test]
+fn basis_plot_refuses_an_existing_file_without_overwrite() {
+    let dir = temp_dir("basis-overwrite");
+    let picture = dir.join("mine.svg");
+    std::fs::write(&picture, "a picture of my own").unwrap();
+    let plot = |extra: &[&str], out: &std::path::Path| {
+        cli()
+            .args(["basis", "plot", "--out"])
+            .arg(out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = plot(&[], &picture);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        format!(
+            "error: output file `{}` already exists; pass --overwrite to replace it, or choose another --out\n",
+            picture.display()
+        )
+    );
+    assert_eq!(
+        std::fs::read_to_string(&picture).unwrap(),
+        "a picture of my own"
+    );
+    let out = plot(&["--overwrite"], &picture);
+    assert!(out.status.success(), "{out:?}");
+    assert!(std::fs::read_to_string(&picture).unwrap().contains("<svg"));
+    let out = plot(&["--overwrite"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("is a directory; choose another --out"),
+        "{out:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `reproduce` chooses the UL-FEM cache directory from the environment (the library
