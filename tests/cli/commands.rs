@@ -768,6 +768,33 @@ fn throughput_prints_rates_memory_and_the_scaling_exponent() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("the throughput scene is 2D"));
 }
 
+/// `throughput --sizes 1e7` rounds to 140 × 1120 blocks of 64 particles, above the
+/// scenes' particle limit, and the error named `body[0]` of the internal scene after
+/// the size had been accepted: the size is now checked up front and named.
+#[test]
+fn throughput_checks_its_sizes_against_the_particle_limit_up_front() {
+    let error = |size: &str| {
+        let out = cli()
+            .args(["throughput", "--sizes", size, "--steps", "1"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{out:?}");
+        String::from_utf8(out.stderr).unwrap()
+    };
+    assert_eq!(
+        error("1e7"),
+        "error: --sizes: 10000000 particles rounds to 10035200 (140 × 1120 blocks of 8 × 8), above the limit of 10000000 particles; give at most 9892352\n"
+    );
+    assert_eq!(
+        error("2e7"),
+        "error: --sizes: 20000000 particles is above the limit of 10000000 particles; give at most 9892352\n"
+    );
+    assert_eq!(
+        error("50"),
+        "error: --sizes: 50 particles is outside 100..=9892352\n"
+    );
+}
+
 /// A student's settling column whose finer PL levels stop before the end time with
 /// the consistent mass (the top functions lose their support).
 const STOPPING_COLUMN: &str = r#"
