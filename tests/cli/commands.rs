@@ -795,6 +795,23 @@ fn throughput_checks_its_sizes_against_the_particle_limit_up_front() {
     );
 }
 
+/// `compare --courant 1.5` said `time.courant: …` without the flag that set it;
+/// `run` names the flags (`FILE with --courant 1.5: time.courant: …`), and so does
+/// `compare` now.
+#[test]
+fn compare_names_the_flag_of_a_set_up_error() {
+    let out = cli()
+        .args(["compare", "column-small-1d", "--courant", "1.5"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("error: column-small-1d with --courant 1.5: time.courant: 1.5 puts the time step at or above the critical step"),
+        "{stderr}"
+    );
+}
+
 /// A student's settling column whose finer PL levels stop before the end time with
 /// the consistent mass (the top functions lose their support).
 const STOPPING_COLUMN: &str = r#"
