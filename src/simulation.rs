@@ -591,6 +591,11 @@ pub fn ps_sampling_warning(sampling: f64) -> Option<String> {
 fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>) -> Vec<Tracked> {
     // The initial positions: the particles' reference positions.
     let (positions, steps) = (&run.driver.particles.x0, run.steps);
+    let exact = if run.solution.is_some_and(|s| s.has_history()) {
+        steps
+    } else {
+        0
+    };
     scene
         .output
         .tracked
@@ -610,12 +615,8 @@ fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>
                 time: Vec::with_capacity(steps),
                 velocity: Vec::with_capacity(steps),
                 displacement: Vec::with_capacity(steps),
-                exact_displacement: Vec::with_capacity(if run.solution.is_some() {
-                    steps
-                } else {
-                    0
-                }),
-                exact_velocity: Vec::with_capacity(if run.solution.is_some() { steps } else { 0 }),
+                exact_displacement: Vec::with_capacity(exact),
+                exact_velocity: Vec::with_capacity(exact),
             }
         })
         .collect()
@@ -706,7 +707,7 @@ where
             t.velocity.push(from_vec(&driver.particles.v[t.particle]));
             t.displacement
                 .push(from_vec(&driver.particles.u[t.particle]));
-            if let Some(s) = solution {
+            if let Some(s) = solution.filter(|s| s.has_history()) {
                 t.exact_displacement
                     .push(s.displacement(t.x0, origin, D, r.time));
                 t.exact_velocity.push(s.velocity(t.x0, origin, D, r.time));
@@ -806,18 +807,32 @@ fn error<const D: usize, B: Basis<f64, D>>(
             density,
             gravity,
             young,
+            geostatic,
         } => {
             let sigma_base = (height * density * gravity).abs();
             let worst = (0..parts.len())
                 .map(|p| {
-                    let y = parts.x[p][D - 1] - origin[D - 1];
-                    let exact = exact::column_equilibrium_stress_linear(
-                        y,
-                        height,
-                        density,
-                        gravity.abs(),
-                        young,
-                    );
+                    let exact = if geostatic {
+                        // Started from the geostatic state: its particles carry
+                        // `σ⁰`, so the law alone does not give the settled height
+                        // of a point; the weight above its reference height does.
+                        let y0 = parts.x0[p][D - 1] - origin[D - 1];
+                        exact::column_equilibrium_stress_at_reference(
+                            y0,
+                            height,
+                            density,
+                            gravity.abs(),
+                        )
+                    } else {
+                        let y = parts.x[p][D - 1] - origin[D - 1];
+                        exact::column_equilibrium_stress_linear(
+                            y,
+                            height,
+                            density,
+                            gravity.abs(),
+                            young,
+                        )
+                    };
                     (parts.sigma[p][(D - 1, D - 1)] - exact).abs() / sigma_base
                 })
                 .fold(0.0, f64::max);

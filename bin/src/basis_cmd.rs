@@ -46,9 +46,30 @@ pub struct PlotArgs {
     /// PS split points: incentre or centroid.
     #[arg(long, default_value = "incentre")]
     split: String,
-    /// Output file.
+    /// Output file. An existing file is refused unless --overwrite is given.
     #[arg(long, default_value = "basis.svg")]
     out: PathBuf,
+    /// Replace the --out file if it exists.
+    #[arg(long)]
+    overwrite: bool,
+}
+
+/// Checks `out` before anything is drawn: a directory is refused, and an existing
+/// file unless `overwrite` (`--overwrite`), as `run --out` refuses a directory that
+/// holds an earlier run's files.
+fn check_out(out: &std::path::Path, overwrite: bool) -> Result<(), CliError> {
+    let shown = psmpm::scene::limits::echo(&out.display().to_string());
+    if out.is_dir() {
+        return Err(CliError::Input(format!(
+            "output file `{shown}` is a directory; choose another --out"
+        )));
+    }
+    if out.exists() && !overwrite {
+        return Err(CliError::Input(format!(
+            "output file `{shown}` already exists; pass --overwrite to replace it, or choose another --out"
+        )));
+    }
+    Ok(())
 }
 
 fn mesh(args: &PlotArgs) -> Result<TriMesh, CliError> {
@@ -82,6 +103,7 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
         parse_split(&args.split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
     let kind =
         BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+    check_out(&args.out, args.overwrite)?;
     let mesh = mesh(&args)?;
     let plot_error = |e: psmpm::output::chart::PlotError| match e {
         psmpm::output::chart::PlotError::FunctionIndex { .. } => {

@@ -108,8 +108,14 @@ fn listed_twice<T: PartialEq>(list: &[T]) -> Option<&T> {
 }
 
 /// Runs `scenes`, up to `jobs` at the same time, their steps on `pool`; results in
-/// the order of `scenes`.
-pub fn run_all(scenes: &[Scene], jobs: usize, pool: &ThreadPool) -> Vec<Result<Summary, CliError>> {
+/// the order of `scenes`, a set-up error as `describe` tells it (naming the
+/// command-line flags that set its field: [`crate::run::run_error`]).
+pub fn run_all(
+    scenes: &[Scene],
+    jobs: usize,
+    pool: &ThreadPool,
+    describe: impl Fn(RunError) -> CliError,
+) -> Vec<Result<Summary, CliError>> {
     let next = AtomicUsize::new(0);
     let progress =
         crate::progress::Progress::new(scenes.iter().map(|s| s.steps() as u64).sum(), "steps");
@@ -133,7 +139,7 @@ pub fn run_all(scenes: &[Scene], jobs: usize, pool: &ThreadPool) -> Vec<Result<S
         .unwrap_or_default()
         .into_iter()
         .map(|r| match r {
-            Some(r) => r.map_err(|e| CliError::Input(e.to_string())),
+            Some(r) => r.map_err(&describe),
             None => Err(CliError::Input("a run did not finish".into())),
         })
         .collect()
@@ -173,7 +179,9 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
     let pool = crate::run::thread_pool(args.threads)?;
-    let results = run_all(&scenes, jobs, &pool);
+    let results = run_all(&scenes, jobs, &pool, |e| {
+        crate::run::run_error(&args.scene, &args.overrides, e)
+    });
     let mut summaries = Vec::new();
     for r in results {
         summaries.push(r?);

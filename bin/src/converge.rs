@@ -236,6 +236,9 @@ pub struct Diagnosis {
     pub order: f64,
     /// Error of that level with half the time step, over its error.
     pub half_dt: Option<f64>,
+    /// Error of that level with a quarter of the time step, over its error:
+    /// measured when half the step lowered the error, to see whether it falls again.
+    pub quarter_dt: Option<f64>,
     /// Error of that level with twice the particles along every axis, over its error.
     pub double_particles: Option<f64>,
     /// What limits the error, and what to change.
@@ -244,6 +247,12 @@ pub struct Diagnosis {
 
 /// A probe that lowers the error by more than this fraction names what limits it.
 const LIMITING_GAIN: f64 = 0.2;
+
+/// The largest fall of the error that one halving of the time step can give when
+/// the step limits it: × 0.25 for a second-order scheme (the central difference),
+/// × 0.5 for a first-order one, with room for the other errors. A halving that
+/// lowers the error more is not the time integration's error falling.
+const STEPWISE_FALL: f64 = 0.15;
 
 /// An order falls when it is below this…
 const LOW_ORDER: f64 = 0.5;
@@ -491,7 +500,15 @@ fn study(
                 Ok(error_of(&summary, &particles).map(|e| e / error))
             };
             let s = &levels[index].0;
-            let half_dt = probe(with_half_time_step(s))?;
+            let half = with_half_time_step(s);
+            let half_dt = probe(half.clone())?;
+            // One halving that lowers the error may be chance (the error of a level
+            // varies with any change to its run): the step limits the error only if
+            // a second halving lowers it again.
+            let quarter_dt = match half_dt {
+                Some(r) if r < 1.0 - LIMITING_GAIN => probe(with_half_time_step(&half))?,
+                _ => None,
+            };
             let double_particles = match with_double_particles(s) {
                 Some(denser) => probe(denser)?,
                 None => None,
@@ -501,8 +518,9 @@ fn study(
                 level: index as u32,
                 order,
                 half_dt,
+                quarter_dt,
                 double_particles,
-                verdict: verdict(s, half_dt, double_particles),
+                verdict: verdict(s, half_dt, quarter_dt, double_particles),
             });
         }
     }
@@ -558,8 +576,30 @@ fn with_double_particles(scene: &Scene) -> Option<Scene> {
     Some(s)
 }
 
-/// What the two probes say limits the error at a level whose order fell.
-fn verdict(scene: &Scene, half_dt: Option<f64>, double_particles: Option<f64>) -> String {
+/// Whether halving the time step lowers the error consistently: `half` and
+/// `quarter` are the errors with half and a quarter of the step over the level's
+/// error. Each halving must lower the error beyond the noise ([`LIMITING_GAIN`])
+/// and by no more than the scheme's order allows ([`STEPWISE_FALL`]).
+fn falls_with_the_step(half: Option<f64>, quarter: Option<f64>) -> bool {
+    let consistent = |r: f64| (STEPWISE_FALL..1.0 - LIMITING_GAIN).contains(&r);
+    match (half, quarter) {
+        (Some(h), Some(q)) if h > 0.0 => consistent(h) && consistent(q / h),
+        _ => false,
+    }
+}
+
+/// What the probes say limits the error at a level whose order fell: half the
+/// time step (and, when that lowered the error, a quarter of it) and twice the
+/// particles, each as the error over the level's error. The step is said to limit
+/// the error only when both halvings lower it by a factor a first- or second-order
+/// scheme gives ([`falls_with_the_step`]); one halving that helped and a second
+/// that did not says that the step is not what limits it.
+fn verdict(
+    scene: &Scene,
+    half_dt: Option<f64>,
+    quarter_dt: Option<f64>,
+    double_particles: Option<f64>,
+) -> String {
     let lowers = |r: Option<f64>| r.is_some_and(|r| r < 1.0 - LIMITING_GAIN);
     let time = if scene.time.courant.is_some() {
         "a smaller `courant` (--courant, or --dt)"
@@ -568,7 +608,18 @@ fn verdict(scene: &Scene, half_dt: Option<f64>, double_particles: Option<f64>) -
     };
     let particles = "more particles per element as h shrinks (`per_block` or `count`, \
                      --particles)";
-    match (lowers(half_dt), lowers(double_particles)) {
+    let step_limits = falls_with_the_step(half_dt, quarter_dt);
+    // Half the step lowered the error, but not consistently with the step.
+    let not_the_step = match (half_dt, quarter_dt) {
+        (Some(h), Some(q)) if lowers(half_dt) && !step_limits => format!(
+            "the error does not fall consistently with the step (half of it × {h:.2}, then the \
+             next halving × {:.2}), so the time step is not what limits it and a smaller one \
+             will not help; ",
+            q / h
+        ),
+        _ => String::new(),
+    };
+    let limits = match (step_limits, lowers(double_particles)) {
         (true, true) => format!(
             "both the time step and the particles per element limit the error: {time} and {particles}"
         ),
@@ -583,12 +634,18 @@ fn verdict(scene: &Scene, half_dt: Option<f64>, double_particles: Option<f64>) -
              (ps, bspline) avoids it"
                 .into()
         }
+        (false, false) if !not_the_step.is_empty() => "nor do more particles lower it: it \
+             has reached a floor that refinement does not remove (for example the reference's \
+             own assumptions, such as small strain, the finest level's error, or an error that \
+             changes with the instants at which particles cross element edges)"
+            .into(),
         (false, false) => "neither a smaller time step nor more particles lower the error: it \
                            has reached a floor that refinement does not remove (for example \
                            the reference's own assumptions, such as small strain, or the \
                            finest level's error)"
             .into(),
-    }
+    };
+    format!("{not_the_step}{limits}")
 }
 
 /// The study as JSON: what the errors are measured against, the levels, the
@@ -618,11 +675,13 @@ fn explanation(study: &Study) -> String {
     for d in diagnoses {
         out += &format!(
             "{} level {}: the order falls to {:.2}. At this level, half the time step \
-             changes the error {}, twice the particles along each axis {}: {}.\n",
+             changes the error {}{}, twice the particles along each axis {}: {}.\n",
             d.basis,
             d.level,
             d.order,
             ratio(d.half_dt),
+            d.quarter_dt
+                .map_or_else(String::new, |r| format!(", a quarter of it × {r:.2}")),
             ratio(d.double_particles),
             d.verdict
         );
@@ -819,5 +878,40 @@ mod tests {
             "{lines}"
         );
         assert!(lines.contains("bspline does not reach"), "{lines}");
+    }
+
+    /// A user's 1D column (pl1d, level 3 of `--blocks 4x1`): half the step lowered
+    /// the error × 0.52, but a quarter of it × 0.54 (halving again: × 1.03, and
+    /// courant 0.125, 0.0625, 0.03125 gave 0.54, 0.49, 0.45 of the level's error).
+    /// The study said "the time step limits the error: a smaller `courant`"; it
+    /// now says that the step is not what limits it.
+    #[test]
+    fn the_step_limits_the_error_only_if_it_falls_with_each_halving() {
+        let scene = Scene::builtin("column-small-1d").unwrap();
+        let once = verdict(&scene, Some(0.52), Some(0.54), Some(1.05));
+        assert!(!once.contains("the time step limits"), "{once}");
+        assert!(
+            once.starts_with("the error does not fall consistently with the step (half of it × 0.52, then the next halving × 1.04)")
+                && once.contains("nor do more particles lower it"),
+            "{once}"
+        );
+        let with_particles = verdict(&scene, Some(0.52), Some(0.54), Some(0.4));
+        assert!(
+            with_particles
+                .contains("a smaller one will not help; the particles per element limit the error"),
+            "{with_particles}"
+        );
+        // First order (× 0.5 twice) and second order (× 0.25 twice) limit it.
+        for r in [0.5, 0.25] {
+            let v = verdict(&scene, Some(r), Some(r * r), Some(1.0));
+            assert!(v.starts_with("the time step limits the error"), "{v}");
+        }
+        // Falling far more than a second-order scheme can is not the step's error.
+        assert!(!falls_with_the_step(Some(0.05), Some(0.0025)));
+        // A halving within the noise does not count, nor one probe alone.
+        assert!(!falls_with_the_step(Some(0.85), Some(0.7)));
+        assert!(!falls_with_the_step(Some(0.5), None));
+        let unmeasured = verdict(&scene, Some(0.5), None, Some(1.0));
+        assert!(!unmeasured.contains("the time step limits"), "{unmeasured}");
     }
 }

@@ -26,7 +26,8 @@
 //! - `mesh.vtu`: the triangulation of a 2D scene (1D scenes have no mesh file).
 //! - `tracked.csv` and `tracked.svg` when the scene tracks particles
 //!   (`output.tracked`): `time, particle, u_x, u_y, v_x, v_y` and, with a reference
-//!   solution, `u_exact_x, u_exact_y, v_exact_x, v_exact_y`, one row per step and
+//!   solution that is a motion (not `column-equilibrium`, a settled state),
+//!   `u_exact_x, u_exact_y, v_exact_x, v_exact_y`, one row per step and
 //!   tracked particle; the plot shows the displacement against time (computed as
 //!   markers, or as a line without a reference; the reference as a line) and below
 //!   it the velocity in the same style, on the same time axis.

@@ -151,7 +151,9 @@ impl Overrides {
     pub fn flags_of(&self, e: &psmpm::scene::SceneError) -> Vec<String> {
         let field = e.field.as_str();
         let mut flags = Vec::new();
-        if field.starts_with("time.") {
+        // The tracked history grows with the steps, which the time flags set.
+        let history = field == "output.tracked" && e.message.contains("tracked points over");
+        if field.starts_with("time.") || history {
             if let Some(dt) = self.dt {
                 flags.push(format!("--dt {dt:?}"));
             }

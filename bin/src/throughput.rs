@@ -27,8 +27,46 @@ const PER_BLOCK: usize = 8;
 const ASPECT: usize = 8;
 /// The fixed time step.
 const DT: f64 = 1e-6;
-/// The largest size measured (particles).
-const MAX_PARTICLES: f64 = 2e7;
+/// Particles of one block.
+const BLOCK_PARTICLES: usize = PER_BLOCK * PER_BLOCK;
+
+/// The blocks `b` of the `b × ASPECT b` grid nearest `n` particles.
+fn blocks_for(n: f64) -> usize {
+    ((n / BLOCK_PARTICLES as f64 / ASPECT as f64).sqrt().round() as usize).max(1)
+}
+
+/// The particles of the `b × ASPECT b` grid.
+fn particles_of(b: usize) -> usize {
+    BLOCK_PARTICLES * ASPECT * b * b
+}
+
+/// Checks a `--sizes` entry before any scene is built: at least 100 particles, and
+/// the grid it rounds to within the scenes' particle limit
+/// ([`psmpm::scene::MAX_PARTICLES`]).
+fn check_size(n: f64) -> Result<(), CliError> {
+    let limit = psmpm::scene::MAX_PARTICLES;
+    // The largest grid within the limit.
+    let most = particles_of((limit as f64 / (BLOCK_PARTICLES * ASPECT) as f64).sqrt() as usize);
+    if !(n >= 100.0 && n.is_finite()) {
+        return Err(CliError::Input(format!(
+            "--sizes: {n} particles is outside 100..={most}"
+        )));
+    }
+    if n > limit as f64 {
+        return Err(CliError::Input(format!(
+            "--sizes: {n} particles is above the limit of {limit} particles; give at most {most}"
+        )));
+    }
+    let b = blocks_for(n);
+    let particles = particles_of(b);
+    if particles > limit {
+        return Err(CliError::Input(format!(
+            "--sizes: {n} particles rounds to {particles} ({b} × {} blocks of {PER_BLOCK} × {PER_BLOCK}), above the limit of {limit} particles; give at most {most}",
+            ASPECT * b
+        )));
+    }
+    Ok(())
+}
 
 /// Arguments of `mpm-cli throughput`.
 #[derive(Debug, clap::Args)]
@@ -96,8 +134,7 @@ fn variant(text: &str) -> Result<(BasisKind, MassKind), CliError> {
 
 /// The column refined to about `n` particles.
 fn scene(n: f64, basis: BasisKind, mass: MassKind, steps: usize) -> Result<Scene, CliError> {
-    let per_block = (PER_BLOCK * PER_BLOCK) as f64;
-    let b = ((n / per_block / ASPECT as f64).sqrt().round() as usize).max(1);
+    let b = blocks_for(n);
     let mut s = Scene::builtin("column-small")
         .map_err(|e| CliError::Input(e.to_string()))?
         .with_basis(basis)
@@ -129,11 +166,7 @@ pub fn throughput(args: ThroughputArgs) -> Result<(), CliError> {
         )));
     }
     for &n in &args.sizes {
-        if !(100.0..=MAX_PARTICLES).contains(&n) {
-            return Err(CliError::Input(format!(
-                "--sizes: {n} particles is outside 100..={MAX_PARTICLES:e}"
-            )));
-        }
+        check_size(n)?;
     }
     let variants: Vec<(String, BasisKind, MassKind)> = args
         .variants

@@ -28,6 +28,29 @@ pub const MAX_OUTLINE_CORNERS: usize = 100_000;
 /// up to every particle of the scene against every corner of the polygon (about 10 s
 /// at the limit).
 pub const MAX_POLYGON_TESTS: f64 = 1e10;
+/// Most points `output.tracked` may list (the nearest particle of each is found
+/// among all particles, and each is recorded every step).
+pub const MAX_TRACKED: usize = 1000;
+/// Most samples of the tracked particles' history a run may record: tracked points
+/// × steps (each sample holds the time, the displacement and the velocity, and with
+/// a reference the exact ones: 72 bytes, so 720 MB at the limit; 1000 points over
+/// 100 steps took 81 MB, over 1000 steps 714 MB). One point over [`MAX_STEPS`]
+/// steps is within it.
+pub const MAX_TRACKED_SAMPLES: usize = 10_000_000;
+
+/// The error of `points` tracked points over `steps` steps when their history
+/// ([`MAX_TRACKED_SAMPLES`]) would be too large; `how` says where the steps come
+/// from (`t_end / dt`, or the Courant number).
+pub fn check_tracked_history(points: usize, steps: usize, how: &str) -> Result<(), String> {
+    let samples = points.saturating_mul(steps);
+    if samples > MAX_TRACKED_SAMPLES {
+        return Err(format!(
+            "{points} tracked points over {steps} steps ({how}) record {samples} samples, above the limit of {MAX_TRACKED_SAMPLES} (points × steps, each kept in memory for tracked.csv): track fewer points, or take fewer steps (a shorter `t_end` or a longer step)"
+        ));
+    }
+    Ok(())
+}
+
 /// Most particle frames `run --out` writes.
 pub const MAX_FRAMES: usize = 100_000;
 /// Most rows `run --format table` collects (it aligns them at the end); more need

@@ -1,8 +1,9 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS, MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D,
-    MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS, MAX_TRIANGLES,
+    check_tracked_history, echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS,
+    MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D, MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS,
+    MAX_TRACKED, MAX_TRIANGLES,
 };
 use super::{
     bad, conflict, Axis, BodyShape, Component, EffectSpec, InitialVelocity, MaterialModel,
@@ -212,6 +213,32 @@ impl Scene {
         let gravity = self.gravity();
         for (i, effect) in self.effects.iter().enumerate() {
             let field = |f: &str| format!("effect[{i}].{f}");
+            // The physics sums two gravity (or damping) effects, but the references
+            // and the geostatic stress take the first gravity alone, and two dampings
+            // may add up to α ≥ 1, which pushes along the velocity: one of each.
+            let once = match effect {
+                EffectSpec::Gravity { .. } => Some((
+                    "gravity",
+                    "`g` (the references and the geostatic stress use the first gravity alone)",
+                )),
+                EffectSpec::Damping { .. } => Some((
+                    "damping",
+                    "`alpha`, below 1 (the damping of two is that of their sum, and from 1 on it pushes along the velocity)",
+                )),
+                _ => None,
+            };
+            if let Some((kind, what)) = once {
+                let same =
+                    |e: &EffectSpec| std::mem::discriminant(e) == std::mem::discriminant(effect);
+                if let Some(j) = self.effects[..i].iter().position(same) {
+                    return Err(conflict(
+                        field("kind"),
+                        format!(
+                            "`{kind}` is already declared by effect[{j}]; give one `{kind}` effect with the sum of their {what}"
+                        ),
+                    ));
+                }
+            }
             match effect {
                 EffectSpec::Gravity { g } => vector(&field("g"), g)?,
                 EffectSpec::Damping { alpha } => {
@@ -373,8 +400,23 @@ impl Scene {
             }
         }
         self.validate_resolutions()?;
+        let tracked = self.output.tracked.len();
+        if tracked > MAX_TRACKED {
+            return Err(bad(
+                "output.tracked",
+                format!(
+                    "lists {tracked} points, above the limit of {MAX_TRACKED}: each is recorded every step; track fewer points, or write the particle frames (`run --out DIR`, every particle at every `--out-every` steps)"
+                ),
+            ));
+        }
         for (i, t) in self.output.tracked.iter().enumerate() {
             vector(&format!("output.tracked[{i}]"), t)?;
+        }
+        if let (Some(dt), true) = (self.time.dt, tracked > 0) {
+            // (With `courant` the run checks it once it knows its step.)
+            let steps = (self.time.t_end / dt).round().max(1.0) as usize;
+            check_tracked_history(tracked, steps, "t_end / dt")
+                .map_err(|m| bad("output.tracked", m))?;
         }
         match self.reference {
             Some(Reference::VibratingBar { v0 }) => {
@@ -388,6 +430,22 @@ impl Scene {
                     "reference.kind",
                     "a column reference needs a gravity effect",
                 ));
+            }
+            Some(Reference::ColumnSelfWeight {}) => {
+                // The settling motion starts stress-free; a geostatic initial stress
+                // holds the column at rest instead.
+                if let Some(k) = self
+                    .effects
+                    .iter()
+                    .position(|e| matches!(e, EffectSpec::GeostaticStress { .. }))
+                {
+                    return Err(conflict(
+                        "reference.kind",
+                        format!(
+                            "`column-self-weight` is the column settling from a stress-free start, but effect[{k}] gives it a geostatic initial stress, which holds it at rest: use `column-equilibrium` (whose error is then measured against the geostatic profile), or leave out the geostatic stress"
+                        ),
+                    ));
+                }
             }
             Some(Reference::AxisAligned { u0 }) => {
                 finite("reference.u0", u0)?;

@@ -416,6 +416,12 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                 .into());
             }
             let steps = ratio.ceil().max(1.0) as usize;
+            crate::scene::limits::check_tracked_history(
+                scene.output.tracked.len(),
+                steps,
+                "t_end / (courant × the critical step)",
+            )
+            .map_err(|m| SceneError::new("output.tracked", ErrorKind::Value, m))?;
             let dt = t_end / steps as f64;
             driver.set_dt(dt);
             Ok((dt, steps, dt_critical))

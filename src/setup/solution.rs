@@ -1,7 +1,7 @@
 //! The scene's reference solution, resolved from its parameters, in the scene's
 //! dimension.
 
-use crate::scene::{Reference, Scene};
+use crate::scene::{EffectSpec, Reference, Scene};
 use crate::studies::exact;
 
 /// The scene's reference solution with its parameters resolved.
@@ -10,11 +10,16 @@ pub(crate) enum Solution {
     Bar(exact::VibratingBar),
     Column(exact::ColumnSelfWeight),
     AxisAligned(exact::AxisAligned),
+    /// The column at rest under its weight: a static state, with no time history.
     Equilibrium {
         height: f64,
         density: f64,
         gravity: f64,
         young: f64,
+        /// The column starts from a `geostatic-stress` initial state, so its
+        /// equilibrium is measured at the particles' reference heights (see
+        /// [`exact::column_equilibrium_stress_at_reference`]).
+        geostatic: bool,
     },
 }
 
@@ -49,8 +54,20 @@ impl Solution {
                 density: m.density,
                 gravity,
                 young: m.young,
+                geostatic: scene
+                    .effects
+                    .iter()
+                    .any(|e| matches!(e, EffectSpec::GeostaticStress { .. })),
             },
         })
+    }
+
+    /// Whether the solution is a motion in time, whose displacement and velocity
+    /// the tracked particles are compared with (`tracked.csv`'s exact columns). The
+    /// column's equilibrium is the state it settles to, not the motion on the way:
+    /// it has none.
+    pub(crate) fn has_history(&self) -> bool {
+        !matches!(self, Solution::Equilibrium { .. })
     }
 
     /// Exact displacement at reference position `x0` (relative to the body's

@@ -456,6 +456,26 @@ pub fn column_equilibrium_stress_linear(
     -young * a * depth_ref
 }
 
+/// Exact equilibrium stress `σ_yy` of the column under self-weight at the
+/// *reference* height `Y = y0` of the point above the fixed bottom: the weight of
+/// the column above it, `σ_yy = −ρ|g| (H − Y)`, whatever the law and the initial
+/// stress. In the 1D bar, and in the 2D column whose sides are held in `x`
+/// (`F_xx = 1`), the first Piola–Kirchhoff stress `P_yY = σ_yy F_xx = σ_yy`, and
+/// equilibrium in the reference configuration, `∂P_yY/∂Y = ρ|g|` with `P_yY = 0` at
+/// the free top `Y = H`, gives it. So it also holds for a column started from a
+/// geostatic initial stress `σ⁰` (which the law's stress adds to): with
+/// `σ⁰ = −ρ|g| (H − Y)` (surface at the top) the column is already there, `u = 0`.
+///
+/// Domain: `H, ρ > 0`, `0 ≤ y0 ≤ H`. The sign of `gravity_magnitude` is ignored.
+pub fn column_equilibrium_stress_at_reference(
+    y0: f64,
+    height: f64,
+    density: f64,
+    gravity_magnitude: f64,
+) -> f64 {
+    -density * gravity_magnitude.abs() * (height - y0)
+}
+
 /// Exact equilibrium height `y_eq(Y) = Y − (ρ|g|/E)(HY − Y²/2)` of the point at
 /// reference height `Y = y0` for the project's linear law `σ = E (F − 1)` (see
 /// [`column_equilibrium_stress_linear`]; the stress there is `−ρ|g| (H − Y)`).

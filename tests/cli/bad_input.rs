@@ -574,6 +574,20 @@ fn range_cases() -> Vec<Case> {
         case("tiny-t-end-in-short-form", COLUMN)
             .edit("t_end = 0.01", "t_end = @@1e-300")
             .expect("time.t_end: is shorter than one time step (t_end = 1e-300, courant = 0.5 gives dt = 1.1374681029968743e-3)"),
+        // Each tracked point is recorded every step: their count is bounded, and so
+        // is points × steps (10 000 points over 100 steps took 357 MB).
+        case("too-many-tracked-points", BAR)
+            .edit("tracked = [[2.0, 0.5]]", &format!("tracked = @@[{}]", vec!["[2.0, 0.5]"; 1001].join(", ")))
+            .expect("output.tracked: lists 1001 points, above the limit of 1000: each is recorded every step; track fewer points, or write the particle frames (`run --out DIR`, every particle at every `--out-every` steps)"),
+        case("tracked-history-too-long", BAR)
+            .edit("t_end = 0.01", "t_end = 10.001")
+            .edit("tracked = [[2.0, 0.5]]", &format!("tracked = @@[{}]", vec!["[2.0, 0.5]"; 1000].join(", ")))
+            .expect("output.tracked: 1000 tracked points over 10001 steps (t_end / dt) record 10001000 samples, above the limit of 10000000 (points × steps, each kept in memory for tracked.csv): track fewer points, or take fewer steps (a shorter `t_end` or a longer step)"),
+        // With `courant` the steps are known at the start of the run, which checks them.
+        case("tracked-history-too-long-with-courant", COLUMN)
+            .edit("t_end = 0.01", "t_end = 100.0")
+            .map(|t| format!("{t}\n[output]\ntracked = @@[{}]\n", vec!["[0.5, 2.0]"; 1000].join(", ")))
+            .expect("output.tracked: 1000 tracked points over 87915 steps (t_end / (courant × the critical step)) record 87915000 samples, above the limit of 10000000 (points × steps, each kept in memory for tracked.csv): track fewer points, or take fewer steps (a shorter `t_end` or a longer step)"),
         case("dim-3", BAR)
             .edit("dim = 2", "dim = @@3")
             .expect("dim: must be 1 or 2, got 3"),
@@ -769,6 +783,18 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n\n", "")
             .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
             .expect("reference.kind: a column reference needs a gravity effect"),
+        // The physics would sum them, but the references and the geostatic stress
+        // take the first gravity, and two dampings may add up to α ≥ 1.
+        case("two-gravity-effects", COLUMN)
+            .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = @@\"gravity\"\ng = [0.0, -1.0]\n\n[[effect]]\nkind = \"traction\"")
+            .expect("effect[2].kind: `gravity` is already declared by effect[0]; give one `gravity` effect with the sum of their `g` (the references and the geostatic stress use the first gravity alone)"),
+        case("two-damping-effects", COLUMN)
+            .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = @@\"damping\"\nalpha = 0.6\n\n[[effect]]\nkind = \"traction\"")
+            .expect("effect[2].kind: `damping` is already declared by effect[1]; give one `damping` effect with the sum of their `alpha`, below 1 (the damping of two is that of their sum, and from 1 on it pushes along the velocity)"),
+        case("column-self-weight-from-a-geostatic-state", COLUMN)
+            .edit("[[effect]]\nkind = \"traction\"", "[[effect]]\nkind = \"geostatic-stress\"\nsurface = 4.0\n\n[[effect]]\nkind = \"traction\"")
+            .edit("kind = \"column-self-weight\"", "kind = @@\"column-self-weight\"")
+            .expect("reference.kind: `column-self-weight` is the column settling from a stress-free start, but effect[2] gives it a geostatic initial stress, which holds it at rest: use `column-equilibrium` (whose error is then measured against the geostatic profile), or leave out the geostatic stress"),
         case("geostatic-stress-without-gravity", BAR)
             .edit("[time]", "[[effect]]\nkind = @@\"geostatic-stress\"\nsurface = 1.0\n\n[time]")
             .expect("effect[0].kind: geostatic stress needs a gravity effect"),

@@ -364,6 +364,79 @@ fn converge_explains_a_falling_order_with_two_probes() {
     );
 }
 
+/// A user's damped 1D column (`converge FILE --levels 4 --blocks 4x1 --t-end 1.0`):
+/// pl1d's error jumps at level 3 (3.3e-2 to 4.7e-1, order −3.83). Half the time step
+/// lowered it × 0.52, and the study said "the time step limits the error: a smaller
+/// `courant`", but a quarter of the step gives × 0.54 (and an eighth, a sixteenth
+/// × 0.49, × 0.45): the error does not fall with the step. The study now halves the
+/// step twice before it blames the step.
+const DAMPED_COLUMN: &str = r#"name = "my-column-1d"
+dim = 1
+basis = "bspline"
+[mesh]
+kind = "interval"
+x = [0.0, 1.0]
+elements = 16
+[material]
+young = 1e6
+density = 1000.0
+[[body]]
+min = [0.0]
+max = [1.0]
+per_block = [4]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [-10.0]
+[[effect]]
+kind = "damping"
+alpha = 0.6
+[time]
+courant = 0.5
+t_end = 2.0
+[reference]
+kind = "column-equilibrium"
+"#;
+
+#[test]
+fn converge_blames_the_time_step_only_if_the_error_falls_with_it() {
+    let dir = temp_dir("converge-step");
+    let scene = dir.join("col1d.toml");
+    std::fs::write(&scene, DAMPED_COLUMN).unwrap();
+    let json = stdout(&[
+        "converge",
+        scene.to_str().unwrap(),
+        "--levels",
+        "4",
+        "--blocks",
+        "4x1",
+        "--t-end",
+        "1.0",
+        "--format",
+        "json",
+    ]);
+    let study: Value = serde_json::from_str(&json).unwrap();
+    let diagnoses = study["diagnoses"].as_array().unwrap();
+    let d = diagnoses.iter().find(|d| d["basis"] == "pl1d").unwrap();
+    assert_eq!(d["level"], 3, "{d}");
+    let (half, quarter) = (
+        d["half_dt"].as_f64().unwrap(),
+        d["quarter_dt"].as_f64().unwrap(),
+    );
+    // One halving lowers the error, the next does not.
+    assert!(half < 0.6 && quarter / half > 0.9, "{d}");
+    let verdict = d["verdict"].as_str().unwrap();
+    assert!(
+        !verdict.contains("the time step limits the error")
+            && verdict.starts_with("the error does not fall consistently with the step")
+            && verdict.contains("a smaller one will not help"),
+        "{verdict}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A scene of the user's own, without an exact solution: a block settling on a fixed
 /// floor. Levels are measured against the finest one, and the output says so.
 #[test]
@@ -462,6 +535,7 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
             "plot",
             "--function",
             "39",
+            "--overwrite",
             "--out",
             function.to_str().unwrap(),
         ])
@@ -474,6 +548,47 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
             && stderr.contains("the basis has 39 functions (indices below 39)"),
         "{stderr}"
     );
+}
+
+/// `basis plot --out FILE` replaced an existing file without a word, where `run
+/// --out` refuses a folder of an earlier run: it now refuses an existing file unless
+/// `--overwrite` is given, and a directory always, before drawing anything.
+#[test]
+fn basis_plot_refuses_an_existing_file_without_overwrite() {
+    let dir = temp_dir("basis-overwrite");
+    let picture = dir.join("mine.svg");
+    std::fs::write(&picture, "a picture of my own").unwrap();
+    let plot = |extra: &[&str], out: &std::path::Path| {
+        cli()
+            .args(["basis", "plot", "--out"])
+            .arg(out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = plot(&[], &picture);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        format!(
+            "error: output file `{}` already exists; pass --overwrite to replace it, or choose another --out\n",
+            picture.display()
+        )
+    );
+    assert_eq!(
+        std::fs::read_to_string(&picture).unwrap(),
+        "a picture of my own"
+    );
+    let out = plot(&["--overwrite"], &picture);
+    assert!(out.status.success(), "{out:?}");
+    assert!(std::fs::read_to_string(&picture).unwrap().contains("<svg"));
+    let out = plot(&["--overwrite"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("is a directory; choose another --out"),
+        "{out:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `reproduce` chooses the UL-FEM cache directory from the environment (the library
@@ -651,6 +766,50 @@ fn throughput_prints_rates_memory_and_the_scaling_exponent() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("the throughput scene is 2D"));
+}
+
+/// `throughput --sizes 1e7` rounds to 140 × 1120 blocks of 64 particles, above the
+/// scenes' particle limit, and the error named `body[0]` of the internal scene after
+/// the size had been accepted: the size is now checked up front and named.
+#[test]
+fn throughput_checks_its_sizes_against_the_particle_limit_up_front() {
+    let error = |size: &str| {
+        let out = cli()
+            .args(["throughput", "--sizes", size, "--steps", "1"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{out:?}");
+        String::from_utf8(out.stderr).unwrap()
+    };
+    assert_eq!(
+        error("1e7"),
+        "error: --sizes: 10000000 particles rounds to 10035200 (140 × 1120 blocks of 8 × 8), above the limit of 10000000 particles; give at most 9892352\n"
+    );
+    assert_eq!(
+        error("2e7"),
+        "error: --sizes: 20000000 particles is above the limit of 10000000 particles; give at most 9892352\n"
+    );
+    assert_eq!(
+        error("50"),
+        "error: --sizes: 50 particles is outside 100..=9892352\n"
+    );
+}
+
+/// `compare --courant 1.5` said `time.courant: …` without the flag that set it;
+/// `run` names the flags (`FILE with --courant 1.5: time.courant: …`), and so does
+/// `compare` now.
+#[test]
+fn compare_names_the_flag_of_a_set_up_error() {
+    let out = cli()
+        .args(["compare", "column-small-1d", "--courant", "1.5"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("error: column-small-1d with --courant 1.5: time.courant: 1.5 puts the time step at or above the critical step"),
+        "{stderr}"
+    );
 }
 
 /// A student's settling column whose finer PL levels stop before the end time with

@@ -440,6 +440,65 @@ fn a_1d_run_writes_about_50_frames_and_no_mesh() {
     check_plot(&json["svg"][key(&energy)], ENERGY_LEGENDS, &[1; 5], 0);
 }
 
+/// The `column-equilibrium` reference is the settled state, with no time history:
+/// `tracked.csv` had `u_exact_x = 0`, `v_exact_x = 0` columns and `tracked.svg` a
+/// flat "exact" line at 0, while the settled displacement is not 0. Both now leave
+/// the exact values out, as for a scene without a reference.
+#[test]
+fn a_column_equilibrium_run_tracks_no_exact_history() {
+    let scenes = TempDir::created("column-equilibrium-scene");
+    let scene = scenes.join("col1d.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "my-column-1d"
+dim = 1
+basis = "bspline"
+[mesh]
+kind = "interval"
+x = [0.0, 1.0]
+elements = 16
+[material]
+young = 1e6
+density = 1000.0
+[[body]]
+min = [0.0]
+max = [1.0]
+per_block = [4]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [-10.0]
+[[effect]]
+kind = "damping"
+alpha = 0.6
+[time]
+courant = 0.5
+t_end = 0.05
+[reference]
+kind = "column-equilibrium"
+[output]
+tracked = [[1.0], [0.5]]
+"#,
+    )
+    .unwrap();
+    let dir = TempDir::new("column-equilibrium-tracked");
+    let out = cli()
+        .arg("run")
+        .arg(&scene)
+        .args(["--diag-every", "0", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let (header, rows) = read_csv(&dir.join("tracked.csv"));
+    assert_eq!(header, ["time", "particle", "u_x", "u_y", "v_x", "v_y"]);
+    assert!(!rows.is_empty());
+    let svg = std::fs::read_to_string(dir.join("tracked.svg")).unwrap();
+    assert!(svg.contains("(MPM)") && !svg.contains("(exact)"), "{svg}");
+}
+
 fn input_error(args: &[&str]) -> String {
     let out = cli().args(args).output().unwrap();
     assert_eq!(out.status.code(), Some(2), "{args:?}");
