@@ -222,23 +222,25 @@ impl BodyContact {
     }
 
     /// The momentum changes `Δp` (`add(k, i, Δp_k)`) that remove the approach
-    /// speed of each pair of bodies in `touching` on their shared function, from
-    /// the trial velocity coefficients `trial(k, i) = v̂ⁿ + Δt F / m`, the lumped
-    /// masses `mass`, the mass gradients `gradient` and the first moments `moment`
-    /// (module doc): the normal from body `a` to body `b` is `(g_b − g_a) / |g_b −
+    /// speed of each pair of bodies in `sums.touching` on their shared function,
+    /// from the trial velocity coefficients `trial(k, i) = v̂ⁿ + Δt F / m` and the
+    /// step's lumped masses, mass gradients and first moments (module doc): the normal from body `a` to body `b` is `(g_b − g_a) / |g_b −
     /// g_a|`, or the direction between their mass centres where the two differ by
     /// more than 60°.
-    #[allow(clippy::too_many_arguments)]
     fn changes(
         &self,
-        mass: &[f64],
-        gradient: &[[f64; 3]],
-        moment: &[[f64; 3]],
-        touching: &[(usize, usize, usize)],
+        sums: &Sums,
         dim: usize,
         trial: impl Fn(usize, usize) -> f64,
         mut add: impl FnMut(usize, usize, f64),
     ) {
+        let Sums {
+            mass,
+            gradient,
+            moment,
+            touching,
+            ..
+        } = sums;
         let n = mass.len() / self.bodies.max(1);
         for &(j, a, b) in touching {
             let (ia, ib) = (j + a * n, j + b * n);
@@ -262,16 +264,13 @@ impl BodyContact {
             let Some(centre) = unit(by_centre) else {
                 continue;
             };
-            let mut normal = match unit(by_gradient) {
+            let normal = match unit(by_gradient) {
                 Some(g) if (0..dim).map(|k| g[k] * centre[k]).sum::<f64>() > 0.5 => g,
                 _ => centre,
             };
-            let length = 1.0;
-            let mut approach = 0.0;
-            for (k, c) in normal.iter_mut().enumerate().take(dim) {
-                *c /= length;
-                approach += (trial(k, ia) - trial(k, ib)) * *c;
-            }
+            let approach: f64 = (0..dim)
+                .map(|k| (trial(k, ia) - trial(k, ib)) * normal[k])
+                .sum();
             if approach > 0.0 {
                 let impulse = ma * mb / (ma + mb) * approach;
                 for (k, c) in normal.iter().enumerate().take(dim) {
@@ -389,23 +388,13 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyContact {
     /// `ṽ = v̂ⁿ + Δt F / m` of the assembled total force `F`.
     fn adjust_forces(&self, total: &[Vec<T>], velocity: &[Vec<T>], forces: &mut [Vec<T>]) {
         let guard = self.sums.lock().unwrap_or_else(|e| e.into_inner());
-        let Sums {
-            mass,
-            gradient,
-            moment,
-            touching,
-            dt,
-            ..
-        } = &*guard;
-        let dt = *dt;
-        if touching.is_empty() || mass.len() != total[0].len() || dt.is_nan() || dt <= 0.0 {
+        let sums = &*guard;
+        let (mass, dt) = (&sums.mass, sums.dt);
+        if sums.touching.is_empty() || mass.len() != total[0].len() || dt.is_nan() || dt <= 0.0 {
             return;
         }
         self.changes(
-            mass,
-            gradient,
-            moment,
-            touching,
+            sums,
             D.min(3),
             |k, i| velocity[k][i].to_f64() + dt * total[k][i].to_f64() / mass[i],
             |k, i, impulse| forces[k][i] += T::of(impulse / dt),
@@ -476,16 +465,15 @@ mod tests {
         let touching = [(0, 0, 1)];
         let velocity = [[1.0, -2.0], [0.0, 3.0]];
         let run = |velocity: [[f64; 2]; 2], touching: &[(usize, usize, usize)]| {
+            let sums = Sums {
+                mass: mass.to_vec(),
+                gradient: gradient.to_vec(),
+                moment: moment.to_vec(),
+                touching: touching.to_vec(),
+                ..Sums::default()
+            };
             let mut change = [[0.0; 2]; 2];
-            contact.changes(
-                &mass,
-                &gradient,
-                &moment,
-                touching,
-                2,
-                |k, i| velocity[k][i],
-                |k, i, p| change[k][i] += p,
-            );
+            contact.changes(&sums, 2, |k, i| velocity[k][i], |k, i, p| change[k][i] += p);
             change
         };
         let change = run(velocity, &touching);

@@ -8,7 +8,7 @@ mod common;
 mod common_cli;
 
 use common::temp_dir;
-use common_cli::cli;
+use common_cli::{cli, DAMPED_COLUMN_1D};
 use serde_json::Value;
 
 fn stdout(args: &[&str]) -> String {
@@ -370,41 +370,11 @@ fn converge_explains_a_falling_order_with_two_probes() {
 /// `courant`", but a quarter of the step gives × 0.54 (and an eighth, a sixteenth
 /// × 0.49, × 0.45): the error does not fall with the step. The study now halves the
 /// step twice before it blames the step.
-const DAMPED_COLUMN: &str = r#"name = "my-column-1d"
-dim = 1
-basis = "bspline"
-[mesh]
-kind = "interval"
-x = [0.0, 1.0]
-elements = 16
-[material]
-young = 1e6
-density = 1000.0
-[[body]]
-min = [0.0]
-max = [1.0]
-per_block = [4]
-[[boundary]]
-tag = "left"
-fix = ["x"]
-[[effect]]
-kind = "gravity"
-g = [-10.0]
-[[effect]]
-kind = "damping"
-alpha = 0.6
-[time]
-courant = 0.5
-t_end = 2.0
-[reference]
-kind = "column-equilibrium"
-"#;
-
 #[test]
 fn converge_blames_the_time_step_only_if_the_error_falls_with_it() {
     let dir = temp_dir("converge-step");
     let scene = dir.join("col1d.toml");
-    std::fs::write(&scene, DAMPED_COLUMN).unwrap();
+    std::fs::write(&scene, DAMPED_COLUMN_1D).unwrap();
     let json = stdout(&[
         "converge",
         scene.to_str().unwrap(),

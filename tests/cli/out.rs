@@ -13,7 +13,7 @@ mod common_cli;
 
 use common::meshio::{array, read_back};
 use common::TempDir;
-use common_cli::{assert_success, cli, stability_scene};
+use common_cli::{assert_success, cli, stability_scene, DAMPED_COLUMN_1D};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -450,37 +450,10 @@ fn a_column_equilibrium_run_tracks_no_exact_history() {
     let scene = scenes.join("col1d.toml");
     std::fs::write(
         &scene,
-        r#"name = "my-column-1d"
-dim = 1
-basis = "bspline"
-[mesh]
-kind = "interval"
-x = [0.0, 1.0]
-elements = 16
-[material]
-young = 1e6
-density = 1000.0
-[[body]]
-min = [0.0]
-max = [1.0]
-per_block = [4]
-[[boundary]]
-tag = "left"
-fix = ["x"]
-[[effect]]
-kind = "gravity"
-g = [-10.0]
-[[effect]]
-kind = "damping"
-alpha = 0.6
-[time]
-courant = 0.5
-t_end = 0.05
-[reference]
-kind = "column-equilibrium"
-[output]
-tracked = [[1.0], [0.5]]
-"#,
+        format!(
+            "{}[output]\ntracked = [[1.0], [0.5]]\n",
+            DAMPED_COLUMN_1D.replace("t_end = 2.0", "t_end = 0.05")
+        ),
     )
     .unwrap();
     let dir = TempDir::new("column-equilibrium-tracked");

@@ -28,3 +28,35 @@ pub fn assert_success(out: &std::process::Output) {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A user's damped 1D column under its weight (B-spline, 16 elements, α = 0.6), with
+/// the `column-equilibrium` reference: `converge` and `--out` tests start from it.
+pub const DAMPED_COLUMN_1D: &str = r#"name = "my-column-1d"
+dim = 1
+basis = "bspline"
+[mesh]
+kind = "interval"
+x = [0.0, 1.0]
+elements = 16
+[material]
+young = 1e6
+density = 1000.0
+[[body]]
+min = [0.0]
+max = [1.0]
+per_block = [4]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [-10.0]
+[[effect]]
+kind = "damping"
+alpha = 0.6
+[time]
+courant = 0.5
+t_end = 2.0
+[reference]
+kind = "column-equilibrium"
+"#;
