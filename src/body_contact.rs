@@ -15,11 +15,17 @@
 //!   a function `i` that carries the lumped masses `m_a = Σ_{p ∈ a} phi_i(x_p) m_p`
 //!   of body `a` and `m_b` of body `b`, the bodies are in contact when their
 //!   surfaces touch: a particle of each within the sum of their radii (half their
-//!   spacings, `½ (V_p⁰)^(1/D)`) among the particles on the function. The normal `n`
-//!   from `a` to `b` is that of the mass gradients `g = Σ_p m_p grad phi_i(x_p)`,
-//!   `(g_b − g_a) / |g_b − g_a|`, unless it is more than 60° from the direction
-//!   between the two bodies' mass centres on the function (a body that nearly fills
-//!   the support has a gradient of noise), which is then taken. With the trial
+//!   spacings, `½ (V_p⁰)^(1/D)`) among the particles on the function. The normal
+//!   comes from the bodies' mass gradients `g = Σ_p m_p grad phi_i(x_p)`, which
+//!   point out of a body (`g = −∫ phi_i ∇ρ`), summed over the functions of the
+//!   vertex of `i` (those with its support: the three PS functions of a vertex,
+//!   whose own gradients lean towards their control-triangle corners by up to 15°
+//!   on a flat surface; PL and B-spline functions are alone). Of the two bodies'
+//!   outward normals, `G_a` and `−G_b`, the longer is taken (`n` from `a` to `b`):
+//!   a face against a corner gives the face's normal, not the corner's. Where that
+//!   is more than 60° from the direction between the two bodies' mass centres on
+//!   the vertex (a body that nearly fills the support has a gradient of noise), the
+//!   centres' direction is taken instead. With the trial
 //!   velocities `ṽ_a = v̂_a + Δt F_a / m_a` (and `ṽ_b`), the bodies approach where
 //!   `(ṽ_a − ṽ_b) · n > 0`, and there the pair of forces
 //!
@@ -29,12 +35,12 @@
 //!   momentum and leaves the tangential velocities alone (no friction). Bodies that
 //!   move apart are left free: nothing holds them together.
 //!
-//! Measured (`docs/scenes.md`, the `body-contact` effect): the mass centres alone as
-//! the normal, with a test of the surfaces along it, tilted the normal at a sliding
-//! block's ends into friction (a block sliding at 1 m/s over another slowed to
-//! 0.83 in 0.18 s and flew off it) and let bodies come to rest a quarter of an
-//! element apart; the mass gradients alone let a block dropped onto another pass
-//! through it (noisy normals on functions the lower block fills).
+//! Measured (`docs/scenes.md`, the `body-contact` effect): normals from the mass
+//! centres alone tilt at a sliding block's ends into friction. Until 2026-12-04
+//! the gradients were taken with the wrong sign (as pointing into the body), so
+//! every normal failed the 60° test and came from the centres: a block sliding at
+//! 1 m/s on a block under gravity stopped within 0.8 s. With the sign right it keeps
+//! 0.55 of its speed at 1 s, with the vertex sums and the longer normal 0.73.
 
 use crate::effect::{Effect, StepState};
 use crate::particles::Particles;
@@ -188,6 +194,9 @@ impl<T: Real, const D: usize, B: Basis<T, D>> Basis<T, D> for PerBody<B> {
 #[derive(Debug)]
 pub struct BodyContact {
     bodies: usize,
+    /// The vertex of each function of every copy: functions with the same
+    /// support share one ([`vertices`]).
+    vertex: Vec<u32>,
     /// What `add_forces` gathers for `adjust_forces`.
     sums: Mutex<Sums>,
 }
@@ -197,10 +206,14 @@ pub struct BodyContact {
 struct Sums {
     /// The lumped mass `m_i = Σ_p phi_i(x_p) m_p`.
     mass: Vec<f64>,
-    /// The mass gradient `Σ_p m_p grad phi_i(x_p)`: it points into the body.
+    /// The mass gradient `Σ_p m_p grad phi_i(x_p)`: it points out of the body.
     gradient: Vec<[f64; 3]>,
     /// The first moment `Σ_p phi_i(x_p) m_p x_p`.
     moment: Vec<[f64; 3]>,
+    /// The mass, mass gradient and first moment summed over each vertex's functions.
+    vertex_mass: Vec<f64>,
+    vertex_gradient: Vec<[f64; 3]>,
+    vertex_moment: Vec<[f64; 3]>,
     /// Other bodies hold mass on the function too.
     shared: Vec<bool>,
     /// The particles of the body on each shared function (scratch).
@@ -212,11 +225,28 @@ struct Sums {
     dt: f64,
 }
 
+/// The vertex of each function of `basis`, numbered from 0 in the order of the
+/// functions: functions with the same support share a vertex (the three PS
+/// functions of a mesh vertex; a PL or B-spline function is alone).
+pub fn vertices<T: Real, const D: usize>(basis: &dyn Basis<T, D>) -> Vec<u32> {
+    let mut numbers: std::collections::HashMap<Vec<usize>, u32> = Default::default();
+    (0..basis.num_functions())
+        .map(|i| {
+            let mut support = basis.function_support(i).to_vec();
+            support.sort_unstable();
+            let next = numbers.len() as u32;
+            *numbers.entry(support).or_insert(next)
+        })
+        .collect()
+}
+
 impl BodyContact {
-    /// Contact between the `bodies` bodies of a [`PerBody`] basis.
-    pub fn new(bodies: usize) -> Self {
+    /// Contact between the bodies of `basis`, a [`PerBody`] basis of `bodies`
+    /// copies.
+    pub fn new<T: Real, const D: usize>(bodies: usize, basis: &dyn Basis<T, D>) -> Self {
         BodyContact {
             bodies,
+            vertex: vertices(basis),
             sums: Mutex::new(Sums::default()),
         }
     }
@@ -224,9 +254,10 @@ impl BodyContact {
     /// The momentum changes `Δp` (`add(k, i, Δp_k)`) that remove the approach
     /// speed of each pair of bodies in `sums.touching` on their shared function,
     /// from the trial velocity coefficients `trial(k, i) = v̂ⁿ + Δt F / m` and the
-    /// step's lumped masses, mass gradients and first moments (module doc): the normal from body `a` to body `b` is `(g_b − g_a) / |g_b −
-    /// g_a|`, or the direction between their mass centres where the two differ by
-    /// more than 60°.
+    /// step's lumped masses and the vertices' mass gradients and mass centres
+    /// (module doc): the normal from body `a` to body `b` is the longer of the
+    /// outward normals `G_a` and `−G_b`, or the direction between the mass centres
+    /// where the two differ by more than 60°.
     fn changes(
         &self,
         sums: &Sums,
@@ -236,30 +267,37 @@ impl BodyContact {
     ) {
         let Sums {
             mass,
-            gradient,
-            moment,
+            vertex_mass,
+            vertex_gradient,
+            vertex_moment,
             touching,
             ..
         } = sums;
         let n = mass.len() / self.bodies.max(1);
+        let unit = |v: [f64; 3]| {
+            let length = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+            (length > 0.0).then(|| v.map(|c| c / length))
+        };
+        let length_squared = |v: &[f64; 3]| v.iter().map(|c| c * c).sum::<f64>();
         for &(j, a, b) in touching {
             let (ia, ib) = (j + a * n, j + b * n);
             let (ma, mb) = (mass[ia], mass[ib]);
             if ma <= 0.0 || mb <= 0.0 {
                 continue;
             }
-            // The mass gradients give the normal; the mass centres on the function
-            // its side (a gradient of a function the body nearly fills is noise):
-            // where the two disagree by more than 60°, the centres' direction.
-            let unit = |v: [f64; 3]| {
-                let length = v.iter().map(|c| c * c).sum::<f64>().sqrt();
-                (length > 0.0).then(|| v.map(|c| c / length))
-            };
+            // The longer outward normal of the two bodies' vertices; the mass
+            // centres give its side (a gradient of a vertex the body nearly fills is
+            // noise): where the two disagree by more than 60°, the centres'
+            // direction.
+            let (va, vb) = (self.vertex[ia] as usize, self.vertex[ib] as usize);
+            let (ga, gb) = (&vertex_gradient[va], &vertex_gradient[vb]);
             let mut by_gradient = [0.0; 3];
             let mut by_centre = [0.0; 3];
+            let a_longer = length_squared(ga) >= length_squared(gb);
             for k in 0..dim {
-                by_gradient[k] = gradient[ib][k] - gradient[ia][k];
-                by_centre[k] = moment[ib][k] / mb - moment[ia][k] / ma;
+                by_gradient[k] = if a_longer { ga[k] } else { -gb[k] };
+                by_centre[k] =
+                    vertex_moment[vb][k] / vertex_mass[vb] - vertex_moment[va][k] / vertex_mass[va];
             }
             let Some(centre) = unit(by_centre) else {
                 continue;
@@ -303,6 +341,9 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyContact {
             members,
             touching,
             dt,
+            vertex_mass,
+            vertex_gradient,
+            vertex_moment,
         } = &mut *guard;
         *dt = state.dt;
         touching.clear();
@@ -324,6 +365,26 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyContact {
                     gradient[i][k] += m * grad[k].to_f64();
                     moment[i][k] += w * particles.x[p][k].to_f64();
                 }
+            }
+        }
+        let vertices = self
+            .vertex
+            .iter()
+            .map(|&v| v as usize + 1)
+            .max()
+            .unwrap_or(0);
+        vertex_mass.clear();
+        vertex_mass.resize(vertices, 0.0);
+        vertex_gradient.clear();
+        vertex_gradient.resize(vertices, [0.0; 3]);
+        vertex_moment.clear();
+        vertex_moment.resize(vertices, [0.0; 3]);
+        for (i, &v) in self.vertex.iter().enumerate().take(n) {
+            let v = v as usize;
+            vertex_mass[v] += mass[i];
+            for k in 0..dim {
+                vertex_gradient[v][k] += gradient[i][k];
+                vertex_moment[v][k] += moment[i][k];
             }
         }
         shared.clear();
@@ -454,38 +515,114 @@ mod tests {
     }
 
     #[test]
+    fn a_mass_gradient_points_out_of_the_body() {
+        // Particles left of a function's point: the gradient points right, away
+        // from them (the sign the contact normal relies on).
+        let basis = square();
+        let centre = (0..basis.num_functions())
+            .find(|&i| basis.function_point(i) == Point::<f64, 2>::new(0.5, 0.5))
+            .unwrap();
+        let mut eval = BasisEval::for_basis(&basis);
+        let mut gradient = [0.0f64; 2];
+        for x in [0.3, 0.4, 0.45] {
+            for y in [0.4, 0.5, 0.6] {
+                let x = Point::<f64, 2>::new(x, y);
+                basis.eval(basis.locate(&x, None).unwrap(), &x, &mut eval);
+                for k in 0..eval.len() {
+                    if eval.index[k] == centre {
+                        gradient[0] += eval.grad_phi[k][0];
+                        gradient[1] += eval.grad_phi[k][1];
+                    }
+                }
+            }
+        }
+        assert!(gradient[0] > 2.0 * gradient[1].abs(), "{gradient:?}");
+    }
+
+    #[test]
+    fn the_three_ps_functions_of_a_vertex_share_it() {
+        use psmpm_basis::basis::powell_sabin::PowellSabin;
+        let ps = PowellSabin::new(
+            block_grid(0.0, 1.0, 0.0, 1.0, 2, 2).unwrap(),
+            psmpm_basis::refinement::SplitPoint::Incentre,
+        )
+        .unwrap();
+        let vertex = vertices::<f64, 2>(&ps);
+        assert_eq!(vertex.len(), ps.num_functions());
+        assert_eq!(
+            vertex.iter().max().map(|&v| 3 * (v as usize + 1)),
+            Some(ps.num_functions())
+        );
+        for i in 0..ps.num_functions() {
+            let same = (0..ps.num_functions())
+                .filter(|&j| vertex[j] == vertex[i])
+                .count();
+            assert_eq!(same, 3);
+        }
+        let linear = square();
+        let alone = (0..linear.num_functions() as u32).collect::<Vec<u32>>();
+        assert_eq!(vertices::<f64, 2>(&linear), alone);
+    }
+
+    #[test]
     fn approaching_bodies_lose_their_normal_approach_and_keep_their_momentum() {
-        let contact = BodyContact::new(2);
-        // One function: body 0 on the left (its mass grows to the left) moving
-        // right, body 1 on the right moving left and sliding up; their surfaces
-        // touch.
-        let mass = [2.0, 1.0];
-        let gradient = [[-1.0, 0.1, 0.0], [1.0, 0.1, 0.0]];
-        let moment = [[0.0; 3], [1.0, 0.0, 0.0]];
+        let contact = BodyContact::new::<f64, 2>(2, &PerBody::new::<f64, 2>(square(), 2));
+        // One function in the base, at the vertex shared by the two copies: body 0
+        // on the left moving right (its outward gradient points right), body 1
+        // on the right moving left and sliding up, with the longer gradient, along
+        // x; their surfaces touch.
+        let n = contact.vertex.len();
+        let mut mass = vec![0.0; n];
+        let mut gradient = vec![[0.0; 3]; n];
+        let mut moment = vec![[0.0; 3]; n];
+        let (i0, i1) = (0, n / 2);
+        mass[i0] = 2.0;
+        mass[i1] = 1.0;
+        gradient[i0] = [0.5, 0.3, 0.0];
+        gradient[i1] = [-1.0, 0.0, 0.0];
+        moment[i1] = [1.0, 0.5, 0.0];
         let touching = [(0, 0, 1)];
-        let velocity = [[1.0, -2.0], [0.0, 3.0]];
-        let run = |velocity: [[f64; 2]; 2], touching: &[(usize, usize, usize)]| {
-            let sums = Sums {
-                mass: mass.to_vec(),
-                gradient: gradient.to_vec(),
-                moment: moment.to_vec(),
+        let mut velocity = [vec![0.0; n], vec![0.0; n]];
+        velocity[0][i0] = 1.0;
+        velocity[0][i1] = -2.0;
+        velocity[1][i1] = 3.0;
+        let run = |velocity: &[Vec<f64>; 2], touching: &[(usize, usize, usize)]| {
+            let mut sums = Sums {
+                mass: mass.clone(),
+                gradient: gradient.clone(),
+                moment: moment.clone(),
                 touching: touching.to_vec(),
                 ..Sums::default()
             };
-            let mut change = [[0.0; 2]; 2];
+            let vertices = n;
+            sums.vertex_mass = mass.clone();
+            sums.vertex_gradient = gradient.clone();
+            sums.vertex_moment = moment.clone();
+            assert_eq!(contact.vertex, (0..vertices as u32).collect::<Vec<_>>());
+            let mut change = [vec![0.0; n], vec![0.0; n]];
             contact.changes(&sums, 2, |k, i| velocity[k][i], |k, i, p| change[k][i] += p);
             change
         };
-        let change = run(velocity, &touching);
+        let change = run(&velocity, &touching);
         let after = |k: usize, i: usize| velocity[k][i] + change[k][i] / mass[i];
         assert!(
-            (after(0, 0) - after(0, 1)).abs() < 1e-14,
+            (after(0, i0) - after(0, i1)).abs() < 1e-14,
             "normal speeds equal"
         );
-        assert!((change[0][0] + change[0][1]).abs() < 1e-14, "momentum kept");
-        assert_eq!(change[1], [0.0, 0.0], "no friction");
+        assert!(
+            (change[0][i0] + change[0][i1]).abs() < 1e-14,
+            "momentum kept"
+        );
+        assert_eq!(
+            [change[1][i0], change[1][i1]],
+            [0.0, 0.0],
+            "no friction: the longer normal, along x"
+        );
         // Bodies that part, or whose surfaces do not touch, are left alone.
-        assert_eq!(run([[-1.0, 2.0], [0.0, 0.0]], &touching), [[0.0; 2]; 2]);
-        assert_eq!(run(velocity, &[]), [[0.0; 2]; 2]);
+        let mut parting = velocity.clone();
+        parting[0][i0] = -1.0;
+        parting[0][i1] = 2.0;
+        assert!(run(&parting, &touching).iter().flatten().all(|&c| c == 0.0));
+        assert!(run(&velocity, &[]).iter().flatten().all(|&c| c == 0.0));
     }
 }

@@ -7,13 +7,16 @@ use crate::particles::Particles;
 use crate::scene::{EffectSpec, ErrorKind, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SVector;
+use psmpm_basis::basis::Basis;
 
 /// The effects `scene` declares, built for `particles` (traction selects its
-/// particles here). Only these are assembled in a run.
+/// particles here; contact between bodies numbers the vertices of `basis`). Only
+/// these are assembled in a run.
 pub fn build_effects<const D: usize>(
     scene: &Scene,
     particles: &Particles<f64, D>,
     contacts: &[WallGeometry],
+    basis: &dyn Basis<f64, D>,
 ) -> Result<Vec<Box<dyn Effect<f64, D>>>, RunError> {
     let solution = Solution::new(scene);
     let mut contacts = contacts.iter();
@@ -84,7 +87,7 @@ pub fn build_effects<const D: usize>(
                 effects.push(Box::new(wall));
             }
             EffectSpec::BodyContact {} => effects.push(Box::new(
-                crate::body_contact::BodyContact::new(scene.bodies.len()),
+                crate::body_contact::BodyContact::new(scene.bodies.len(), basis),
             )),
             // An initial state, not an effect: `particles::apply_initial_states`.
             EffectSpec::GeostaticStress { .. } => {}

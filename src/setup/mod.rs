@@ -130,7 +130,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
     let mut particles = particles::place::<D>(scene, &lattice);
     particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles);
-    let effects = build_effects(scene, &particles, &domain.contacts)?;
+    let effects = build_effects(scene, &particles, &domain.contacts, &domain.basis)?;
     // The lattice's positions and volumes are in `particles` now: free them before
     // the driver allocates (they would otherwise count in the run's peak memory).
     let body_sizes = std::mem::take(&mut lattice.body_sizes);
