@@ -466,6 +466,12 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyContact {
     fn does_work(&self) -> bool {
         true
     }
+    /// Frictionless contact only takes energy out: work it adds over the run is
+    /// energy the discretisation gained (PL's default mass spreads the forces
+    /// sized on lumped rows through nearly consistent ones).
+    fn dissipative(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

@@ -36,6 +36,11 @@ pub struct StepReport {
     /// Work done on the body by the non-conservative effects (body forces,
     /// traction, damping) since the start, `Σ_n Δt F^n · v̂^n`.
     pub work: f64,
+    /// The part of `work` done by the effects that can only take energy out
+    /// (frictionless contact between bodies, [`crate::effect::Effect::dissipative`]):
+    /// where it is positive the discretisation gained that energy, and the
+    /// verdict counts it as growth ([`StepReport::unearned_work`]).
+    pub dissipated: f64,
     /// Total mass.
     pub mass: f64,
     /// Total momentum, `dim` components ([`StepReport::momentum`]).
@@ -96,6 +101,12 @@ impl StepReport {
     /// effects: constant up to the time-integration error.
     pub fn total_energy(&self) -> f64 {
         self.kinetic + self.strain + self.potential - self.work
+    }
+
+    /// What the dissipative effects added over the run, `max(dissipated, 0)`: energy
+    /// gained, not work done.
+    pub fn unearned_work(&self) -> f64 {
+        self.dissipated.max(0.0)
     }
 
     /// `[time, kinetic, strain, potential, work, total]`: the energy history's row.
@@ -333,10 +344,13 @@ impl Verdict {
             self.potential.1.max(r.potential),
         );
         self.work = (self.work.0.min(r.work), self.work.1.max(r.work));
-        let change = r.total_energy() - self.e0;
+        let unearned = r.unearned_work();
+        let change = r.total_energy() + unearned - self.e0;
         self.drift = self.drift.max(change.abs());
         self.growth = self.growth.max(change);
-        self.growth_centred = self.growth_centred.max(r.total_centred - self.e0);
+        self.growth_centred = self
+            .growth_centred
+            .max(r.total_centred + unearned - self.e0);
         if self.growth_crossed.is_none()
             && self.growth_centred > 0.0
             && self.growth_centred >= STABLE_ENERGY_GROWTH * self.scale()

@@ -116,6 +116,14 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     fn does_work(&self) -> bool {
         false
     }
+    /// `true` for an effect whose forces can only take energy out (frictionless
+    /// contact between bodies): the driver also accumulates its work apart
+    /// ([`StepReport::dissipated`](crate::diagnostics::StepReport::dissipated)), and
+    /// what it adds over the run is energy the discretisation gained, which the
+    /// verdict counts as growth rather than as work done.
+    fn dissipative(&self) -> bool {
+        false
+    }
     /// The run's time step is `dt` (called when the driver is built and whenever
     /// its step changes), for effects whose forces depend on it.
     fn set_time_step(&mut self, _dt: f64) {}

@@ -908,6 +908,25 @@ pub fn energy_growth_hint(
     )
 }
 
+/// What the dissipative effects (contact between bodies) added to the energy over
+/// the run, `unearned` ([`StepReport::unearned_work`]), when it is at least 1 % of
+/// the energy scale `scale`, and the fix: with PL and a mass other than `lumped`
+/// the forces sized on lumped rows spread through nearly consistent rows (a user's
+/// PL1D bars gained 30 times their energy that way, `docs/scenes.md`).
+pub fn unearned_work_hint(scene: &Scene, unearned: f64, scale: f64) -> Option<String> {
+    (unearned > 0.0 && unearned >= 0.01 * scale).then(|| {
+        let fix = if body_contact_warning(scene).is_some() {
+            "use `mass = \"lumped\"` (`--mass lumped`) or a smooth basis (PS, or `bspline` in 1D)"
+        } else {
+            "lower the step"
+        };
+        format!(
+            "the contact between bodies added {unearned:.3e} to the energy over the run ({:.0} % of the energy scale), although its forces can only take energy out: it is counted as energy gained, not as work; {fix}",
+            100.0 * unearned / scale
+        )
+    })
+}
+
 /// What a condition estimate above [`STABLE_CONDITION`] says about the system the
 /// mass strategy `mass` (a [`Summary::mass`] name) solves, and what to do about it.
 /// On `docs/examples/drop-plate.toml` to t = 0.3: `lumped` 3.7e19, `partial`
@@ -958,6 +977,13 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 run.driver.functions_per_element(),
             )
         });
+    // Contact between bodies that added energy: name it before the step.
+    let energy_growth_hint = energy_growth_hint.map(|hint| {
+        match unearned_work_hint(scene, end.unearned_work(), tally.verdict.scale()) {
+            Some(contact) => format!("{contact}; otherwise: {hint}"),
+            None => hint,
+        }
+    });
     let driver = run.driver;
     let now = crate::material::max_rotation(&driver.particles.f);
     let max_rotation = tally.max_rotation.max(now);

@@ -31,14 +31,26 @@ where
     /// Power of the non-conservative forces with the velocity at the start of the
     /// step, `v̂ⁿ`; before the first step `v̂⁰` is the projection of the initial
     /// particle velocities with this step's mass matrix.
-    pub(super) fn power_at_start(&mut self) -> Result<f64, StepError> {
+    /// The second: that of the dissipative effects' forces alone.
+    pub(super) fn power_at_start(&mut self) -> Result<[f64; 2], StepError> {
         if self.work_force.is_empty() {
-            return Ok(0.0);
+            return Ok([0.0; 2]);
         }
         if !self.velocity_known {
             self.project_initial_velocity()?;
         }
-        Ok(phases::power(&self.work_force, &self.velocity))
+        Ok([
+            phases::power(&self.work_force, &self.velocity),
+            self.dissipative_power(),
+        ])
+    }
+
+    fn dissipative_power(&self) -> f64 {
+        if self.dissipative_force.is_empty() {
+            0.0
+        } else {
+            phases::power(&self.dissipative_force, &self.velocity)
+        }
     }
 
     /// `v̂⁰`: the projection of the initial particle velocities with this step's
@@ -62,12 +74,14 @@ where
     /// Work of the non-conservative effects over the step with the mean of the
     /// start and end velocities, the rule under which the kinetic energy of the
     /// symplectic Euler update changes: `W += Δt F · (v̂ⁿ + v̂ⁿ⁺¹) / 2`.
-    pub(super) fn book_work(&mut self, power_start: f64) {
+    /// The dissipative effects' part the same way, into `dissipated`.
+    pub(super) fn book_work(&mut self, power_start: [f64; 2]) {
         self.velocity_known = true;
         if !self.work_force.is_empty() {
-            self.work += 0.5
-                * (power_start + phases::power(&self.work_force, &self.velocity))
-                * self.dt.to_f64();
+            let dt = self.dt.to_f64();
+            self.work +=
+                0.5 * (power_start[0] + phases::power(&self.work_force, &self.velocity)) * dt;
+            self.dissipated += 0.5 * (power_start[1] + self.dissipative_power()) * dt;
         }
     }
 
@@ -86,6 +100,7 @@ where
             strain: e.strain,
             potential: e.potential,
             work: self.work,
+            dissipated: self.dissipated,
             mass: e.mass,
             momentum: e.momentum,
             dim: D,

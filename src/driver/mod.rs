@@ -176,6 +176,9 @@ where
     velocity_known: bool,
     /// Forces of the non-conservative effects (for their work); empty without any.
     work_force: Vec<Vec<T>>,
+    /// Forces of the dissipative effects ([`Effect::dissipative`]), a part of
+    /// `work_force`; empty without any.
+    dissipative_force: Vec<Vec<T>>,
     /// Scratch for [`Effect::adjust_forces`]; empty without effects.
     adjust: Vec<Vec<T>>,
     /// Per-particle forces of the effects that act per particle
@@ -204,6 +207,8 @@ where
     /// or the initial state's before the first step.
     previous_energy: Option<(f64, f64)>,
     work: f64,
+    /// The part of `work` done by the dissipative effects ([`Effect::dissipative`]).
+    dissipated: f64,
     inputs: StrategyInputs,
     last_report: MassReport,
     last_condition: Option<f64>,
@@ -362,6 +367,7 @@ where
             velocity: vec![vec![T::zero(); n]; D],
             velocity_known: false,
             work_force: scratch(effects.iter().any(|e| e.does_work())),
+            dissipative_force: scratch(effects.iter().any(|e| e.does_work() && e.dissipative())),
             adjust: scratch(!effects.is_empty()),
             energy_terms: vec![[0.0; 8]; phases::chunks(np)],
             centred_terms: vec![0.0; phases::chunks(np)],
@@ -376,6 +382,7 @@ where
                 Vec::new()
             },
             work: 0.0,
+            dissipated: 0.0,
             constraints: Constraints::new(general, n),
             inputs,
             last_condition: None,
@@ -622,9 +629,15 @@ where
         if tracks_work {
             phases::zero(&mut self.work_force);
         }
+        if !self.dissipative_force.is_empty() {
+            phases::zero(&mut self.dissipative_force);
+        }
         for effect in self.effects.iter().filter(|e| !e.acts_per_particle()) {
             if effect.does_work() {
                 effect.add_forces(&self.particles, &state, &mut self.work_force);
+                if effect.dissipative() {
+                    effect.add_forces(&self.particles, &state, &mut self.dissipative_force);
+                }
             } else {
                 effect.add_forces(&self.particles, &state, &mut self.rhs);
             }
@@ -640,6 +653,9 @@ where
         for effect in &self.effects {
             if effect.does_work() {
                 effect.adjust_forces(&self.rhs, &self.velocity, &mut self.work_force);
+                if effect.dissipative() {
+                    effect.adjust_forces(&self.rhs, &self.velocity, &mut self.dissipative_force);
+                }
             }
             effect.adjust_forces(&self.rhs, &self.velocity, &mut self.adjust);
         }
