@@ -186,6 +186,12 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
     for r in results {
         summaries.push(r?);
     }
+    // What `run` warns about, per variant (on standard error, before the table).
+    for s in &summaries {
+        for warning in &s.warnings {
+            eprintln!("warning ({} {}): {warning}", s.basis, s.mass);
+        }
+    }
     print_summaries(&summaries, args.format);
     let failed = summaries.iter().filter(|s| !s.stable).count();
     crate::error::study_verdict(args.strict, failed, summaries.len())

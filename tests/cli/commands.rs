@@ -8,7 +8,7 @@ mod common;
 mod common_cli;
 
 use common::temp_dir;
-use common_cli::{cli, DAMPED_COLUMN_1D};
+use common_cli::{assert_success, cli, DAMPED_COLUMN_1D};
 use serde_json::Value;
 
 fn stdout(args: &[&str]) -> String {
@@ -905,6 +905,41 @@ fn a_body_far_too_soft_for_its_weight_is_named_as_the_cause() {
     );
     assert!(
         stderr.contains("check the units of `young` (Pa)"),
+        "{stderr}"
+    );
+}
+
+/// `compare` printed none of the warnings `run` prints (a user's 1D bars with
+/// contact between bodies, PL1D with its default mass, which `run` warns about):
+/// each variant's warnings now go to standard error, named by the variant.
+#[test]
+fn compare_prints_each_variants_warnings() {
+    let dir = temp_dir("compare-warnings");
+    let scene = dir.join("bars.toml");
+    std::fs::write(
+        &scene,
+        "name = \"bars\"\ndim = 1\nbasis = \"bspline\"\n[mesh]\nkind = \"interval\"\nx = [0.0, 12.0]\nelements = 96\n[material]\nyoung = 1e4\ndensity = 1.0\n[[body]]\nmin = [1.0]\nmax = [2.0]\nper_block = [4]\ninitial_velocity = { kind = \"uniform\", value = [2.0] }\n[[body]]\nmin = [3.0]\nmax = [5.0]\nper_block = [4]\n[[effect]]\nkind = \"body-contact\"\n[time]\ncourant = 0.3\nt_end = 0.02\n",
+    )
+    .unwrap();
+    let out = cli()
+        .args([
+            "compare",
+            scene.to_str().unwrap(),
+            "--basis",
+            "bspline,pl1d",
+        ])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(
+        warnings[0].starts_with("warning (pl1d extended-hybrid): ")
+            && warnings[0].contains("`--mass lumped`"),
         "{stderr}"
     );
 }
