@@ -72,16 +72,16 @@ fn check_size(n: f64) -> Result<(), CliError> {
 #[derive(Debug, clap::Args)]
 pub struct ThroughputArgs {
     /// Particle counts, comma-separated (each rounded to the nearest block grid).
-    #[arg(long, value_delimiter = ',', default_values_t = [1e4, 1e5])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1e4, 1e5], allow_hyphen_values = true)]
     sizes: Vec<f64>,
     /// Variants BASIS:MASS, comma-separated (mass `default` is the default strategy).
     #[arg(long, value_delimiter = ',', default_values_t = ["pl:lumped".to_string(), "ps:lumped".to_string(), "ps:consistent".to_string(), "ps:default".to_string()])]
     variants: Vec<String>,
     /// Steps timed per variant and size.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, allow_hyphen_values = true, value_parser = crate::whole::<usize>("from 1 to 10000"))]
     steps: usize,
     /// Threads of the particle phases (default: all cores).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<usize>(crate::THREADS_RANGE))]
     threads: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
