@@ -87,6 +87,10 @@ pub struct Summary {
     /// The critical time step of the basis, mass strategy and material at the start
     /// ([`crate::driver::Driver::critical_time_step`]), when it could be estimated.
     pub dt_critical: Option<f64>,
+    /// The scene's Courant number `C` when it sets the step (`Δt = C Δt_crit`,
+    /// shortened to end at `t_end`; `dt / dt_critical` is the ratio the run used),
+    /// `None` when the scene gives `dt`.
+    pub courant: Option<f64>,
     /// Largest condition-number estimate (when requested).
     pub max_condition: Option<f64>,
     /// Total energy at the start.
@@ -991,6 +995,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             max_deactivated: tally.deactivated,
             max_extended: tally.extended,
             dt_critical: run.dt_critical,
+            courant: scene.time.courant,
             max_condition,
             energy_initial: tally.verdict.initial_energy(),
             // A failed step leaves the particles half updated: the energy is that

@@ -241,6 +241,9 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             .unwrap();
     assert_eq!(&written, summary);
     assert_eq!(written["steps"], 500);
+    // The step is given (`dt`): no Courant number; the critical step is there.
+    assert_eq!(written.get("courant"), Some(&Value::Null), "{written}");
+    assert!(written["dt_critical"].as_f64().unwrap() > 1e-3, "{written}");
     assert_eq!(written["stable"], true);
 
     // tracked.csv: per step and particle, with the reference.

@@ -749,3 +749,34 @@ fn an_ill_conditioned_mass_names_its_cause_and_fix() {
         String::from_utf8_lossy(&default.stderr)
     );
 }
+
+/// The summary (printed, and `summary.json` with `--out`) holds the Courant number
+/// the scene set the step with, beside the critical step it was taken of.
+#[test]
+fn the_summary_has_the_courant_number_and_the_critical_step() {
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--courant",
+            "0.4",
+            "--t-end",
+            "0.05",
+            "--diag-every",
+            "0",
+            "--format",
+            "json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary.get("courant"), Some(&Value::from(0.4)), "{summary}");
+    // The step is C times the critical step, shortened to end at t_end.
+    let ratio = summary["dt"].as_f64().unwrap() / summary["dt_critical"].as_f64().unwrap();
+    assert!(ratio <= 0.4 + 1e-12 && ratio > 0.35, "{ratio}");
+}
