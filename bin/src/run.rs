@@ -348,31 +348,43 @@ fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     args.overrides.apply(s)
 }
 
+/// A diagnostics row of `--format json`: the columns of `diagnostics.csv` as keys.
 fn row_json(r: &StepReport) -> serde_json::Value {
-    json!({
-        "step": r.step,
-        "time": r.time,
-        "kinetic": r.kinetic,
-        "strain": r.strain,
-        "potential": r.potential,
-        "work": r.work,
-        "total": r.total_energy(),
-        "total_centred": r.total_centred,
-        "mass": r.mass,
-        "momentum": r.momentum(),
-        "max_speed": r.max_speed,
-        "active": r.mass_report.active,
-        "lumped_rows": r.mass_report.lumped_rows,
-        "deactivated": r.mass_report.deactivated,
-        "extended": r.mass_report.extended,
-        "treated": r.mass_report.treated(),
-        "worst_coverage": r.mass_report.worst_coverage.map(|(f, c)| json!({
-            "function": f,
-            "coverage": c,
-            "position": r.worst_coverage_at.map(|x| x[..r.dim].to_vec()),
-        })),
-        "condition": r.condition,
-    })
+    let worst = r.mass_report.worst_coverage;
+    let at = |k: usize| r.worst_coverage_at.filter(|_| k < r.dim).map(|x| x[k]);
+    // The values of `out::diagnostics_record`, in the order of its columns: the
+    // keys are the CSV header's, numbers as numbers, `null` for an empty field.
+    let values = [
+        json!(r.step),
+        json!(r.time),
+        json!(r.kinetic),
+        json!(r.strain),
+        json!(r.potential),
+        json!(r.work),
+        json!(r.total_energy()),
+        json!(r.total_centred),
+        json!(r.mass),
+        json!(r.momentum()[0]),
+        // (0 in 1D, as in the CSV)
+        json!(r.momentum().get(1).copied().unwrap_or(0.0)),
+        json!(r.max_speed),
+        json!(r.mass_report.active),
+        json!(r.mass_report.lumped_rows),
+        json!(r.mass_report.deactivated),
+        json!(r.mass_report.extended),
+        json!(worst.map(|(_, c)| c)),
+        json!(worst.map(|(f, _)| f)),
+        json!(at(0)),
+        json!(at(1)),
+        json!(r.condition),
+    ];
+    serde_json::Value::Object(
+        out::DIAGNOSTICS_COLUMNS
+            .iter()
+            .map(|k| k.to_string())
+            .zip(values)
+            .collect(),
+    )
 }
 
 const COLUMNS: [&str; 12] = [
