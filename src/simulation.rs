@@ -76,7 +76,8 @@ pub struct Summary {
     /// Error against the reference solution (see `error_measure`), `None` without one.
     pub error: Option<f64>,
     /// What `error` measures: `E_u` (thesis eq. (4.4)), `rms-position` (paper
-    /// eq. (47)), `max-relative-sigma-yy` (paper eq. (48)).
+    /// eq. (47)), `max-relative-sigma-yy` (paper eq. (48); `max-relative-sigma-xx`
+    /// in 1D, whose one stress is σ_xx).
     pub error_measure: Option<&'static str>,
     /// Largest number of lumped rows in a step.
     pub max_lumped_rows: usize,
@@ -990,7 +991,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             dt: run.dt,
             t_end: driver.time(),
             error,
-            error_measure: scene.reference.map(|r| r.error_measure()),
+            error_measure: scene.reference.map(|r| r.error_measure(scene.dim)),
             max_lumped_rows: tally.lumped,
             max_deactivated: tally.deactivated,
             max_extended: tally.extended,
