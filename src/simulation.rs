@@ -23,6 +23,7 @@ use crate::body_contact::PerBody;
 use crate::diagnostics::Verdict;
 use crate::driver::{PhaseTimes, StepError, StepReport};
 use crate::particles::Particles;
+use crate::scene::limits::{echo_fixed, echo_number};
 use crate::scene::{Scene, SceneError};
 use crate::setup::{self, from_vec, Basis1d, Basis2d, Domain, Prepared, Solution};
 use crate::studies::exact;
@@ -397,8 +398,11 @@ pub fn self_weight_warning<const D: usize>(
     (strain > SELF_WEIGHT_STRAIN).then(|| {
         let e = material.elastic(p);
         format!(
-            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {g_norm}, H = {height:.4} along g, E = {}), far beyond small strains (and beyond what the `linear-elastic` and `corotational` laws model): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
-            e.density, e.young
+            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {}, H = {} along g, E = {}), far beyond small strains (and beyond what the `linear-elastic` and `corotational` laws model): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
+            echo_number(e.density),
+            echo_number(g_norm),
+            echo_fixed(height, 4),
+            echo_number(e.young)
         )
     })
 }
@@ -653,7 +657,7 @@ fn tracked_warnings<const D: usize>(
                     "output.tracked[{k}] at {} lies {distance:.3e} from the particle it tracks (particle {p} at {}, the nearest; {:.1} particle spacings away): put the point inside a body",
                     crate::driver::point(&point[..D]),
                     crate::driver::point(&t.x0[..D]),
-                    distance / spacing
+                    echo_fixed(distance / spacing, 1)
                 )
             })
         })

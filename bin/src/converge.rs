@@ -339,7 +339,8 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
     if let Some(e) = args.target_error {
         if !(e.is_finite() && e > 0.0) {
             return Err(CliError::Input(format!(
-                "--target-error must be a positive error, got {e}"
+                "--target-error must be a positive error, got {}",
+                psmpm::scene::limits::echo_number(e)
             )));
         }
     }

@@ -17,6 +17,7 @@ use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::mass::MassKind;
+use psmpm::scene::limits::echo_number;
 use psmpm::scene::{MeshSpec, Scene};
 use psmpm::simulation;
 use serde::Serialize;
@@ -49,19 +50,22 @@ fn check_size(n: f64) -> Result<(), CliError> {
     let most = particles_of((limit as f64 / (BLOCK_PARTICLES * ASPECT) as f64).sqrt() as usize);
     if !(n >= 100.0 && n.is_finite()) {
         return Err(CliError::Input(format!(
-            "--sizes: {n} particles is outside 100..={most}"
+            "--sizes: {} particles is outside 100..={most}",
+            echo_number(n)
         )));
     }
     if n > limit as f64 {
         return Err(CliError::Input(format!(
-            "--sizes: {n} particles is above the limit of {limit} particles; give at most {most}"
+            "--sizes: {} particles is above the limit of {limit} particles; give at most {most}",
+            echo_number(n)
         )));
     }
     let b = blocks_for(n);
     let particles = particles_of(b);
     if particles > limit {
         return Err(CliError::Input(format!(
-            "--sizes: {n} particles rounds to {particles} ({b} × {} blocks of {PER_BLOCK} × {PER_BLOCK}), above the limit of {limit} particles; give at most {most}",
+            "--sizes: {} particles rounds to {particles} ({b} × {} blocks of {PER_BLOCK} × {PER_BLOCK}), above the limit of {limit} particles; give at most {most}",
+            echo_number(n),
             ASPECT * b
         )));
     }
