@@ -907,7 +907,7 @@ fn inconsistent_cases() -> Vec<Case> {
             .at(8, 11).expect("mesh.outline: invalid mesh parameter: the boundary intersects itself: segment (0, 0)–(1, 1) of the outer polygon meets segment (1, 0)–(0, 1) of the outer polygon"),
         case("edge-length-below-the-mesher-limit", SQUARE)
             .edit("edge_length = 0.25", "edge_length = 1e-5")
-            .at(10, 15).expect("mesh.edge_length: edge length 0.00001 on an outline of extent 1 × 1 gives about 2.309e10 triangles, above the limit of 4000000"),
+            .at(10, 15).expect("mesh.edge_length: edge length 1e-5 on an outline of extent 1 × 1 gives about 2.309e10 triangles, above the limit of 4000000"),
         case("block-grid-beyond-the-generator-limit", BAR)
             .edit("blocks = [4, 1]", "blocks = [4096, 4096]")
             .edit("per_block = [4, 4]", "per_block = [1, 1]")
