@@ -326,7 +326,8 @@ pub fn collapse_reason(
         }
     };
     format!(
-        "the body collapsed: det F fell to {jacobian:.1e} at particle {particle} (at {position}, sampled at t = {time:.4}), below {COLLAPSED_JACOBIAN}: compressed to under 5 % of its volume, which no elastic law here models; {fix}"
+        "the body collapsed: det F fell to {jacobian:.1e} at particle {particle} (at {position}, sampled at t = {}), below {COLLAPSED_JACOBIAN}: compressed to under 5 % of its volume, which no elastic law here models; {fix}",
+        crate::scene::limits::echo_fixed(time, 4)
     )
 }
 

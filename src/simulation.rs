@@ -23,6 +23,7 @@ use crate::body_contact::PerBody;
 use crate::diagnostics::Verdict;
 use crate::driver::{PhaseTimes, StepError, StepReport};
 use crate::particles::Particles;
+use crate::scene::limits::{echo_fixed, echo_number};
 use crate::scene::{Scene, SceneError};
 use crate::setup::{self, from_vec, Basis1d, Basis2d, Domain, Prepared, Solution};
 use crate::studies::exact;
@@ -76,7 +77,8 @@ pub struct Summary {
     /// Error against the reference solution (see `error_measure`), `None` without one.
     pub error: Option<f64>,
     /// What `error` measures: `E_u` (thesis eq. (4.4)), `rms-position` (paper
-    /// eq. (47)), `max-relative-sigma-yy` (paper eq. (48)).
+    /// eq. (47)), `max-relative-sigma-yy` (paper eq. (48); `max-relative-sigma-xx`
+    /// in 1D, whose one stress is σ_xx).
     pub error_measure: Option<&'static str>,
     /// Largest number of lumped rows in a step.
     pub max_lumped_rows: usize,
@@ -87,6 +89,10 @@ pub struct Summary {
     /// The critical time step of the basis, mass strategy and material at the start
     /// ([`crate::driver::Driver::critical_time_step`]), when it could be estimated.
     pub dt_critical: Option<f64>,
+    /// The scene's Courant number `C` when it sets the step (`Δt = C Δt_crit`,
+    /// shortened to end at `t_end`; `dt / dt_critical` is the ratio the run used),
+    /// `None` when the scene gives `dt`.
+    pub courant: Option<f64>,
     /// Largest condition-number estimate (when requested).
     pub max_condition: Option<f64>,
     /// Total energy at the start.
@@ -392,8 +398,11 @@ pub fn self_weight_warning<const D: usize>(
     (strain > SELF_WEIGHT_STRAIN).then(|| {
         let e = material.elastic(p);
         format!(
-            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {g_norm}, H = {height:.4} along g, E = {}), far beyond small strains (and beyond what the `linear-elastic` and `corotational` laws model): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
-            e.density, e.young
+            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {}, H = {} along g, E = {}), far beyond small strains (and beyond what the `linear-elastic` and `corotational` laws model): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
+            echo_number(e.density),
+            echo_number(g_norm),
+            echo_fixed(height, 4),
+            echo_number(e.young)
         )
     })
 }
@@ -648,7 +657,7 @@ fn tracked_warnings<const D: usize>(
                     "output.tracked[{k}] at {} lies {distance:.3e} from the particle it tracks (particle {p} at {}, the nearest; {:.1} particle spacings away): put the point inside a body",
                     crate::driver::point(&point[..D]),
                     crate::driver::point(&t.x0[..D]),
-                    distance / spacing
+                    echo_fixed(distance / spacing, 1)
                 )
             })
         })
@@ -1012,11 +1021,12 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             dt: run.dt,
             t_end: driver.time(),
             error,
-            error_measure: scene.reference.map(|r| r.error_measure()),
+            error_measure: scene.reference.map(|r| r.error_measure(scene.dim)),
             max_lumped_rows: tally.lumped,
             max_deactivated: tally.deactivated,
             max_extended: tally.extended,
             dt_critical: run.dt_critical,
+            courant: scene.time.courant,
             max_condition,
             energy_initial: tally.verdict.initial_energy(),
             // A failed step leaves the particles half updated: the energy is that

@@ -124,3 +124,40 @@ fn every_strategy_conserves_mass() {
         assert!(masses.iter().all(|m| (m - m0).abs() <= 1e-12 * m0));
     }
 }
+
+/// The column's equilibrium reference in 1D measures `σ_xx` (the axis of 1D is x)
+/// and says so; in 2D it measures `σ_yy`.
+#[test]
+fn the_1d_column_equilibrium_error_is_named_for_sigma_xx() {
+    let mut s = Scene::builtin("column-small-1d").unwrap();
+    s.reference = Some(psmpm::scene::Reference::ColumnEquilibrium {});
+    s.time.t_end = 1e-3;
+    let summary = run(&s, &mut |_| {}).unwrap();
+    assert_eq!(summary.error_measure, Some("max-relative-sigma-xx"));
+    assert!(summary.error.is_some_and(f64::is_finite), "{summary:?}");
+    let damped = Scene::builtin("column-damped").unwrap();
+    assert_eq!(
+        damped.reference.map(|r| r.error_measure(damped.dim)),
+        Some("max-relative-sigma-yy")
+    );
+}
+
+/// In 1D a slip wall (`fix = ["normal"]`) holds the one component, x: the same
+/// run, bit for bit, as `fix = ["x"]` (docs/scenes.md, `[[boundary]]`).
+#[test]
+fn a_1d_slip_wall_is_the_same_as_fixing_x() {
+    let fixed = Scene::builtin("column-small-1d").unwrap();
+    let mut slip = fixed.clone();
+    slip.boundaries[0].fix = vec![psmpm::scene::Component::Normal];
+    let mut reports = [Vec::new(), Vec::new()];
+    for (s, reports) in [&fixed, &slip].into_iter().zip(&mut reports) {
+        let mut s = s.clone();
+        s.time.t_end = 0.05;
+        run(&s, &mut |r| {
+            reports.push((r.kinetic, r.strain, r.potential))
+        })
+        .unwrap();
+    }
+    assert!(reports[0].len() >= 500, "{}", reports[0].len());
+    assert_eq!(reports[0], reports[1]);
+}

@@ -399,3 +399,46 @@ t_end = 1e-5
         );
     }
 }
+
+/// A traction selects its particles once, at t = 0, and they keep their load after
+/// they leave the box (docs/scenes.md, "`[[effect]]` with `kind = \"traction\"`"): a
+/// free bar pulled at its end gains the momentum `traction × length × t` although
+/// the loaded particle left the box long before the end.
+#[test]
+fn a_traction_keeps_loading_the_particles_it_selected_at_the_start() {
+    let mut s = bar_1d(
+        vec![EffectSpec::Traction {
+            min: vec![0.97],
+            max: vec![1.0],
+            traction: vec![0.2],
+            length: 1.0,
+            ramp: 0.0,
+        }],
+        1.0,
+    );
+    // Free, in a mesh long enough for the bar to move along it.
+    s.mesh = MeshSpec::Interval {
+        x: [0.0, 2.0],
+        elements: 16,
+    };
+    s.boundaries.clear();
+    // Lumped: the elements the bar moves into have no particles yet.
+    s.mass = psmpm::mass::MassKind::parse("lumped").unwrap();
+    s.validate().unwrap();
+    let mut momentum = Vec::new();
+    let out = run_1d(&s, &mut |r| momentum.push((r.time, r.momentum()[0]))).unwrap();
+    assert!(out.summary.failure.is_none(), "{:?}", out.summary.failure);
+    // The loaded particle (the last, at x0 = 0.984) is far out of the box at the end.
+    let last = out.particles.len() - 1;
+    let x = out.particles.x0[last][0] + out.particles.u[last][0];
+    assert!(out.particles.x0[last][0] > 0.97 && x > 1.05, "x = {x}");
+    // The impulse of the load, F t with F = 0.2, at every step: had the load
+    // stopped when the particle left the box, the momentum would stop growing there.
+    for &(t, p) in &momentum {
+        assert!(
+            (p - 0.2 * t).abs() < 1e-6 * (0.2 * t).max(1e-3),
+            "momentum {p} at t = {t}"
+        );
+    }
+    assert!((momentum.last().unwrap().0 - 1.0).abs() < 1e-9);
+}

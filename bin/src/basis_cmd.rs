@@ -29,7 +29,7 @@ pub enum BasisCommand {
 #[derive(Debug, clap::Args)]
 pub struct PlotArgs {
     /// Block grid NXxNY of unit blocks, on [0, NX] × [0, NY] (4 triangles per block).
-    #[arg(long, value_name = "NXxNY", conflicts_with_all = ["scene", "mesh"])]
+    #[arg(long, value_name = "NXxNY", allow_hyphen_values = true, conflicts_with_all = ["scene", "mesh"])]
     blocks: Option<String>,
     /// Use the mesh of this scene (built-in name or FILE.toml).
     #[arg(long, conflicts_with = "mesh")]
@@ -38,7 +38,7 @@ pub struct PlotArgs {
     #[arg(long)]
     mesh: Option<PathBuf>,
     /// Draw basis function K instead of the mesh.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_hyphen_values = true, value_parser = crate::whole::<usize>("0 or more"))]
     function: Option<usize>,
     /// Basis of the function plot: ps or pl.
     #[arg(long, default_value = "ps")]

@@ -30,11 +30,11 @@ pub struct CompareArgs {
     #[arg(long, value_delimiter = ',')]
     mass: Vec<String>,
     /// Variants run at the same time (default: the number of cores).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::whole::<usize>("1 or more"))]
     jobs: Option<usize>,
     /// Threads of the particle phases, shared by the variants running at the same
     /// time (default: all cores). The results are the same for any number.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<usize>(crate::THREADS_RANGE))]
     threads: Option<usize>,
     #[command(flatten)]
     overrides: Overrides,

@@ -32,7 +32,7 @@ pub struct ConvergeArgs {
     #[arg(long)]
     mass: Option<String>,
     /// Number of levels (1 to 7).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_hyphen_values = true, value_parser = crate::whole::<u32>("from 1 to 7"))]
     levels: u32,
     #[command(flatten)]
     overrides: Overrides,
@@ -54,12 +54,12 @@ pub struct ConvergeArgs {
     /// falls to this value (log-log interpolation between the two levels around
     /// it) and how many times faster the fastest basis gets there (a
     /// work-precision comparison; `docs/performance.md`).
-    #[arg(long, value_name = "ERROR")]
+    #[arg(long, value_name = "ERROR", allow_hyphen_values = true)]
     target_error: Option<f64>,
     /// Threads of each run's particle phases (default: all cores; 1 for
     /// work-precision timings on a shared machine). The errors are the same for any
     /// number.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<usize>(crate::THREADS_RANGE))]
     threads: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -339,7 +339,8 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
     if let Some(e) = args.target_error {
         if !(e.is_finite() && e > 0.0) {
             return Err(CliError::Input(format!(
-                "--target-error must be a positive error, got {e}"
+                "--target-error must be a positive error, got {}",
+                psmpm::scene::limits::echo_number(e)
             )));
         }
     }

@@ -34,6 +34,29 @@ struct Cli {
     command: Command,
 }
 
+/// The value parser of a whole-number option. Numeric options take
+/// `allow_hyphen_values` (clap's `allow_negative_numbers` misses `-1e-3`), so that
+/// a leading minus is part of the value: `--threads -1` is then refused naming the
+/// option and its range (`invalid value '-1' for '--threads <N>': must be a whole
+/// number from 1 to 1024`), not taken for an option of its own with clap's tip to
+/// write `-- -1`. `range` says which values the option takes; the command checks
+/// the bounds of a value that parses.
+pub(crate) fn whole<T>(
+    range: &'static str,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
+where
+    T: std::str::FromStr + Clone + Send + Sync + 'static,
+{
+    move |text: &str| {
+        text.parse::<T>()
+            .map_err(|_| format!("must be a whole number {range}"))
+    }
+}
+
+/// The range of `--threads`, as [`whole`] names it ([`MAX_THREADS`] the limit).
+pub(crate) const THREADS_RANGE: &str = "from 1 to 1024";
+const _: () = assert!(psmpm::scene::limits::MAX_THREADS == 1024);
+
 /// Output format of a command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Format {

@@ -5,6 +5,9 @@ use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::studies::projection::{self, MassOption, StudyError, StudyRow, MAX_LEVELS};
+
+// `--levels` names its range as "from 1 to 6".
+const _: () = assert!(MAX_LEVELS == 6);
 use std::path::PathBuf;
 
 /// Arguments of `mpm-cli project`.
@@ -17,7 +20,7 @@ pub struct ProjectArgs {
     #[arg(long, default_value = "consistent,lumped")]
     mass: String,
     /// Number of refinement levels (1 to 6); the default reproduces the thesis' tables.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, allow_hyphen_values = true, value_parser = crate::whole::<usize>("from 1 to 6"))]
     levels: usize,
     /// Project on this Gmsh mesh (.msh, format 4.1 or 2.2 ASCII) instead of the unit square.
     #[arg(long, value_name = "FILE.msh")]

@@ -25,10 +25,10 @@ use std::sync::Arc;
 #[derive(Debug, Clone, clap::Args)]
 pub struct Overrides {
     /// Block grid NXxNY of a block mesh (1D: number of elements, e.g. 8x1).
-    #[arg(long, value_name = "NXxNY")]
+    #[arg(long, value_name = "NXxNY", allow_hyphen_values = true)]
     pub blocks: Option<String>,
     /// Particles per block PXxPY (1D: per element, e.g. 4x1).
-    #[arg(long, value_name = "PXxPY")]
+    #[arg(long, value_name = "PXxPY", allow_hyphen_values = true)]
     pub particles: Option<String>,
     /// PS split points: incentre or centroid (the thesis' tables).
     #[arg(long)]
@@ -38,14 +38,14 @@ pub struct Overrides {
     #[arg(long)]
     pub layout: Option<String>,
     /// Time step (replaces the scene's dt or Courant number).
-    #[arg(long, allow_negative_numbers = true, conflicts_with = "courant")]
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "courant")]
     pub dt: Option<f64>,
     /// Time step as a fraction C of the critical step estimated at the start,
     /// Δt = C Δt_crit (replaces the scene's dt or Courant number; below 1).
-    #[arg(long, value_name = "C", allow_negative_numbers = true)]
+    #[arg(long, value_name = "C", allow_hyphen_values = true)]
     pub courant: Option<f64>,
     /// End time.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
     /// Run with a time step above the critical step estimated at the start (an error
     /// otherwise): to see what an unstable step does.
@@ -200,7 +200,7 @@ pub struct RunArgs {
     overrides: Overrides,
     /// Print diagnostics every N steps (0: summary only; default: the scene's
     /// `output.diagnostics_every`, else about 20 rows).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::whole::<usize>("0 or more"))]
     diag_every: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -212,7 +212,13 @@ pub struct RunArgs {
     out: Option<PathBuf>,
     /// With --out: a particle frame every N steps (default: about 50 frames; 0: the
     /// first and last state only, which are always written).
-    #[arg(long, value_name = "N", requires = "out")]
+    #[arg(
+        long,
+        value_name = "N",
+        requires = "out",
+        allow_hyphen_values = true,
+        value_parser = crate::whole::<usize>("0 or more")
+    )]
     out_every: Option<usize>,
     /// With --out: replace the files of an earlier run in DIR (frames, particles.pvd,
     /// summary.json, the CSV and SVG files a run writes). Without it a DIR that is not
@@ -235,7 +241,7 @@ pub struct RunArgs {
     picture: String,
     /// Threads of the particle phases (default: all cores). The results are the
     /// same, bit for bit, for any number.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<usize>(crate::THREADS_RANGE))]
     threads: Option<usize>,
 }
 
@@ -342,31 +348,43 @@ fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     args.overrides.apply(s)
 }
 
+/// A diagnostics row of `--format json`: the columns of `diagnostics.csv` as keys.
 fn row_json(r: &StepReport) -> serde_json::Value {
-    json!({
-        "step": r.step,
-        "time": r.time,
-        "kinetic": r.kinetic,
-        "strain": r.strain,
-        "potential": r.potential,
-        "work": r.work,
-        "total": r.total_energy(),
-        "total_centred": r.total_centred,
-        "mass": r.mass,
-        "momentum": r.momentum(),
-        "max_speed": r.max_speed,
-        "active": r.mass_report.active,
-        "lumped_rows": r.mass_report.lumped_rows,
-        "deactivated": r.mass_report.deactivated,
-        "extended": r.mass_report.extended,
-        "treated": r.mass_report.treated(),
-        "worst_coverage": r.mass_report.worst_coverage.map(|(f, c)| json!({
-            "function": f,
-            "coverage": c,
-            "position": r.worst_coverage_at.map(|x| x[..r.dim].to_vec()),
-        })),
-        "condition": r.condition,
-    })
+    let worst = r.mass_report.worst_coverage;
+    let at = |k: usize| r.worst_coverage_at.filter(|_| k < r.dim).map(|x| x[k]);
+    // The values of `out::diagnostics_record`, in the order of its columns: the
+    // keys are the CSV header's, numbers as numbers, `null` for an empty field.
+    let values = [
+        json!(r.step),
+        json!(r.time),
+        json!(r.kinetic),
+        json!(r.strain),
+        json!(r.potential),
+        json!(r.work),
+        json!(r.total_energy()),
+        json!(r.total_centred),
+        json!(r.mass),
+        json!(r.momentum()[0]),
+        // (0 in 1D, as in the CSV)
+        json!(r.momentum().get(1).copied().unwrap_or(0.0)),
+        json!(r.max_speed),
+        json!(r.mass_report.active),
+        json!(r.mass_report.lumped_rows),
+        json!(r.mass_report.deactivated),
+        json!(r.mass_report.extended),
+        json!(worst.map(|(_, c)| c)),
+        json!(worst.map(|(f, _)| f)),
+        json!(at(0)),
+        json!(at(1)),
+        json!(r.condition),
+    ];
+    serde_json::Value::Object(
+        out::DIAGNOSTICS_COLUMNS
+            .iter()
+            .map(|k| k.to_string())
+            .zip(values)
+            .collect(),
+    )
 }
 
 const COLUMNS: [&str; 12] = [

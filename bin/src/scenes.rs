@@ -35,7 +35,7 @@ pub fn list(args: ScenesArgs) -> Result<(), CliError> {
         .map(|(name, line, _)| Scene::builtin(name).map(|s| (s, *line)))
         .collect::<Result<_, _>>()
         .map_err(CliError::Input)?;
-    let reference = |s: &Scene| s.reference.map_or("-", |r| r.error_measure());
+    let reference = |s: &Scene| s.reference.map_or("-", |r| r.error_measure(s.dim));
     match args.format {
         Format::Json => {
             let items: Vec<_> = rows
@@ -45,7 +45,7 @@ pub fn list(args: ScenesArgs) -> Result<(), CliError> {
                         "name": s.name,
                         "dim": s.dim,
                         "basis": s.basis.name(),
-                        "error": s.reference.map(|r| r.error_measure()),
+                        "error": s.reference.map(|r| r.error_measure(s.dim)),
                         "description": line,
                     })
                 })

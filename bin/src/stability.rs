@@ -81,14 +81,14 @@ pub struct StabilityArgs {
     #[arg(long, value_name = "DIR")]
     dir: Option<PathBuf>,
     /// Runs at the same time (default: the number of cores).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::whole::<usize>("1 or more"))]
     jobs: Option<usize>,
     /// Exit with status 1 when a case is unstable (default: 0, the table marks it).
     #[arg(long)]
     strict: bool,
     /// Threads of the particle phases, shared by the runs at the same time
     /// (default: all cores). The results are the same for any number.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<usize>(crate::THREADS_RANGE))]
     threads: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]

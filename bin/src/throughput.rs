@@ -17,6 +17,7 @@ use crate::table::{fixed2, sci, Table};
 use crate::Format;
 use psmpm::bases::BasisKind;
 use psmpm::mass::MassKind;
+use psmpm::scene::limits::echo_number;
 use psmpm::scene::{MeshSpec, Scene};
 use psmpm::simulation;
 use serde::Serialize;
@@ -49,19 +50,22 @@ fn check_size(n: f64) -> Result<(), CliError> {
     let most = particles_of((limit as f64 / (BLOCK_PARTICLES * ASPECT) as f64).sqrt() as usize);
     if !(n >= 100.0 && n.is_finite()) {
         return Err(CliError::Input(format!(
-            "--sizes: {n} particles is outside 100..={most}"
+            "--sizes: {} particles is outside 100..={most}",
+            echo_number(n)
         )));
     }
     if n > limit as f64 {
         return Err(CliError::Input(format!(
-            "--sizes: {n} particles is above the limit of {limit} particles; give at most {most}"
+            "--sizes: {} particles is above the limit of {limit} particles; give at most {most}",
+            echo_number(n)
         )));
     }
     let b = blocks_for(n);
     let particles = particles_of(b);
     if particles > limit {
         return Err(CliError::Input(format!(
-            "--sizes: {n} particles rounds to {particles} ({b} × {} blocks of {PER_BLOCK} × {PER_BLOCK}), above the limit of {limit} particles; give at most {most}",
+            "--sizes: {} particles rounds to {particles} ({b} × {} blocks of {PER_BLOCK} × {PER_BLOCK}), above the limit of {limit} particles; give at most {most}",
+            echo_number(n),
             ASPECT * b
         )));
     }
@@ -72,16 +76,16 @@ fn check_size(n: f64) -> Result<(), CliError> {
 #[derive(Debug, clap::Args)]
 pub struct ThroughputArgs {
     /// Particle counts, comma-separated (each rounded to the nearest block grid).
-    #[arg(long, value_delimiter = ',', default_values_t = [1e4, 1e5])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1e4, 1e5], allow_hyphen_values = true)]
     sizes: Vec<f64>,
     /// Variants BASIS:MASS, comma-separated (mass `default` is the default strategy).
     #[arg(long, value_delimiter = ',', default_values_t = ["pl:lumped".to_string(), "ps:lumped".to_string(), "ps:consistent".to_string(), "ps:default".to_string()])]
     variants: Vec<String>,
     /// Steps timed per variant and size.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, allow_hyphen_values = true, value_parser = crate::whole::<usize>("from 1 to 10000"))]
     steps: usize,
     /// Threads of the particle phases (default: all cores).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<usize>(crate::THREADS_RANGE))]
     threads: Option<usize>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]

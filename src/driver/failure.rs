@@ -426,7 +426,7 @@ pub(crate) fn point(x: &[f64]) -> String {
             }
             // Six significant digits, read back so that `{}` prints the shortest form.
             let rounded: f64 = format!("{c:.5e}").parse().unwrap_or(c);
-            format!("{rounded}")
+            crate::scene::limits::echo_number(rounded)
         })
         .collect();
     format!("[{}]", coordinates.join(", "))

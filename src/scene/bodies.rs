@@ -98,7 +98,8 @@ impl Scene {
                 return Err(bad(
                     field,
                     format!(
-                        "the particles of body[{b}] would have mass {mass:e} (density {density} times particle volume {volume:e}); it must be positive and finite"
+                        "the particles of body[{b}] would have mass {mass:e} (density {} times particle volume {volume:e}); it must be positive and finite",
+                        echo_number(density)
                     ),
                 ));
             }
@@ -243,7 +244,7 @@ impl Scene {
                     Some(r) => {
                         return Err(bad(
                             field("radius"),
-                            format!("must be positive and finite, got {r}"),
+                            format!("must be positive and finite, got {}", echo_number(r)),
                         ))
                     }
                     None => return Err(bad(field("radius"), "a `disk` body needs `radius`")),
@@ -295,7 +296,7 @@ impl Scene {
                 field("jitter"),
                 format!(
                     "must be in [0, 0.5) (a fraction of the lattice cell), got {}",
-                    body.jitter
+                    echo_number(body.jitter)
                 ),
             ));
         }

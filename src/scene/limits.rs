@@ -135,6 +135,17 @@ pub fn echo_number(x: f64) -> String {
     }
 }
 
+/// A number with `decimals` fixed decimals in a message (`{:.2}`), in exponent
+/// notation with as many decimals from 1e6 up, so that a huge value is not printed
+/// with hundreds of digits.
+pub fn echo_fixed(x: f64, decimals: usize) -> String {
+    if x.abs() < 1e6 || !x.is_finite() {
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.decimals$e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

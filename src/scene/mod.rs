@@ -670,11 +670,13 @@ pub enum Reference {
 }
 
 impl Reference {
-    /// Name of the error measure.
-    pub fn error_measure(&self) -> &'static str {
+    /// Name of the error measure in `dim` dimensions (the column's stress is
+    /// `σ_yy` in 2D and `σ_xx` in 1D, whose axis is x).
+    pub fn error_measure(&self, dim: usize) -> &'static str {
         match self {
             Reference::VibratingBar { .. } | Reference::ColumnSelfWeight {} => "E_u",
             Reference::AxisAligned { .. } => "rms-position",
+            Reference::ColumnEquilibrium {} if dim == 1 => "max-relative-sigma-xx",
             Reference::ColumnEquilibrium {} => "max-relative-sigma-yy",
         }
     }

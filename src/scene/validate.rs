@@ -90,7 +90,11 @@ impl Scene {
             } else {
                 Err(bad(
                     field,
-                    format!("needs min < max, got [{}, {}]", r[0], r[1]),
+                    format!(
+                        "needs min < max, got [{}, {}]",
+                        echo_number(r[0]),
+                        echo_number(r[1])
+                    ),
                 ))
             }
         };
@@ -245,7 +249,7 @@ impl Scene {
                     if !(0.0..1.0).contains(alpha) {
                         return Err(bad(
                             field("alpha"),
-                            format!("must be in [0, 1), got {alpha}"),
+                            format!("must be in [0, 1), got {}", echo_number(*alpha)),
                         ));
                     }
                 }
@@ -261,7 +265,10 @@ impl Scene {
                     vector(&field("traction"), traction)?;
                     positive(&field("length"), *length)?;
                     if !(*ramp >= 0.0 && ramp.is_finite()) {
-                        return Err(bad(field("ramp"), format!("must be ≥ 0, got {ramp}")));
+                        return Err(bad(
+                            field("ramp"),
+                            format!("must be ≥ 0, got {}", echo_number(*ramp)),
+                        ));
                     }
                 }
                 EffectSpec::BodyForce { value } => vector(&field("value"), value)?,
@@ -283,7 +290,7 @@ impl Scene {
                     if !(*stiffness > 0.0 && *stiffness <= 1.0) {
                         return Err(bad(
                             field("stiffness"),
-                            format!("must be in (0, 1], got {stiffness}"),
+                            format!("must be in (0, 1], got {}", echo_number(*stiffness)),
                         ));
                     }
                     if let Some(j) = self.effects[..i].iter().position(
@@ -489,10 +496,12 @@ impl Scene {
                 return Err(conflict(
                     "reference.v0",
                     format!(
-                        "is {v0}, but the bar starts in the sine mode with v0 = {w} \
+                        "is {}, but the bar starts in the sine mode with v0 = {} \
                          ([{field}]): the reference would be another motion; give both the \
                          same v0, or `kind = \"exact\"` in [{field}] to start from the \
-                         reference"
+                         reference",
+                        echo_number(v0),
+                        echo_number(*w)
                     ),
                 ));
             }
@@ -520,9 +529,12 @@ impl Scene {
                     "body[0].max",
                     format!(
                         "the `vibrating-bar` reference is a bar fixed at both ends, but body[0] \
-                         spans [{lo}, {hi}] along x and the mesh, whose ends carry the walls, \
+                         spans [{}, {}] along x and the mesh, whose ends carry the walls, \
                          [{}, {}]: make the body span the mesh, or leave out [reference]",
-                        mesh_x[0], mesh_x[1]
+                        echo_number(lo),
+                        echo_number(hi),
+                        echo_number(mesh_x[0]),
+                        echo_number(mesh_x[1])
                     ),
                 ));
             }
@@ -585,7 +597,7 @@ impl Scene {
                 if !(h > 0.0 && h.is_finite()) {
                     return Err(bad(
                         field("edge_length"),
-                        format!("must be positive and finite, got {h}"),
+                        format!("must be positive and finite, got {}", echo_number(h)),
                     ));
                 }
                 check_triangles(&field("edge_length"), outline, h)?;
@@ -664,9 +676,10 @@ fn check_triangles(field: &str, outline: &[[f64; 2]], h: f64) -> Result<(), Scen
         return Err(bad(
             field,
             format!(
-                "edge length {h} on an outline of extent {} × {} gives about {triangles:.3e} triangles, above the limit of {MAX_TRIANGLES}",
-                hi[0] - lo[0],
-                hi[1] - lo[1]
+                "edge length {} on an outline of extent {} × {} gives about {triangles:.3e} triangles, above the limit of {MAX_TRIANGLES}",
+                echo_number(h),
+                echo_number(hi[0] - lo[0]),
+                echo_number(hi[1] - lo[1])
             ),
         ));
     }

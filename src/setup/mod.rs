@@ -27,6 +27,7 @@ use crate::material::MaterialError;
 use crate::material::{AnyMaterial, Corotational, Elastic, LinearElastic, NeoHookean};
 use crate::materials::MaterialTable;
 use crate::particles::Particles;
+use crate::scene::limits::{echo_fixed, echo_number};
 use crate::scene::{ErrorKind, MaterialModel, MaterialSpec, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SVector;
@@ -117,7 +118,8 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
                 "time.courant",
                 ErrorKind::Value,
                 format!(
-                    "{c} puts the time step at or above the critical step, where the explicit update is unstable: give a value below 1 (0.5 serves smooth motion, 0.25 impacts and large strains), or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway"
+                    "{} puts the time step at or above the critical step, where the explicit update is unstable: give a value below 1 (0.5 serves smooth motion, 0.25 impacts and large strains), or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway",
+                    echo_number(c)
                 ),
             )
             .into());
@@ -144,7 +146,6 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     let dt = scene.dt(h);
     if !(dt.is_normal() && dt > 0.0) {
         // A fixed `dt` is validated; this is the Courant-number guess `C h / c`.
-        use crate::scene::limits::echo_number;
         return Err(SceneError::new(
             "time.courant",
             ErrorKind::Conflict,
@@ -253,7 +254,7 @@ fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> ([f64; D], [f64; 
 /// `(lo, hi)`: in a hole or notch when it lies inside the box, outside otherwise.
 fn outside_the_mesh<const D: usize>(position: &[f64], (lo, hi): ([f64; D], [f64; D])) -> String {
     let span = (0..D)
-        .map(|k| format!("[{}, {}]", lo[k], hi[k]))
+        .map(|k| format!("[{}, {}]", echo_number(lo[k]), echo_number(hi[k])))
         .collect::<Vec<_>>()
         .join(" × ");
     let inside_box = (0..D).all(|k| position.get(k).is_some_and(|&x| lo[k] <= x && x <= hi[k]));
@@ -449,7 +450,8 @@ fn above_critical(scene: &Scene, dt: f64, critical: f64, singular: Option<String
             "time.dt",
             ErrorKind::Conflict,
             format!(
-                "the time step {dt} is above the critical step {critical:.3e} estimated at the start for this mesh, basis (`{}`) and mass strategy (`{}`) (Courant number {:.3e}) because the mass matrix is nearly singular: {why}",
+                "the time step {} is above the critical step {critical:.3e} estimated at the start for this mesh, basis (`{}`) and mass strategy (`{}`) (Courant number {:.3e}) because the mass matrix is nearly singular: {why}",
+                echo_number(dt),
                 scene.basis.name(),
                 scene.mass.spec(),
                 dt / critical
@@ -460,10 +462,11 @@ fn above_critical(scene: &Scene, dt: f64, critical: f64, singular: Option<String
         "time.dt",
         ErrorKind::Conflict,
         format!(
-            "the time step {dt} is above the critical step {critical:.3e} estimated at the start for this mesh, basis (`{}`) and mass strategy (`{}`): its Courant number is {:.2}; lower `time.dt` below {critical:.3e}, or give `courant = 0.5` instead of `dt`, or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway",
+            "the time step {} is above the critical step {critical:.3e} estimated at the start for this mesh, basis (`{}`) and mass strategy (`{}`): its Courant number is {}; lower `time.dt` below {critical:.3e}, or give `courant = 0.5` instead of `dt`, or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway",
+            echo_number(dt),
             scene.basis.name(),
             scene.mass.spec(),
-            dt / critical
+            echo_fixed(dt / critical, 2)
         ),
     )
 }

@@ -6,7 +6,7 @@ use super::regions::{self, Region};
 use super::{to_vec, Solution};
 use crate::effect::{Geostatic, InitialStress};
 use crate::particles::Particles;
-use crate::scene::limits::MAX_PARTICLES;
+use crate::scene::limits::{echo_number, MAX_PARTICLES};
 use crate::scene::{BodyShape, EffectSpec, ErrorKind, InitialVelocity, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SMatrix;
@@ -82,9 +82,9 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
                         format!("body[{b}].max"),
                         ErrorKind::Conflict,
                         if body.per_block.is_some() {
-                            format!("the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h} (the mesh's block size along that axis over `per_block`): make the extent a multiple of it, choose `blocks` (or `--blocks`) so that it is, or give `count` instead of `per_block`")
+                            format!("the body's extent {} along axis {k} is not a whole number of lattice cells of size {} (the mesh's block size along that axis over `per_block`): make the extent a multiple of it, choose `blocks` (or `--blocks`) so that it is, or give `count` instead of `per_block`", echo_number(extent), echo_number(h))
                         } else {
-                            format!("the body's extent {extent} along axis {k} is not a whole number of lattice cells of size {h} (`spacing`): make the extent a multiple of it, or give `count` instead")
+                            format!("the body's extent {} along axis {k} is not a whole number of lattice cells of size {} (`spacing`): make the extent a multiple of it, or give `count` instead", echo_number(extent), echo_number(h))
                         },
                     )
                     .into());

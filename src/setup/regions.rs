@@ -130,8 +130,8 @@ pub(crate) fn fill_lattice(
             ErrorKind::Conflict,
             format!(
                 "no lattice cell of size {} × {} has its centre inside the body's {}: the lattice is too coarse for it",
-                h[0],
-                h[1],
+                crate::scene::limits::echo_number(h[0]),
+                crate::scene::limits::echo_number(h[1]),
                 body.shape.name()
             ),
         ));

@@ -907,7 +907,7 @@ fn inconsistent_cases() -> Vec<Case> {
             .at(8, 11).expect("mesh.outline: invalid mesh parameter: the boundary intersects itself: segment (0, 0)–(1, 1) of the outer polygon meets segment (1, 0)–(0, 1) of the outer polygon"),
         case("edge-length-below-the-mesher-limit", SQUARE)
             .edit("edge_length = 0.25", "edge_length = 1e-5")
-            .at(10, 15).expect("mesh.edge_length: edge length 0.00001 on an outline of extent 1 × 1 gives about 2.309e10 triangles, above the limit of 4000000"),
+            .at(10, 15).expect("mesh.edge_length: edge length 1e-5 on an outline of extent 1 × 1 gives about 2.309e10 triangles, above the limit of 4000000"),
         case("block-grid-beyond-the-generator-limit", BAR)
             .edit("blocks = [4, 1]", "blocks = [4096, 4096]")
             .edit("per_block = [4, 4]", "per_block = [1, 1]")
@@ -1156,6 +1156,31 @@ fn mesh_cases() -> Vec<Case> {
 }
 
 /// Writes the bases and the meshes into `dir`.
+/// Numbers far from 1 (`1e300`, `1e-300`) are echoed in their shortest form, in
+/// exponent notation, not as hundreds of digits.
+fn extreme_number_cases() -> Vec<Case> {
+    vec![
+        case("huge-mesh-extent-against-the-bar", BAR)
+            .edit("x = [0.0, 4.0]", "x = [0.0, 1e300]")
+            .at(24, 7).expect("body[0].max: the `vibrating-bar` reference is a bar fixed at both ends, but body[0] spans [0, 4] along x and the mesh, whose ends carry the walls, [0, 1e300]: make the body span the mesh, or leave out [reference]"),
+        case("huge-mesh-extent-reversed", BAR)
+            .edit("y = [0.0, 1.0]", "y = [1e300, 1.0]")
+            .at(12, 5).expect("mesh.y: needs min < max, got [1e300, 1]"),
+        case("huge-polygon-extent", SQUARE)
+            .edit("outline = [[0.0, 0.0], [1.0, 0.0]", "outline = [[0.0, 0.0], [1e300, 0.0]")
+            .at(10, 15).expect("mesh.edge_length: edge length 0.25 on an outline of extent 1e300 × 1 gives about 3.695e301 triangles, above the limit of 4000000"),
+        case("tiny-edge-length", SQUARE)
+            .edit("edge_length = 0.25", "edge_length = 1e-300")
+            .at(10, 15).expect("mesh.edge_length: edge length 1e-300 on an outline of extent 1 × 1 gives about inf triangles, above the limit of 4000000"),
+        case("huge-body-outside-the-mesh", SQUARE)
+            .edit("max = [1.0, 1.0]", "max = [1e300, 1.0]")
+            .at(20, 7).expect("body[0].max: the particle at [3.125e298, 0.03125] lies outside the mesh, which spans [0, 1] × [0, 1]; the body must lie inside the meshed domain"),
+        case("huge-time-step", BAR)
+            .edit("dt = 1e-3\nt_end = 0.01", "dt = 1e300\nt_end = 1e301")
+            .at(39, 6).expect("time.dt: the time step 1e300 is above the critical step 1.196e-2 estimated at the start for this mesh, basis (`ps`) and mass strategy (`consistent`): its Courant number is 8.36e301; lower `time.dt` below 1.196e-2, or give `courant = 0.5` instead of `dt`, or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway"),
+    ]
+}
+
 fn setup(dir: &Path) {
     let meshes = dir.join("meshes");
     std::fs::create_dir_all(&meshes).unwrap();
@@ -1204,6 +1229,7 @@ fn malformed_scenes_name_file_line_column_and_field() {
         inconsistent_cases(),
         missing_cases(),
         mesh_cases(),
+        extreme_number_cases(),
     ]
     .into_iter()
     .flatten()

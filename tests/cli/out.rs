@@ -195,21 +195,23 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
         "docs/scenes.md, `What run --out DIR writes`"
     );
     assert_eq!(csv.len(), steps);
+    // The rows of --format json have the CSV header's keys, no more and no fewer.
+    let mut columns: Vec<&str> = header.iter().map(String::as_str).collect();
+    columns.sort_unstable();
+    for json in rows {
+        let mut keys: Vec<&str> = json
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        keys.sort_unstable();
+        assert_eq!(keys, columns, "the keys of a --format json row");
+    }
     for (row, json) in csv.iter().zip(rows) {
         assert_eq!(row.len(), header.len());
-        let expected = |name: &str| -> Value {
-            match name {
-                "momentum_x" => json["momentum"][0].clone(),
-                "momentum_y" => json["momentum"][1].clone(),
-                "worst_coverage" => json["worst_coverage"]["coverage"].clone(),
-                "worst_function" => json["worst_coverage"]["function"].clone(),
-                "worst_x" => json["worst_coverage"]["position"][0].clone(),
-                "worst_y" => json["worst_coverage"]["position"][1].clone(),
-                other => json[other].clone(),
-            }
-        };
         for (name, field) in header.iter().zip(row) {
-            let want = expected(name);
+            let want = json[name.as_str()].clone();
             if want.is_null() {
                 // Not measured (the condition without --condition, coverage with a
                 // strategy that does not measure it): an empty field.
@@ -241,6 +243,9 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             .unwrap();
     assert_eq!(&written, summary);
     assert_eq!(written["steps"], 500);
+    // The step is given (`dt`): no Courant number; the critical step is there.
+    assert_eq!(written.get("courant"), Some(&Value::Null), "{written}");
+    assert!(written["dt_critical"].as_f64().unwrap() > 1e-3, "{written}");
     assert_eq!(written["stable"], true);
 
     // tracked.csv: per step and particle, with the reference.

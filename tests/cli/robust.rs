@@ -285,7 +285,7 @@ fn scene_cases() -> Vec<Case> {
         scene_case(
             "polygon-edge-length",
             square(&[("edge_length = 0.25", "edge_length = 1e-6")]),
-            "mesh.edge_length: edge length 0.000001",
+            "mesh.edge_length: edge length 1e-6",
         ),
         scene_case(
             "polygon-edge-length-tiny",

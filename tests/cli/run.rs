@@ -157,6 +157,131 @@ fn bad_input_is_a_one_line_error_with_status_2() {
     assert!(input_error(&["run", "vibrating-bar", "--t-end", "0"]).contains("t_end"));
 }
 
+/// A negative value of a numeric option is taken as its value (not as an option of
+/// its own, with clap's tip to write `-- -1`) and refused naming the option and the
+/// values it takes: every numeric option of every command.
+#[test]
+fn negative_option_values_are_refused_by_name_with_their_range() {
+    let out_dir = std::env::temp_dir().join(format!("psmpm-negative-{}", std::process::id()));
+    let out_dir = out_dir.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["run", "vibrating-bar", "--dt", "-1"],
+            "time.dt: must be positive",
+        ),
+        (
+            &["run", "vibrating-bar", "--courant", "-0.5"],
+            "time.courant: must be positive",
+        ),
+        (
+            &["run", "vibrating-bar", "--t-end", "-1"],
+            "time.t_end: must be positive",
+        ),
+        (
+            &["run", "vibrating-bar", "--diag-every", "-1"],
+            "'--diag-every <DIAG_EVERY>': must be a whole number 0 or more",
+        ),
+        (
+            &[
+                "run",
+                "vibrating-bar",
+                "--out",
+                out_dir,
+                "--out-every",
+                "-1",
+            ],
+            "'--out-every <N>': must be a whole number 0 or more",
+        ),
+        (
+            &["run", "vibrating-bar", "--threads", "-1"],
+            "'--threads <N>': must be a whole number from 1 to 1024",
+        ),
+        (
+            &["run", "vibrating-bar", "--blocks", "-1x4"],
+            "--blocks must look like 4x1, got `-1x4`",
+        ),
+        (
+            &["run", "vibrating-bar", "--particles", "-2x2"],
+            "--particles must look like 4x1, got `-2x2`",
+        ),
+        (
+            &["compare", "vibrating-bar", "--jobs", "-1"],
+            "'--jobs <JOBS>': must be a whole number 1 or more",
+        ),
+        (
+            &["compare", "vibrating-bar", "--threads", "-2"],
+            "'--threads <N>': must be a whole number from 1 to 1024",
+        ),
+        (
+            &["compare", "vibrating-bar", "--dt", "-1e-3"],
+            "time.dt: must be positive",
+        ),
+        (
+            &["converge", "vibrating-bar", "--levels", "-1"],
+            "'--levels <LEVELS>': must be a whole number from 1 to 7",
+        ),
+        (
+            &["converge", "vibrating-bar", "--target-error", "-1e-6"],
+            "--target-error must be a positive error, got -1e-6",
+        ),
+        (
+            &["converge", "vibrating-bar", "--threads", "-1"],
+            "'--threads <N>': must be a whole number from 1 to 1024",
+        ),
+        (
+            &["converge", "vibrating-bar", "--courant", "-0.5"],
+            "time.courant: must be positive",
+        ),
+        (
+            &["project", "--levels", "-1"],
+            "'--levels <LEVELS>': must be a whole number from 1 to 6",
+        ),
+        (
+            &["basis", "plot", "--function", "-1"],
+            "'--function <K>': must be a whole number 0 or more",
+        ),
+        (&["basis", "plot", "--blocks", "-2x2"], "--blocks"),
+        (
+            &["stability", "--jobs", "-1"],
+            "'--jobs <JOBS>': must be a whole number 1 or more",
+        ),
+        (
+            &["stability", "--threads", "-1"],
+            "'--threads <N>': must be a whole number from 1 to 1024",
+        ),
+        (
+            &["throughput", "--sizes", "-1e4"],
+            "--sizes: -10000 particles is outside 100..=",
+        ),
+        (
+            &["throughput", "--sizes", "1e4,-1"],
+            "--sizes: -1 particles is outside 100..=",
+        ),
+        (
+            &["throughput", "--steps", "-1"],
+            "'--steps <STEPS>': must be a whole number from 1 to 10000",
+        ),
+        (
+            &["throughput", "--threads", "-1"],
+            "'--threads <N>': must be a whole number from 1 to 1024",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = cli().args(*args).output().unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(expected),
+            "{args:?}: expected `{expected}` in\n{stderr}"
+        );
+        assert!(
+            !stderr.contains("tip:") && !stderr.contains("unexpected argument"),
+            "{args:?}: {stderr}"
+        );
+    }
+    assert!(!std::path::Path::new(out_dir).exists());
+}
+
 #[test]
 fn a_particle_leaving_the_mesh_is_a_numerical_failure_with_status_1() {
     // A huge time step (allowed although above the critical one) throws the bar's
@@ -623,4 +748,35 @@ fn an_ill_conditioned_mass_names_its_cause_and_fix() {
         "{}",
         String::from_utf8_lossy(&default.stderr)
     );
+}
+
+/// The summary (printed, and `summary.json` with `--out`) holds the Courant number
+/// the scene set the step with, beside the critical step it was taken of.
+#[test]
+fn the_summary_has_the_courant_number_and_the_critical_step() {
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar",
+            "--courant",
+            "0.4",
+            "--t-end",
+            "0.05",
+            "--diag-every",
+            "0",
+            "--format",
+            "json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary.get("courant"), Some(&Value::from(0.4)), "{summary}");
+    // The step is C times the critical step, shortened to end at t_end.
+    let ratio = summary["dt"].as_f64().unwrap() / summary["dt_critical"].as_f64().unwrap();
+    assert!(ratio <= 0.4 + 1e-12 && ratio > 0.35, "{ratio}");
 }

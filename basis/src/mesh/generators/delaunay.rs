@@ -25,8 +25,8 @@ pub fn delaunay(points: &[Vec2]) -> Result<TriMesh, MeshError> {
         .position(|p| !(p.x.is_finite() && p.y.is_finite()))
     {
         return Err(MeshError::InvalidParameter(format!(
-            "point {i} = ({}, {}) is not finite",
-            points[i].x, points[i].y
+            "point {i} = {} is not finite",
+            super::polygon::point(points[i])
         )));
     }
     let mut order: Vec<usize> = (0..points.len()).collect();

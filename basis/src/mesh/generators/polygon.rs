@@ -188,7 +188,7 @@ impl PolygonDomain {
             {
                 return invalid(
                     part_of(l),
-                    format!("{name} has a non-finite corner ({}, {})", p.x, p.y),
+                    format!("{name} has a non-finite corner {}", point(*p)),
                 );
             }
         }
@@ -214,7 +214,7 @@ impl PolygonDomain {
                 if (b - a).norm() <= tol {
                     return invalid(
                         part_of(l),
-                        format!("a segment of {name} has zero length at ({}, {})", a.x, a.y),
+                        format!("a segment of {name} has zero length at {}", point(a)),
                     );
                 }
             }
@@ -272,10 +272,18 @@ impl PolygonDomain {
         });
         if let Some((m, u)) = first {
             let ((a, b), (c, d)) = (all[m], all[u]);
-            return invalid(part_of(ids[u].0), format!(
-                "the boundary intersects itself: segment ({}, {})–({}, {}) of {} meets segment ({}, {})–({}, {}) of {}",
-                a.x, a.y, b.x, b.y, loops[ids[m].0].1, c.x, c.y, d.x, d.y, loops[ids[u].0].1
-            ));
+            return invalid(
+                part_of(ids[u].0),
+                format!(
+                    "the boundary intersects itself: segment {}–{} of {} meets segment {}–{} of {}",
+                    point(a),
+                    point(b),
+                    loops[ids[m].0].1,
+                    point(c),
+                    point(d),
+                    loops[ids[u].0].1
+                ),
+            );
         }
         // No two segments meet, so a loop lies inside another exactly when its first
         // corner does: the parity of the crossings of a ray from it, per loop.
@@ -407,6 +415,21 @@ pub fn polygon_mesh(domain: &PolygonDomain, target_edge_length: f64) -> Result<T
     });
     mesh.require_tagged_boundary()?;
     Ok(mesh)
+}
+
+/// A point in a message, `(x, y)`, each coordinate in its shortest form and in
+/// exponent notation outside `1e-4 ≤ |x| < 1e16` (`1e300`, not 301 digits).
+pub(crate) fn point(p: Vec2) -> String {
+    format!("({}, {})", number(p.x), number(p.y))
+}
+
+/// A number in a message: see [`point`].
+pub(crate) fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 #[cfg(test)]
