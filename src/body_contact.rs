@@ -197,6 +197,8 @@ pub struct BodyContact {
     /// The vertex of each function of every copy: functions with the same
     /// support share one ([`vertices`]).
     vertex: Vec<u32>,
+    /// How many vertices `vertex` numbers.
+    vertices: usize,
     /// What `add_forces` gathers for `adjust_forces`.
     sums: Mutex<Sums>,
 }
@@ -244,9 +246,11 @@ impl BodyContact {
     /// Contact between the bodies of `basis`, a [`PerBody`] basis of `bodies`
     /// copies.
     pub fn new<T: Real, const D: usize>(bodies: usize, basis: &dyn Basis<T, D>) -> Self {
+        let vertex = vertices(basis);
         BodyContact {
             bodies,
-            vertex: vertices(basis),
+            vertices: vertex.iter().map(|&v| v as usize + 1).max().unwrap_or(0),
+            vertex,
             sums: Mutex::new(Sums::default()),
         }
     }
@@ -367,26 +371,6 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyContact {
                 }
             }
         }
-        let vertices = self
-            .vertex
-            .iter()
-            .map(|&v| v as usize + 1)
-            .max()
-            .unwrap_or(0);
-        vertex_mass.clear();
-        vertex_mass.resize(vertices, 0.0);
-        vertex_gradient.clear();
-        vertex_gradient.resize(vertices, [0.0; 3]);
-        vertex_moment.clear();
-        vertex_moment.resize(vertices, [0.0; 3]);
-        for (i, &v) in self.vertex.iter().enumerate().take(n) {
-            let v = v as usize;
-            vertex_mass[v] += mass[i];
-            for k in 0..dim {
-                vertex_gradient[v][k] += gradient[i][k];
-                vertex_moment[v][k] += moment[i][k];
-            }
-        }
         shared.clear();
         shared.resize(n, false);
         let mut any = false;
@@ -403,6 +387,22 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyContact {
         }
         if !any {
             return;
+        }
+        // The vertices' sums, read only where bodies share functions.
+        let vertices = self.vertices;
+        vertex_mass.clear();
+        vertex_mass.resize(vertices, 0.0);
+        vertex_gradient.clear();
+        vertex_gradient.resize(vertices, [0.0; 3]);
+        vertex_moment.clear();
+        vertex_moment.resize(vertices, [0.0; 3]);
+        for (i, &v) in self.vertex.iter().enumerate().take(n) {
+            let v = v as usize;
+            vertex_mass[v] += mass[i];
+            for k in 0..dim {
+                vertex_gradient[v][k] += gradient[i][k];
+                vertex_moment[v][k] += moment[i][k];
+            }
         }
         members.resize_with(n, Vec::new);
         members.iter_mut().for_each(Vec::clear);
