@@ -491,8 +491,12 @@ pub struct Fragments {
 }
 
 /// The [`Fragments`] of `particles`: the neighbour relation walked once, marking
-/// the particles with a neighbour and joining the pieces (union–find).
-pub fn fragments<const D: usize>(particles: &Particles<f64, D>) -> Fragments {
+/// the particles with a neighbour and joining the pieces (union–find). The pieces
+/// are those of each body: `body_sizes` are the numbers of particles of the bodies,
+/// whose particles follow each other in that order (empty: one body), and
+/// neighbours of different bodies are not joined, so bodies that start in contact
+/// and part stay one piece each, while a body torn in two is two.
+pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[usize]) -> Fragments {
     fn root(parent: &mut [usize], mut a: usize) -> usize {
         while parent[a] != a {
             parent[a] = parent[parent[a]];
@@ -501,10 +505,21 @@ pub fn fragments<const D: usize>(particles: &Particles<f64, D>) -> Fragments {
         a
     }
     let n = particles.len();
+    let mut body = vec![0u32; n];
+    if body_sizes.iter().sum::<usize>() == n {
+        let mut first = 0;
+        for (b, &size) in body_sizes.iter().enumerate() {
+            body[first..first + size].fill(b as u32);
+            first += size;
+        }
+    }
     let mut near = vec![false; n];
     let mut parent: Vec<usize> = (0..n).collect();
     let measured = neighbours(particles, |p, q| {
         near[p] = true;
+        if body[p] != body[q] {
+            return;
+        }
         let (a, b) = (root(&mut parent, p), root(&mut parent, q));
         if a != b {
             parent[a.max(b)] = a.min(b);
@@ -531,12 +546,12 @@ pub fn fragments<const D: usize>(particles: &Particles<f64, D>) -> Fragments {
 
 /// [`Fragments::stray`] of `particles`.
 pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
-    fragments(particles).stray
+    fragments(particles, &[]).stray
 }
 
-/// [`Fragments::pieces`] of `particles`.
+/// [`Fragments::pieces`] of `particles`, taken as one body.
 pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
-    fragments(particles).pieces
+    fragments(particles, &[]).pieces
 }
 
 /// The warning for a run whose particles form more [`pieces`] at the end (`end`,
@@ -553,7 +568,7 @@ pub fn pieces_warning(start: usize, end: &[usize], particles: usize) -> Option<S
             .collect();
         let more = if end.len() > 4 { ", …" } else { "" };
         format!(
-            "the particles form {} pieces at the end ({start} at the start), holding {}{more} of them: a body came apart (torn where it was stretched, or broken at an impact; bodies that started in contact and separated count too), which the energy verdict does not show: look at the particles (`--out`); a body torn where it stretches needs more particles per element there (`per_block`, `count` or `spacing`), one broken at an impact also a smaller `courant`",
+            "the particles form {} pieces at the end ({start} at the start), holding {}{more} of them: a body came apart (torn where it was stretched, or broken at an impact), which the energy verdict does not show: look at the particles (`--out`); a body torn where it stretches needs more particles per element there (`per_block`, `count` or `spacing`), one broken at an impact also a smaller `courant`",
             end.len(),
             shares.join(", ")
         )
@@ -691,7 +706,7 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
-    let at_start = fragments(&driver.particles);
+    let at_start = fragments(&driver.particles, &run.body_sizes);
     let (stray_at_start, pieces_at_start) = (at_start.stray, at_start.pieces.len());
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
     let mut max_rotation_non_objective = driver
@@ -1004,7 +1019,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .max_rotation_of_non_objective(&driver.particles.f, now),
         ),
     );
-    let at_end = fragments(&driver.particles);
+    let at_end = fragments(&driver.particles, &run.body_sizes);
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
@@ -1187,6 +1202,16 @@ mod tests {
         assert_eq!(pieces(&lattice(1.0, 0.5, 0)), vec![70, 30]);
         assert_eq!(pieces(&lattice(1.0, 0.0, 2)), vec![98]);
         assert!(pieces_warning(1, &[100], 100).is_none());
+        // The rows from 7 on as a body of their own (30 particles after the 70 of
+        // the first): two pieces touching at the start, and still two once they
+        // part, since pieces are counted per body; a body torn is one more.
+        let two_bodies = |gap: f64| fragments(&lattice(1.0, gap, 0), &[70, 30]).pieces;
+        assert_eq!(two_bodies(0.0), vec![70, 30]);
+        assert_eq!(two_bodies(0.5), vec![70, 30]);
+        let mut torn = lattice(1.0, 0.0, 0);
+        (0..20).for_each(|p| torn.x[p].y -= 0.5);
+        assert_eq!(fragments(&torn, &[70, 30]).pieces, vec![50, 30, 20]);
+        assert_eq!(fragments(&torn, &[]).pieces, vec![80, 20]);
         let warning = pieces_warning(1, &[70, 30], 100).unwrap();
         assert!(
             warning.contains("2 pieces at the end (1 at the start), holding 70 %, 30 %"),

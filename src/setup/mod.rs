@@ -103,6 +103,9 @@ pub(crate) struct Prepared<const D: usize, B: Basis<f64, D>> {
     /// The lower corner of the first body's bounding box (the origin of the
     /// reference solutions).
     pub origin: [f64; 2],
+    /// The number of particles of each body, in the order of the scene's bodies:
+    /// the particles of body `b` follow those of the bodies before it.
+    pub body_sizes: Vec<usize>,
 }
 
 /// Sets up the run of `scene` on `domain`: material, particles with their initial
@@ -203,6 +206,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         functions,
         solution,
         origin,
+        body_sizes,
     })
 }
 
