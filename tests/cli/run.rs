@@ -157,6 +157,20 @@ fn bad_input_is_a_one_line_error_with_status_2() {
     assert!(input_error(&["run", "vibrating-bar", "--t-end", "0"]).contains("t_end"));
 }
 
+/// `--mass deactivate:1e400` said the threshold was not positive; `1e400` reads as
+/// infinity, and the message now says so, naming `--mass` and the range.
+#[test]
+fn a_mass_parameter_that_overflows_is_named_not_finite() {
+    assert_eq!(
+        input_error(&["run", "vibrating-bar", "--mass", "deactivate:1e400"]),
+        "error: --mass: `deactivate:1e400`: the threshold `1e400` is not finite (it reads as infinity: beyond ±1.8e308); give a positive finite number\n"
+    );
+    assert_eq!(
+        input_error(&["run", "vibrating-bar", "--mass", "extended-hybrid:0.01:1e400"]),
+        "error: --mass: `extended-hybrid:0.01:1e400`: the coverage `1e400` is not finite (it reads as infinity: beyond ±1.8e308); give a number in (0, 1)\n"
+    );
+}
+
 /// A negative value of a numeric option is taken as its value (not as an option of
 /// its own, with clap's tip to write `-- -1`) and refused naming the option and the
 /// values it takes: every numeric option of every command.
