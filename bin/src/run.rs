@@ -336,11 +336,31 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
     }
 }
 
+/// The basis `--basis NAME` gives a scene of dimension `dim`; the error names the
+/// option, the scene's dimension and the bases that fit it.
+pub fn basis_option(name: &str, dim: usize) -> Result<BasisKind, CliError> {
+    let basis = BasisKind::parse(name).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+    if basis.dim() != dim {
+        let fit: Vec<&str> = BasisKind::ALL
+            .into_iter()
+            .filter(|k| k.dim() == dim)
+            .map(BasisKind::name)
+            .collect();
+        return Err(CliError::Input(format!(
+            "--basis {0}: `{0}` is a {1}D basis but the scene is {dim}D; give a {dim}D basis: {2}",
+            basis.name(),
+            basis.dim(),
+            fit.join(" or ")
+        )));
+    }
+    Ok(basis)
+}
+
 /// The scene of `run` with the command line's choices applied, validated.
 fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     let mut s = read_scene(&args.scene)?;
     if let Some(b) = &args.basis {
-        s.basis = BasisKind::parse(b).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+        s.basis = basis_option(b, s.dim)?;
     }
     if let Some(m) = &args.mass {
         s.mass = MassKind::parse(m).map_err(|m| CliError::Input(format!("--mass: {m}")))?;

@@ -171,6 +171,25 @@ fn a_mass_parameter_that_overflows_is_named_not_finite() {
     );
 }
 
+/// `--basis pl1d` on a 2D scene said `basis: …` without the option that chose it;
+/// the error now names `--basis`, the scene's dimension and the bases that fit, both
+/// ways, on `run` and on `compare`.
+#[test]
+fn a_basis_of_the_wrong_dimension_names_the_option() {
+    assert_eq!(
+        input_error(&["run", "vibrating-bar", "--basis", "pl1d"]),
+        "error: --basis pl1d: `pl1d` is a 1D basis but the scene is 2D; give a 2D basis: ps or pl\n"
+    );
+    assert_eq!(
+        input_error(&["run", "vibrating-bar-1d", "--basis", "ps"]),
+        "error: --basis ps: `ps` is a 2D basis but the scene is 1D; give a 1D basis: bspline or pl1d\n"
+    );
+    assert_eq!(
+        input_error(&["compare", "vibrating-bar-1d", "--basis", "bspline,pl"]),
+        "error: --basis pl: `pl` is a 2D basis but the scene is 1D; give a 1D basis: bspline or pl1d\n"
+    );
+}
+
 /// A negative value of a numeric option is taken as its value (not as an option of
 /// its own, with clap's tip to write `-- -1`) and refused naming the option and the
 /// values it takes: every numeric option of every command.
