@@ -474,8 +474,17 @@ impl Scene {
                 "a [reference] solution is over the first body's box: body[0] must be a `box`",
             ));
         }
-        if self.steps() == 0 {
-            return Err(conflict("time.t_end", "is shorter than one time step"));
+        if let (Some(dt), 0) = (self.time.dt, self.steps()) {
+            // `t_end / dt` rounds to no step: the step is what does not fit (with
+            // `courant` the run checks it once it knows its step).
+            return Err(conflict(
+                "time.dt",
+                format!(
+                    "{} exceeds t_end = {}: the run takes t_end / dt steps, rounded, and that is none; give a `dt` of at most t_end, or a longer `t_end`",
+                    echo_number(dt),
+                    echo_number(self.time.t_end)
+                ),
+            ));
         }
         Ok(())
     }

@@ -662,8 +662,15 @@ fn range_cases() -> Vec<Case> {
             .edit("t_end = 0.01", "t_end = @@-1.0")
             .expect("time.t_end: must be positive and finite, got -1"),
         case("t-end-below-one-step", BAR)
-            .edit("t_end = 0.01", "t_end = @@1e-5")
-            .expect("time.t_end: is shorter than one time step"),
+            .edit("dt = 1e-3", "dt = @@1e-3")
+            .edit("t_end = 0.01", "t_end = 1e-5")
+            .expect("time.dt: 0.001 exceeds t_end = 1e-5: the run takes t_end / dt steps, rounded, and that is none; give a `dt` of at most t_end, or a longer `t_end`"),
+        // A user's `dt = 10` named only `t_end`: the step is named, at its line, with
+        // both values.
+        case("dt-above-t-end", BAR)
+            .edit("dt = 1e-3", "dt = @@10.0")
+            .edit("t_end = 0.01", "t_end = 1.0")
+            .expect("time.dt: 10 exceeds t_end = 1: the run takes t_end / dt steps, rounded, and that is none; give a `dt` of at most t_end, or a longer `t_end`"),
         case("zero-blocks", BAR)
             .edit("blocks = [4, 1]", "blocks = @@[4, 0]")
             .expect("mesh.blocks: each count must be in 1..=4096, got [4, 0]"),
