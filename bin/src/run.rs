@@ -11,7 +11,7 @@ use psmpm::mass::MassKind;
 use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
-use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
+use psmpm::scene::limits::{echo, plural, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
 use psmpm::scene::{parse_split, BlockLayout, BodyShape, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
@@ -818,13 +818,13 @@ pub fn summary_comments(summary: &Summary) -> String {
 pub fn summary_text(summary: &Summary) -> String {
     let mut out = String::new();
     out += &format!(
-        "{} · {} · {} mass · {} functions · {} particles · {} steps of {} to t = {}\n",
+        "{} · {} · {} mass · {} · {} · {} of {} to t = {}\n",
         summary.scene,
         summary.basis,
         summary.mass,
-        summary.functions,
-        summary.particles,
-        summary.steps,
+        plural(summary.functions, "function", "functions"),
+        plural(summary.particles, "particle", "particles"),
+        plural(summary.steps, "step", "steps"),
         sci(summary.dt),
         short(summary.t_end)
     );

@@ -1,7 +1,7 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    check_tracked_history, echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS,
+    check_tracked_history, echo, echo_number, plural, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS,
     MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D, MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS,
     MAX_TRACKED, MAX_TRIANGLES,
 };
@@ -78,7 +78,10 @@ impl Scene {
         };
         let vector = |field: &str, v: &[f64]| -> Result<(), SceneError> {
             if v.len() != d {
-                return Err(bad(field, format!("needs {d} entries, got {}", v.len())));
+                return Err(bad(
+                    field,
+                    format!("needs {}, got {}", plural(d, "entry", "entries"), v.len()),
+                ));
             }
             v.iter().try_for_each(|&x| finite(field, x))
         };

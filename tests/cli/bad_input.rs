@@ -754,6 +754,19 @@ fn inconsistent_cases() -> Vec<Case> {
         case("body-with-three-coordinates", BAR)
             .edit("max = [4.0, 1.0]", "max = @@[4.0, 1.0, 1.0]")
             .expect("body[0].max: needs 2 entries, got 3"),
+        // In 1D the count is one: "needs 1 entry", not "needs 1 entries".
+        case("1d-body-with-two-coordinates", BAR_1D)
+            .edit("max = [4.0]", "max = @@[4.0, 1.0]")
+            .expect("body[0].max: needs 1 entry, got 2"),
+        case("1d-gravity-with-two-components", BAR_1D)
+            .edit("[time]", "[[effect]]\nkind = \"gravity\"\ng = @@[0.0, -9.81]\n\n[time]")
+            .expect("effect[0].g: needs 1 entry, got 2"),
+        case("1d-spacing-with-two-lengths", BAR_1D)
+            .edit("per_block = [2]", "spacing = @@[0.5, 0.5]")
+            .expect("body[0].spacing: needs 1 positive finite length, got [0.5, 0.5]"),
+        case("linear-velocity-gradient-with-one-row", BAR)
+            .edit("kind = \"exact\"", "kind = \"linear\"\nvalue = [0.0, 0.0]\norigin = [0.0, 0.0]\ngradient = @@[[0.0, 1.0]]")
+            .expect("initial_velocity.gradient: needs 2 rows of 2 entries, got 1 row"),
         case("body-min-not-below-max", BAR)
             .edit("max = [4.0, 1.0]", "max = @@[4.0, 0.0]")
             .expect("body[0].max: needs min < max on every axis, got min = [0.0, 0.0], max = [4.0, 0.0]"),

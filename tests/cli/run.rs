@@ -190,6 +190,28 @@ fn a_basis_of_the_wrong_dimension_names_the_option() {
     );
 }
 
+/// A run of one step said "1 steps of"; the summary's counts agree with them.
+#[test]
+fn a_one_step_summary_says_1_step() {
+    let out = cli()
+        .args([
+            "run",
+            "column-small-1d",
+            "--t-end",
+            "1e-4",
+            "--diag-every",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains(" functions · 32 particles · 1 step of 1.00e-4 to t = 0.0001\n"),
+        "{text}"
+    );
+}
+
 /// A negative value of a numeric option is taken as its value (not as an option of
 /// its own, with clap's tip to write `-- -1`) and refused naming the option and the
 /// values it takes: every numeric option of every command.
