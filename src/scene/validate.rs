@@ -193,10 +193,16 @@ impl Scene {
                 ));
             }
             if let Some(j) = self.boundaries[..i].iter().position(|o| o.tag == bc.tag) {
+                // In 1D an end has one component, the axis (`x`, or `normal`).
+                let fix = if d == 1 {
+                    "(in 1D `fix = [\"normal\"]`: the axis, an end's only component)"
+                } else {
+                    "listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)"
+                };
                 return Err(conflict(
                     format!("boundary[{i}].tag"),
                     format!(
-                        "`{}` is already held by boundary[{j}]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)",
+                        "`{}` is already held by boundary[{j}]: give each tag one [[boundary]] {fix}",
                         echo(&bc.tag)
                     ),
                 ));
@@ -285,9 +291,13 @@ impl Scene {
                 }
                 EffectSpec::ContactWall { tag, stiffness } => {
                     if self.dim != 2 {
+                        // In 1D the wall's normal is the axis: a slip wall holds it.
                         return Err(conflict(
                             field("kind"),
-                            "a contact wall needs a 2D scene (in 1D, fix the end: `[[boundary]]` with `fix = [\"x\"]`)",
+                            format!(
+                                "a contact wall needs a 2D scene; in 1D hold the end with a `[[boundary]]` in place of this effect: `tag = \"{}\"` and `fix = [\"normal\"]` (in 1D the normal is the axis)",
+                                echo(tag)
+                            ),
                         ));
                     }
                     if !(*stiffness > 0.0 && *stiffness <= 1.0) {

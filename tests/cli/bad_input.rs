@@ -892,6 +892,14 @@ fn inconsistent_cases() -> Vec<Case> {
         case("a-tag-in-two-boundaries", BAR)
             .edit("tag = \"right\"\nfix = [\"x\", \"y\"]", "tag = \"right\"\nfix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = @@\"left\"\nfix = [\"normal\"]")
             .expect("boundary[2].tag: `left` is already held by boundary[0]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)"),
+        // The 1D suggestions are valid in 1D: no `y`, and the frictionless end of a
+        // contact wall is the slip wall `fix = ["normal"]` (the axis) on its tag.
+        case("a-tag-in-two-boundaries-in-1d", BAR_1D)
+            .edit("tag = \"left\"\nfix = [\"x\"]", "tag = \"left\"\nfix = [\"x\"]\n\n[[boundary]]\ntag = @@\"left\"\nfix = [\"normal\"]")
+            .expect("boundary[1].tag: `left` is already held by boundary[0]: give each tag one [[boundary]] (in 1D `fix = [\"normal\"]`: the axis, an end's only component)"),
+        case("contact-wall-in-1d", BAR_1D)
+            .edit("[time]", "[[effect]]\nkind = @@\"contact-wall\"\ntag = \"right\"\n\n[time]")
+            .expect("effect[0].kind: a contact wall needs a 2D scene; in 1D hold the end with a `[[boundary]]` in place of this effect: `tag = \"right\"` and `fix = [\"normal\"]` (in 1D the normal is the axis)"),
         case("a-basis-in-two-resolutions", BAR)
             .edit("[study]", "[[resolution]]\nbasis = @@\"pl\"\nblocks = [16, 2]\n\n[study]")
             .expect("resolution[1].basis: `pl` already has a resolution (resolution[0]): give each basis one [[resolution]]"),
