@@ -64,7 +64,10 @@ pub struct MaterialTable {
 
 /// A particle's law index that is not in the table.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("particle {particle} has law {law}, but the table has {laws} laws")]
+#[error(
+    "particle {particle} has law {law}, but the table has {}",
+    crate::scene::limits::plural(*laws, "law", "laws")
+)]
 pub struct TableError {
     /// The particle.
     pub particle: usize,

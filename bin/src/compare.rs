@@ -62,7 +62,7 @@ pub fn variants(
     } else {
         bases
             .iter()
-            .map(|b| BasisKind::parse(b).map_err(|m| CliError::Input(format!("--basis: {m}"))))
+            .map(|b| crate::run::basis_option(b, base.dim))
             .collect::<Result<_, _>>()?
     };
     let masses: Vec<MassKind> = if masses.is_empty() {

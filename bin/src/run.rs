@@ -11,7 +11,7 @@ use psmpm::mass::MassKind;
 use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
-use psmpm::scene::limits::{echo, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
+use psmpm::scene::limits::{echo, plural, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
 use psmpm::scene::{parse_split, BlockLayout, BodyShape, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
@@ -336,11 +336,31 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
     }
 }
 
+/// The basis `--basis NAME` gives a scene of dimension `dim`; the error names the
+/// option, the scene's dimension and the bases that fit it.
+pub fn basis_option(name: &str, dim: usize) -> Result<BasisKind, CliError> {
+    let basis = BasisKind::parse(name).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+    if basis.dim() != dim {
+        let fit: Vec<&str> = BasisKind::ALL
+            .into_iter()
+            .filter(|k| k.dim() == dim)
+            .map(BasisKind::name)
+            .collect();
+        return Err(CliError::Input(format!(
+            "--basis {0}: `{0}` is a {1}D basis but the scene is {dim}D; give a {dim}D basis: {2}",
+            basis.name(),
+            basis.dim(),
+            fit.join(" or ")
+        )));
+    }
+    Ok(basis)
+}
+
 /// The scene of `run` with the command line's choices applied, validated.
 fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     let mut s = read_scene(&args.scene)?;
     if let Some(b) = &args.basis {
-        s.basis = BasisKind::parse(b).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+        s.basis = basis_option(b, s.dim)?;
     }
     if let Some(m) = &args.mass {
         s.mass = MassKind::parse(m).map_err(|m| CliError::Input(format!("--mass: {m}")))?;
@@ -798,13 +818,13 @@ pub fn summary_comments(summary: &Summary) -> String {
 pub fn summary_text(summary: &Summary) -> String {
     let mut out = String::new();
     out += &format!(
-        "{} · {} · {} mass · {} functions · {} particles · {} steps of {} to t = {}\n",
+        "{} · {} · {} mass · {} · {} · {} of {} to t = {}\n",
         summary.scene,
         summary.basis,
         summary.mass,
-        summary.functions,
-        summary.particles,
-        summary.steps,
+        plural(summary.functions, "function", "functions"),
+        plural(summary.particles, "particle", "particles"),
+        plural(summary.steps, "step", "steps"),
         sci(summary.dt),
         short(summary.t_end)
     );

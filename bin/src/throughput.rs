@@ -50,8 +50,9 @@ fn check_size(n: f64) -> Result<(), CliError> {
     let most = particles_of((limit as f64 / (BLOCK_PARTICLES * ASPECT) as f64).sqrt() as usize);
     if !(n >= 100.0 && n.is_finite()) {
         return Err(CliError::Input(format!(
-            "--sizes: {} particles is outside 100..={most}",
-            echo_number(n)
+            "--sizes: {} {} is outside 100..={most}",
+            echo_number(n),
+            if n == 1.0 { "particle" } else { "particles" }
         )));
     }
     if n > limit as f64 {

@@ -122,7 +122,8 @@ where
         let particles = self.particles.len();
         if particles < consistent {
             return Some(format!(
-                "{particles} particles for {consistent} functions solved with the `{}` mass: a mass matrix summed from fewer particles than functions is singular; use more particles per element (`per_block` or `count`; `--particles`)",
+                "{} for {consistent} functions solved with the `{}` mass: a mass matrix summed from fewer particles than functions is singular; use more particles per element (`per_block` or `count`; `--particles`)",
+                crate::scene::limits::plural(particles, "particle", "particles"),
                 self.mass.spec()
             ));
         }
@@ -332,7 +333,8 @@ where
                 "`extended-hybrid` (the default), which also lumps the rows of functions covered below 0.75"
             };
             format!(
-                "`{spec}` treated {treated} functions and the rest is still singular{worst}: use more particles per element (`per_block` or `count`; `--particles`), or {alternative}"
+                "`{spec}` treated {} and the rest is still singular{worst}: use more particles per element (`per_block` or `count`; `--particles`), or {alternative}",
+                crate::scene::limits::plural(treated, "function", "functions")
             )
         } else {
             match self.last_report.worst_coverage {

@@ -145,27 +145,44 @@ impl MassKind {
             None => (name, None),
         };
         let shown = crate::scene::limits::echo(name);
+        // A number that parses but is not finite (`1e400` overflows to infinity,
+        // `nan`) is named as such, with the range wanted: "must be positive" would
+        // hide why `1e400` fails.
+        let not_finite = |a: &str, v: f64, what: &str, range: &str| {
+            let why = if v.is_nan() {
+                "is not a number".to_string()
+            } else {
+                format!(
+                    "is not finite (it reads as {}infinity: beyond ±1.8e308)",
+                    if v < 0.0 { "minus " } else { "" }
+                )
+            };
+            format!(
+                "`{shown}`: the {what} `{}` {why}; give {range}",
+                crate::scene::limits::echo(a)
+            )
+        };
         let number = |a: &str| -> Result<f64, String> {
-            a.parse::<f64>()
-                .ok()
-                .filter(|v| *v > 0.0 && v.is_finite())
-                .ok_or_else(|| {
-                    format!(
-                        "`{shown}`: the threshold must be a positive number, got `{}`",
-                        crate::scene::limits::echo(a)
-                    )
-                })
+            match a.parse::<f64>() {
+                Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+                Ok(v) if !v.is_finite() => {
+                    Err(not_finite(a, v, "threshold", "a positive finite number"))
+                }
+                _ => Err(format!(
+                    "`{shown}`: the threshold must be a positive number, got `{}`",
+                    crate::scene::limits::echo(a)
+                )),
+            }
         };
         let fraction = |a: &str| -> Result<f64, String> {
-            a.parse::<f64>()
-                .ok()
-                .filter(|v| *v > 0.0 && *v < 1.0)
-                .ok_or_else(|| {
-                    format!(
-                        "`{shown}`: the coverage must be a number in (0, 1), got `{}`",
-                        crate::scene::limits::echo(a)
-                    )
-                })
+            match a.parse::<f64>() {
+                Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+                Ok(v) if !v.is_finite() => Err(not_finite(a, v, "coverage", "a number in (0, 1)")),
+                _ => Err(format!(
+                    "`{shown}`: the coverage must be a number in (0, 1), got `{}`",
+                    crate::scene::limits::echo(a)
+                )),
+            }
         };
         match (head, arg) {
             ("default", None) => Ok(MassKind::default()),

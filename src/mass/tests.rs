@@ -262,6 +262,47 @@ fn deactivation_removes_small_rows_and_lumped_matches_row_sums() {
     assert!(rhs.iter().all(|&y| y == 0.0 || (y - 1.0).abs() < 1e-14));
 }
 
+/// `deactivate:1e400` parses to infinity: the message said the threshold must be
+/// positive; every strategy parameter read as a number now says it is not finite
+/// and gives the range.
+#[test]
+fn mass_parameters_that_are_not_finite_are_named_so() {
+    let error = |spec: &str| MassKind::parse(spec).unwrap_err();
+    assert_eq!(
+        error("deactivate:1e400"),
+        "`deactivate:1e400`: the threshold `1e400` is not finite (it reads as infinity: beyond ±1.8e308); give a positive finite number"
+    );
+    assert_eq!(
+        error("partial:-1e400"),
+        "`partial:-1e400`: the threshold `-1e400` is not finite (it reads as minus infinity: beyond ±1.8e308); give a positive finite number"
+    );
+    assert_eq!(
+        error("deactivate:nan"),
+        "`deactivate:nan`: the threshold `nan` is not a number; give a positive finite number"
+    );
+    for (spec, value) in [
+        ("partial-coverage:1e400", "1e400"),
+        ("extended:inf", "inf"),
+        ("extended-hybrid:1e400:0.5", "1e400"),
+        ("extended-hybrid:0.01:1e400", "1e400"),
+        ("extended-hybrid-apic:0.01:0.5:1e999", "1e999"),
+    ] {
+        assert_eq!(
+            error(spec),
+            format!("`{spec}`: the coverage `{value}` is not finite (it reads as infinity: beyond ±1.8e308); give a number in (0, 1)")
+        );
+    }
+    // Finite values out of range keep their messages.
+    assert_eq!(
+        error("deactivate:-1"),
+        "`deactivate:-1`: the threshold must be a positive number, got `-1`"
+    );
+    assert_eq!(
+        error("extended:1.5"),
+        "`extended:1.5`: the coverage must be a number in (0, 1), got `1.5`"
+    );
+}
+
 #[test]
 fn mass_kinds_parse() {
     assert_eq!(

@@ -311,7 +311,9 @@ pub fn write_particles_vtu<W: Write, T: Scalar, const D: usize>(
     ];
     if let Some((name, len)) = lengths.iter().find(|(_, len)| *len != n) {
         return Err(invalid(format!(
-            "particles have {n} positions but {len} entries in `{name}`"
+            "particles have {} but {} in `{name}`",
+            crate::scene::limits::plural(n, "position", "positions"),
+            crate::scene::limits::plural(*len, "entry", "entries")
         )));
     }
     // Component k of a D-vector, zero beyond D (and beyond 3).

@@ -2,7 +2,7 @@
 //! lattice, its material and initial velocity (its own or the scene's), and the
 //! number of particles of all bodies, bounded before any is made.
 
-use super::limits::{echo_number, MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS};
+use super::limits::{echo_number, plural, MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS};
 use super::{
     bad, conflict, Body, BodyShape, ErrorKind, InitialVelocity, MaterialSpec, MeshSpec, Scene,
     SceneError,
@@ -179,7 +179,7 @@ impl Scene {
                     if v.len() != d {
                         return Err(bad(
                             field(name),
-                            format!("needs {d} entries, got {}", v.len()),
+                            format!("needs {}, got {}", plural(d, "entry", "entries"), v.len()),
                         ));
                     }
                     if let Some(x) = v.iter().find(|x| !x.is_finite()) {
@@ -336,7 +336,10 @@ impl Scene {
                 if h.len() != d || h.iter().any(|&x| !(x > 0.0 && x.is_finite())) {
                     return Err(bad(
                         field("spacing"),
-                        format!("needs {d} positive finite lengths, got {h:?}"),
+                        format!(
+                            "needs {}, got {h:?}",
+                            plural(d, "positive finite length", "positive finite lengths")
+                        ),
                     ));
                 }
             }
@@ -385,7 +388,10 @@ impl Scene {
         let sub = |f: &str| format!("{field}.{f}");
         let vector = |f: String, v: &[f64]| -> Result<(), SceneError> {
             if v.len() != d {
-                return Err(bad(f, format!("needs {d} entries, got {}", v.len())));
+                return Err(bad(
+                    f,
+                    format!("needs {}, got {}", plural(d, "entry", "entries"), v.len()),
+                ));
             }
             match v.iter().find(|x| !x.is_finite()) {
                 Some(x) => Err(bad(f, format!("must be finite, got {x}"))),
@@ -422,7 +428,12 @@ impl Scene {
                 if gradient.len() != d {
                     return Err(bad(
                         sub("gradient"),
-                        format!("needs {d} rows of {d} entries, got {} rows", gradient.len()),
+                        format!(
+                            "needs {} of {}, got {}",
+                            plural(d, "row", "rows"),
+                            plural(d, "entry", "entries"),
+                            plural(gradient.len(), "row", "rows")
+                        ),
                     ));
                 }
                 for row in gradient {

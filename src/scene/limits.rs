@@ -135,6 +135,16 @@ pub fn echo_number(x: f64) -> String {
     }
 }
 
+/// `n` with the noun that agrees with it, for messages: `1 entry`, `2 entries`,
+/// `0 entries`.
+pub fn plural(n: usize, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {many}")
+    }
+}
+
 /// A number with `decimals` fixed decimals in a message (`{:.2}`), in exponent
 /// notation with as many decimals from 1e6 up, so that a huge value is not printed
 /// with hundreds of digits.
@@ -149,6 +159,13 @@ pub fn echo_fixed(x: f64, decimals: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plural_agrees_with_the_count() {
+        assert_eq!(plural(1, "entry", "entries"), "1 entry");
+        assert_eq!(plural(2, "entry", "entries"), "2 entries");
+        assert_eq!(plural(0, "entry", "entries"), "0 entries");
+    }
 
     #[test]
     fn echo_number_is_short() {

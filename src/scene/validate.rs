@@ -1,7 +1,7 @@
 //! Validation: a scene is consistent, or the error names the field.
 
 use super::limits::{
-    check_tracked_history, echo, echo_number, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS,
+    check_tracked_history, echo, echo_number, plural, MAX_BLOCKS, MAX_BLOCKS_PER_AXIS,
     MAX_DESCRIPTION_CHARS, MAX_ELEMENTS_1D, MAX_NAME_CHARS, MAX_OUTLINE_CORNERS, MAX_STEPS,
     MAX_TRACKED, MAX_TRIANGLES,
 };
@@ -78,7 +78,10 @@ impl Scene {
         };
         let vector = |field: &str, v: &[f64]| -> Result<(), SceneError> {
             if v.len() != d {
-                return Err(bad(field, format!("needs {d} entries, got {}", v.len())));
+                return Err(bad(
+                    field,
+                    format!("needs {}, got {}", plural(d, "entry", "entries"), v.len()),
+                ));
             }
             v.iter().try_for_each(|&x| finite(field, x))
         };
@@ -190,10 +193,16 @@ impl Scene {
                 ));
             }
             if let Some(j) = self.boundaries[..i].iter().position(|o| o.tag == bc.tag) {
+                // In 1D an end has one component, the axis (`x`, or `normal`).
+                let fix = if d == 1 {
+                    "(in 1D `fix = [\"normal\"]`: the axis, an end's only component)"
+                } else {
+                    "listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)"
+                };
                 return Err(conflict(
                     format!("boundary[{i}].tag"),
                     format!(
-                        "`{}` is already held by boundary[{j}]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)",
+                        "`{}` is already held by boundary[{j}]: give each tag one [[boundary]] {fix}",
                         echo(&bc.tag)
                     ),
                 ));
@@ -282,9 +291,13 @@ impl Scene {
                 }
                 EffectSpec::ContactWall { tag, stiffness } => {
                     if self.dim != 2 {
+                        // In 1D the wall's normal is the axis: a slip wall holds it.
                         return Err(conflict(
                             field("kind"),
-                            "a contact wall needs a 2D scene (in 1D, fix the end: `[[boundary]]` with `fix = [\"x\"]`)",
+                            format!(
+                                "a contact wall needs a 2D scene; in 1D hold the end with a `[[boundary]]` in place of this effect: `tag = \"{}\"` and `fix = [\"normal\"]` (in 1D the normal is the axis)",
+                                echo(tag)
+                            ),
                         ));
                     }
                     if !(*stiffness > 0.0 && *stiffness <= 1.0) {
@@ -474,8 +487,17 @@ impl Scene {
                 "a [reference] solution is over the first body's box: body[0] must be a `box`",
             ));
         }
-        if self.steps() == 0 {
-            return Err(conflict("time.t_end", "is shorter than one time step"));
+        if let (Some(dt), 0) = (self.time.dt, self.steps()) {
+            // `t_end / dt` rounds to no step: the step is what does not fit (with
+            // `courant` the run checks it once it knows its step).
+            return Err(conflict(
+                "time.dt",
+                format!(
+                    "{} exceeds t_end = {}: the run takes t_end / dt steps, rounded, and that is none; give a `dt` of at most t_end, or a longer `t_end`",
+                    echo_number(dt),
+                    echo_number(self.time.t_end)
+                ),
+            ));
         }
         Ok(())
     }

@@ -662,8 +662,15 @@ fn range_cases() -> Vec<Case> {
             .edit("t_end = 0.01", "t_end = @@-1.0")
             .expect("time.t_end: must be positive and finite, got -1"),
         case("t-end-below-one-step", BAR)
-            .edit("t_end = 0.01", "t_end = @@1e-5")
-            .expect("time.t_end: is shorter than one time step"),
+            .edit("dt = 1e-3", "dt = @@1e-3")
+            .edit("t_end = 0.01", "t_end = 1e-5")
+            .expect("time.dt: 0.001 exceeds t_end = 1e-5: the run takes t_end / dt steps, rounded, and that is none; give a `dt` of at most t_end, or a longer `t_end`"),
+        // A user's `dt = 10` named only `t_end`: the step is named, at its line, with
+        // both values.
+        case("dt-above-t-end", BAR)
+            .edit("dt = 1e-3", "dt = @@10.0")
+            .edit("t_end = 0.01", "t_end = 1.0")
+            .expect("time.dt: 10 exceeds t_end = 1: the run takes t_end / dt steps, rounded, and that is none; give a `dt` of at most t_end, or a longer `t_end`"),
         case("zero-blocks", BAR)
             .edit("blocks = [4, 1]", "blocks = @@[4, 0]")
             .expect("mesh.blocks: each count must be in 1..=4096, got [4, 0]"),
@@ -747,6 +754,19 @@ fn inconsistent_cases() -> Vec<Case> {
         case("body-with-three-coordinates", BAR)
             .edit("max = [4.0, 1.0]", "max = @@[4.0, 1.0, 1.0]")
             .expect("body[0].max: needs 2 entries, got 3"),
+        // In 1D the count is one: "needs 1 entry", not "needs 1 entries".
+        case("1d-body-with-two-coordinates", BAR_1D)
+            .edit("max = [4.0]", "max = @@[4.0, 1.0]")
+            .expect("body[0].max: needs 1 entry, got 2"),
+        case("1d-gravity-with-two-components", BAR_1D)
+            .edit("[time]", "[[effect]]\nkind = \"gravity\"\ng = @@[0.0, -9.81]\n\n[time]")
+            .expect("effect[0].g: needs 1 entry, got 2"),
+        case("1d-spacing-with-two-lengths", BAR_1D)
+            .edit("per_block = [2]", "spacing = @@[0.5, 0.5]")
+            .expect("body[0].spacing: needs 1 positive finite length, got [0.5, 0.5]"),
+        case("linear-velocity-gradient-with-one-row", BAR)
+            .edit("kind = \"exact\"", "kind = \"linear\"\nvalue = [0.0, 0.0]\norigin = [0.0, 0.0]\ngradient = @@[[0.0, 1.0]]")
+            .expect("initial_velocity.gradient: needs 2 rows of 2 entries, got 1 row"),
         case("body-min-not-below-max", BAR)
             .edit("max = [4.0, 1.0]", "max = @@[4.0, 0.0]")
             .expect("body[0].max: needs min < max on every axis, got min = [0.0, 0.0], max = [4.0, 0.0]"),
@@ -872,6 +892,14 @@ fn inconsistent_cases() -> Vec<Case> {
         case("a-tag-in-two-boundaries", BAR)
             .edit("tag = \"right\"\nfix = [\"x\", \"y\"]", "tag = \"right\"\nfix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = @@\"left\"\nfix = [\"normal\"]")
             .expect("boundary[2].tag: `left` is already held by boundary[0]: give each tag one [[boundary]] listing all it holds (`fix = [\"x\", \"y\"]`, or `[\"normal\"]` alone)"),
+        // The 1D suggestions are valid in 1D: no `y`, and the frictionless end of a
+        // contact wall is the slip wall `fix = ["normal"]` (the axis) on its tag.
+        case("a-tag-in-two-boundaries-in-1d", BAR_1D)
+            .edit("tag = \"left\"\nfix = [\"x\"]", "tag = \"left\"\nfix = [\"x\"]\n\n[[boundary]]\ntag = @@\"left\"\nfix = [\"normal\"]")
+            .expect("boundary[1].tag: `left` is already held by boundary[0]: give each tag one [[boundary]] (in 1D `fix = [\"normal\"]`: the axis, an end's only component)"),
+        case("contact-wall-in-1d", BAR_1D)
+            .edit("[time]", "[[effect]]\nkind = @@\"contact-wall\"\ntag = \"right\"\n\n[time]")
+            .expect("effect[0].kind: a contact wall needs a 2D scene; in 1D hold the end with a `[[boundary]]` in place of this effect: `tag = \"right\"` and `fix = [\"normal\"]` (in 1D the normal is the axis)"),
         case("a-basis-in-two-resolutions", BAR)
             .edit("[study]", "[[resolution]]\nbasis = @@\"pl\"\nblocks = [16, 2]\n\n[study]")
             .expect("resolution[1].basis: `pl` already has a resolution (resolution[0]): give each basis one [[resolution]]"),

@@ -763,6 +763,10 @@ fn throughput_checks_its_sizes_against_the_particle_limit_up_front() {
         error("50"),
         "error: --sizes: 50 particles is outside 100..=9892352\n"
     );
+    assert_eq!(
+        error("1"),
+        "error: --sizes: 1 particle is outside 100..=9892352\n"
+    );
 }
 
 /// `compare --courant 1.5` said `time.courant: …` without the flag that set it;

@@ -203,7 +203,7 @@ fn scene_cases() -> Vec<Case> {
         scene_case(
             "end-before-one-step",
             bar(&[("t_end = 0.01", "t_end = 1e-4")]),
-            "time.t_end: is shorter than one time step",
+            "time.dt: 0.001 exceeds t_end = 0.0001",
         ),
         scene_case(
             "courant-end-before-one-step",
@@ -421,7 +421,7 @@ fn command_line_cases() -> Vec<Case> {
         args_case("nan-dt", None, &["run", "vibrating-bar", "--dt", "NaN"], "time.dt: must be positive and finite"),
         args_case("infinite-dt", None, &["run", "vibrating-bar", "--dt", "inf"], "time.dt: must be positive and finite"),
         args_case("infinite-t-end", None, &["run", "vibrating-bar", "--t-end", "inf"], "time.t_end: must be positive and finite"),
-        args_case("t-end-before-one-step", None, &["run", "vibrating-bar", "--t-end", "1e-9"], "is shorter than one time step"),
+        args_case("t-end-before-one-step", None, &["run", "vibrating-bar", "--t-end", "1e-9"], "--t-end 1e-9: time.dt: 0.001 exceeds t_end = 1e-9"),
         args_case("compare-dt-over-the-limit", None, &["compare", "vibrating-bar", "--dt", "1e-12"], "--dt 1e-12"),
         args_case("converge-dt-over-the-limit", None, &["converge", "vibrating-bar", "--dt", "1e-12"], "above the limit of 10000000"),
         args_case("converge-target-error-not-positive", None, &["converge", "vibrating-bar", "--target-error", "0"], "--target-error must be a positive error, got 0"),

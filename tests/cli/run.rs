@@ -157,6 +157,61 @@ fn bad_input_is_a_one_line_error_with_status_2() {
     assert!(input_error(&["run", "vibrating-bar", "--t-end", "0"]).contains("t_end"));
 }
 
+/// `--mass deactivate:1e400` said the threshold was not positive; `1e400` reads as
+/// infinity, and the message now says so, naming `--mass` and the range.
+#[test]
+fn a_mass_parameter_that_overflows_is_named_not_finite() {
+    assert_eq!(
+        input_error(&["run", "vibrating-bar", "--mass", "deactivate:1e400"]),
+        "error: --mass: `deactivate:1e400`: the threshold `1e400` is not finite (it reads as infinity: beyond ±1.8e308); give a positive finite number\n"
+    );
+    assert_eq!(
+        input_error(&["run", "vibrating-bar", "--mass", "extended-hybrid:0.01:1e400"]),
+        "error: --mass: `extended-hybrid:0.01:1e400`: the coverage `1e400` is not finite (it reads as infinity: beyond ±1.8e308); give a number in (0, 1)\n"
+    );
+}
+
+/// `--basis pl1d` on a 2D scene said `basis: …` without the option that chose it;
+/// the error now names `--basis`, the scene's dimension and the bases that fit, both
+/// ways, on `run` and on `compare`.
+#[test]
+fn a_basis_of_the_wrong_dimension_names_the_option() {
+    assert_eq!(
+        input_error(&["run", "vibrating-bar", "--basis", "pl1d"]),
+        "error: --basis pl1d: `pl1d` is a 1D basis but the scene is 2D; give a 2D basis: ps or pl\n"
+    );
+    assert_eq!(
+        input_error(&["run", "vibrating-bar-1d", "--basis", "ps"]),
+        "error: --basis ps: `ps` is a 2D basis but the scene is 1D; give a 1D basis: bspline or pl1d\n"
+    );
+    assert_eq!(
+        input_error(&["compare", "vibrating-bar-1d", "--basis", "bspline,pl"]),
+        "error: --basis pl: `pl` is a 2D basis but the scene is 1D; give a 1D basis: bspline or pl1d\n"
+    );
+}
+
+/// A run of one step said "1 steps of"; the summary's counts agree with them.
+#[test]
+fn a_one_step_summary_says_1_step() {
+    let out = cli()
+        .args([
+            "run",
+            "column-small-1d",
+            "--t-end",
+            "1e-4",
+            "--diag-every",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains(" functions · 32 particles · 1 step of 1.00e-4 to t = 0.0001\n"),
+        "{text}"
+    );
+}
+
 /// A negative value of a numeric option is taken as its value (not as an option of
 /// its own, with clap's tip to write `-- -1`) and refused naming the option and the
 /// values it takes: every numeric option of every command.

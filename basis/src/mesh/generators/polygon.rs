@@ -166,9 +166,12 @@ impl PolygonDomain {
             return invalid(
                 PolygonPart::OuterTags,
                 format!(
-                    "the outer polygon has {} segments but {} tags (one per segment i → i + 1)",
+                    "the outer polygon has {} segments but {} (one per segment i → i + 1)",
                     self.outer.len(),
-                    self.outer_tags.len()
+                    match self.outer_tags.len() {
+                        1 => "1 tag".to_string(),
+                        n => format!("{n} tags"),
+                    }
                 ),
             );
         }
@@ -584,6 +587,8 @@ mod tests {
         let mut d = square.clone();
         d.outer_tags.pop();
         assert!(msg(&d).contains("4 segments but 3 tags"));
+        d.outer_tags.truncate(1);
+        assert!(msg(&d).contains("4 segments but 1 tag ("), "{}", msg(&d));
         let mut d = square.clone();
         d.outer_tags[2] = String::new();
         assert!(msg(&d).contains("empty"));
