@@ -69,16 +69,22 @@ impl Scene {
             }
             (None, Some(per)) => {
                 let blocks = self.blocks()?;
-                let (lo, hi) = match (&self.mesh, k) {
-                    (MeshSpec::Blocks { x, .. }, 0) | (MeshSpec::Interval { x, .. }, 0) => {
-                        (x[0], x[1])
-                    }
-                    (MeshSpec::Blocks { y, .. }, _) => (y[0], y[1]),
-                    _ => return None,
-                };
+                let (lo, hi) = self.block_mesh_range(k)?;
                 Some((hi - lo) / blocks[k] as f64 / *per.get(k)? as f64)
             }
             (None, None) => None,
+        }
+    }
+
+    /// The range `[x0, x1]` (`k = 0`) or `[y0, y1]` (`k = 1`) of a `blocks` or
+    /// `interval` mesh; `None` for other meshes.
+    pub fn block_mesh_range(&self, k: usize) -> Option<(f64, f64)> {
+        match (&self.mesh, k) {
+            (MeshSpec::Blocks { x, .. }, 0) | (MeshSpec::Interval { x, .. }, 0) => {
+                Some((x[0], x[1]))
+            }
+            (MeshSpec::Blocks { y, .. }, 1) => Some((y[0], y[1])),
+            _ => None,
         }
     }
 

@@ -75,6 +75,31 @@ pub fn particle_lattice(scene: &Scene) -> Result<Lattice, RunError> {
             let n = if body.per_block.is_some() || body.spacing.is_some() {
                 let n = extent / h;
                 if (n - n.round()).abs() > WHOLE_CELLS * n.max(1.0) || n.round() < 1.0 {
+                    // A box beyond a block mesh: say so rather than that its extent is
+                    // not a whole number of the lattice's cells, the mesh's blocks.
+                    if let (Some(_), Some((lo, hi))) = (&body.per_block, scene.block_mesh_range(k))
+                    {
+                        let (field, end, side) = if body.min[k] < lo {
+                            ("min", lo, "at least")
+                        } else {
+                            ("max", hi, "at most")
+                        };
+                        if body.min[k] < lo || body.max[k] > hi {
+                            return Err(SceneError::new(
+                                format!("body[{b}].{field}"),
+                                ErrorKind::Conflict,
+                                format!(
+                                    "the body's box [{}, {}] along axis {k} reaches beyond the mesh's [{}, {}]: a body must lie inside the mesh; make `{field}` {side} {}, or enlarge the mesh",
+                                    echo_number(body.min[k]),
+                                    echo_number(body.max[k]),
+                                    echo_number(lo),
+                                    echo_number(hi),
+                                    echo_number(end)
+                                ),
+                            )
+                            .into());
+                        }
+                    }
                     // Ten significant digits: 0.8, not 0.7999999999999999.
                     let shown = |x: f64| format!("{x:.9e}").parse::<f64>().unwrap_or(x);
                     let (extent, h) = (shown(extent), shown(h));

@@ -918,6 +918,9 @@ fn inconsistent_cases() -> Vec<Case> {
         case("body-outside-the-mesh", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 2.0]")
             .at(22, 1).at(24, 7).expect("body[0].max: the particle at [0.125, 1.125] lies outside the mesh, which spans [0, 4] × [0, 1]; the body must lie inside the meshed domain"),
+        case("body-partly-above-the-mesh-off-its-lattice", BAR)
+            .edit("max = [4.0, 1.0]", "max = @@[4.0, 1.1]")
+            .expect("body[0].max: the body's box [0, 1.1] along axis 1 reaches beyond the mesh's [0, 1]: a body must lie inside the mesh; make `max` at most 1, or enlarge the mesh"),
         case("body-below-the-mesh", BAR)
             .edit("min = [0.0, 0.0]", "min = [0.0, -1.0]")
             .at(23, 7).expect("body[0].min: the particle at [0.125, -0.875] lies outside the mesh, which spans [0, 4] × [0, 1]; the body must lie inside the meshed domain"),
