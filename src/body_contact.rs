@@ -49,7 +49,7 @@
 //! the longer normal alone), and part with `e` 0.68 instead of 0.61.
 //!
 //! Open: stacked bodies sink into each other slowly, since overlapping positions
-//! are never pushed back. A correction of the overlap was tried (2026-12-05, not
+//! are never pushed back. A correction of the overlap was tried (2026-12-04, not
 //! kept; `docs/scenes.md`, the `body-contact` effect): the overlap `δ` along the
 //! normal of the touching pairs on each function, and a separating speed `β δ / Δt`
 //! in place of zero approach, either in the contact forces or on the projected

@@ -178,7 +178,7 @@ t_end = 0.5
     }
     let (speed, height) = (momentum / mass, height / mass);
     // Measured: 0.85 (docs/scenes.md, the `body-contact` effect; 0.84 with the
-    // longer of the two normals alone, before 2026-12-05); with the normals of the
+    // longer of the two normals alone, before 2026-12-04); with the normals of the
     // mass centres alone, as before 2026-12-04, 0.25.
     assert!(speed > 0.75, "{speed}");
     // It rests on the lower block: its centre stays at 0.75, within 2 % of its
@@ -244,7 +244,7 @@ t_end = 0.6
 
 /// Two equal blocks meeting head-on on a mesh that is mirror-symmetric about the
 /// plane between them stay mirror images of each other to round-off. Until
-/// 2026-12-05 the normal on a function of that plane was the longer of the two
+/// 2026-12-04 the normal on a function of that plane was the longer of the two
 /// bodies' outward normals, which are mirror images there, so round-off chose one
 /// and tilted the contact: the particles' positions were 7.8e-4 from mirror images
 /// at t = 0.5 (1.2 % of their spacing), without contact 2.3e-14.
