@@ -505,8 +505,11 @@ pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[us
         a
     }
     let n = particles.len();
-    let mut body = vec![0u32; n];
-    if body_sizes.iter().sum::<usize>() == n {
+    // The body of each particle, where there are several (no buffer for one: the
+    // run's peak memory per particle counts it).
+    let mut body = Vec::new();
+    if body_sizes.len() > 1 && body_sizes.iter().sum::<usize>() == n {
+        body = vec![0u32; n];
         let mut first = 0;
         for (b, &size) in body_sizes.iter().enumerate() {
             body[first..first + size].fill(b as u32);
@@ -517,7 +520,7 @@ pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[us
     let mut parent: Vec<usize> = (0..n).collect();
     let measured = neighbours(particles, |p, q| {
         near[p] = true;
-        if body[p] != body[q] {
+        if !body.is_empty() && body[p] != body[q] {
             return;
         }
         let (a, b) = (root(&mut parent, p), root(&mut parent, q));
