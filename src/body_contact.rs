@@ -310,10 +310,9 @@ impl BodyContact {
             if ma <= 0.0 || mb <= 0.0 {
                 continue;
             }
-            // The longer outward normal of the two bodies' vertices; the mass
-            // centres give its side (a gradient of a vertex the body nearly fills is
-            // noise): where the two disagree by more than 60°, the centres'
-            // direction.
+            // The two bodies' outward normals at their vertices; the mass centres
+            // give the side (a gradient of a vertex the body nearly fills is noise):
+            // where the two disagree by more than 60°, the centres' direction.
             let (va, vb) = (self.vertex[ia] as usize, self.vertex[ib] as usize);
             let (ga, gb) = (&vertex_gradient[va], &vertex_gradient[vb]);
             let mut by_gradient = [0.0; 3];
