@@ -11,7 +11,7 @@ use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::{Basis, TriMesh};
 use psmpm::output::basis_picture::{basis_function_plot, BasisPlotOptions};
 use psmpm::output::mesh_picture::{mesh_plot, MeshPlotOptions};
-use psmpm::scene::parse_split;
+use psmpm::scene::{parse_mirror_line, parse_split};
 use std::path::PathBuf;
 
 /// `mpm-cli basis ...`.
@@ -46,6 +46,10 @@ pub struct PlotArgs {
     /// PS split points: incentre or centroid.
     #[arg(long, default_value = "incentre")]
     split: String,
+    /// PS: the mirror line the control triangles keep where a vertex is symmetric
+    /// about both axes: vertical or horizontal.
+    #[arg(long, value_name = "LINE", default_value = "vertical")]
+    mirror_line: String,
     /// Output file. An existing file is refused unless --overwrite is given.
     #[arg(long, default_value = "basis.svg")]
     out: PathBuf,
@@ -101,6 +105,8 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
     let BasisCommand::Plot(args) = command;
     let split: SplitPoint =
         parse_split(&args.split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
+    let mirror_line = parse_mirror_line(&args.mirror_line)
+        .map_err(|m| CliError::Input(format!("--mirror-line: {m}")))?;
     let kind =
         BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
     check_out(&args.out, args.overwrite)?;
@@ -113,7 +119,8 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
     };
     let functions = match (args.function, kind) {
         (None, BasisKind::Ps) => {
-            let ps = PowellSabin::<f64>::new(mesh, split).map_err(|e| CliError::Input(e.to_string()))?;
+            let ps = PowellSabin::<f64>::with_mirror(mesh, split, mirror_line)
+                .map_err(|e| CliError::Input(e.to_string()))?;
             let options = MeshPlotOptions {
                 title: format!(
                     "Powell–Sabin refinement and control triangles ({} triangles, {} functions)",
@@ -131,7 +138,8 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
             ))
         }
         (Some(k), BasisKind::Ps) => {
-            let ps = PowellSabin::<f64>::new(mesh, split).map_err(|e| CliError::Input(e.to_string()))?;
+            let ps = PowellSabin::<f64>::with_mirror(mesh, split, mirror_line)
+                .map_err(|e| CliError::Input(e.to_string()))?;
             basis_function_plot(&args.out, &ps, k, &BasisPlotOptions::default()).map_err(plot_error)?;
             ps.num_functions()
         }

@@ -12,7 +12,7 @@ use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
 use psmpm::scene::limits::{echo, plural, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
-use psmpm::scene::{parse_split, BlockLayout, BodyShape, Scene, SceneError};
+use psmpm::scene::{parse_mirror_line, parse_split, BlockLayout, BodyShape, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
 use std::io::Write;
@@ -33,6 +33,10 @@ pub struct Overrides {
     /// PS split points: incentre or centroid (the thesis' tables).
     #[arg(long)]
     pub split: Option<String>,
+    /// PS: the mirror line the basis keeps where a vertex is symmetric about both
+    /// axes (block grids): vertical (default) or horizontal, the scene's own.
+    #[arg(long, value_name = "LINE")]
+    pub mirror_line: Option<String>,
     /// Triangulation of each block: four-triangles (the seeds' grid) or delaunay
     /// (Delaunay of block corners and centres, the thesis' tables).
     #[arg(long)]
@@ -101,6 +105,16 @@ impl Overrides {
                 )));
             }
             s.split = parse_split(split).map_err(|m| CliError::Input(format!("--split: {m}")))?;
+        }
+        if let Some(line) = &self.mirror_line {
+            if dim == 1 {
+                return Err(CliError::Input(format!(
+                    "--mirror-line {}: a 1D scene has no control triangles",
+                    echo(line)
+                )));
+            }
+            s.mirror_line = parse_mirror_line(line)
+                .map_err(|m| CliError::Input(format!("--mirror-line: {m}")))?;
         }
         if let Some(layout) = &self.layout {
             let l = match layout.as_str() {

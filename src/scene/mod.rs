@@ -63,7 +63,7 @@
 
 use crate::bases::BasisKind;
 use crate::mass::MassKind;
-use psmpm_basis::basis::powell_sabin::SplitPoint;
+use psmpm_basis::basis::powell_sabin::{MirrorAxis, SplitPoint};
 use serde::{Deserialize, Serialize};
 
 mod annotate;
@@ -80,7 +80,7 @@ pub use annotate::annotate;
 pub use bodies::{region_polygon, DEFAULT_PER_TRIANGLE, MAX_SUBDIVIDE};
 pub use builtin::BUILTIN;
 pub use limits::{MAX_BLOCKS, MAX_PARTICLES};
-pub use names::{parse_split, split_to_str};
+pub use names::{mirror_line_to_str, parse_mirror_line, parse_split, split_to_str};
 
 /// A fully declared run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -99,6 +99,17 @@ pub struct Scene {
     /// PS split points (ignored by the other bases).
     #[serde(default, with = "names::split_name")]
     pub split: SplitPoint,
+    /// PS: the mirror line the control triangle keeps at a vertex whose PS points
+    /// are mirror-symmetric about both axis-aligned lines through it (the interior
+    /// vertices of the block grids), `vertical` or `horizontal`: the scene's own
+    /// mirror line, so that the mass strategies keep its symmetry
+    /// ([`psmpm_basis::basis::powell_sabin::MirrorAxis`]). Ignored by the other bases.
+    #[serde(
+        default,
+        with = "names::mirror_line_name",
+        skip_serializing_if = "names::is_vertical"
+    )]
+    pub mirror_line: MirrorAxis,
     /// Mass strategy.
     /// The mass strategy; absent means [`MassKind::default`] (extension).
     #[serde(with = "names::mass_name", default)]

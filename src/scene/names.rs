@@ -1,6 +1,7 @@
-//! How bases, mass strategies and split points are named in scene files.
+//! How bases, mass strategies, split points and mirror lines are named in scene
+//! files.
 
-use psmpm_basis::basis::powell_sabin::SplitPoint;
+use psmpm_basis::basis::powell_sabin::{MirrorAxis, SplitPoint};
 
 pub(super) mod basis_name {
     use crate::bases::BasisKind;
@@ -56,4 +57,41 @@ pub fn parse_split(name: &str) -> Result<SplitPoint, String> {
             super::limits::echo(other)
         )),
     }
+}
+
+pub(super) mod mirror_line_name {
+    use psmpm_basis::basis::powell_sabin::MirrorAxis;
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(m: &MirrorAxis, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(super::mirror_line_to_str(*m))
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<MirrorAxis, D::Error> {
+        let name = String::deserialize(d)?;
+        super::parse_mirror_line(&name).map_err(serde::de::Error::custom)
+    }
+}
+
+/// `vertical` or `horizontal`.
+pub fn mirror_line_to_str(m: MirrorAxis) -> &'static str {
+    match m {
+        MirrorAxis::Vertical => "vertical",
+        MirrorAxis::Horizontal => "horizontal",
+    }
+}
+
+/// Parses `vertical` or `horizontal`.
+pub fn parse_mirror_line(name: &str) -> Result<MirrorAxis, String> {
+    match name {
+        "vertical" => Ok(MirrorAxis::Vertical),
+        "horizontal" => Ok(MirrorAxis::Horizontal),
+        other => Err(format!(
+            "unknown mirror line `{}` (known: vertical, horizontal)",
+            super::limits::echo(other)
+        )),
+    }
+}
+
+/// `true` for the default mirror line (left out when a scene is written).
+pub(super) fn is_vertical(m: &MirrorAxis) -> bool {
+    *m == MirrorAxis::Vertical
 }

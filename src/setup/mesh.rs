@@ -48,7 +48,8 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let contacts = contact_walls(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
-            PowellSabin::<f64>::new(mesh, scene.split).map_err(|e| conflict("basis", e))?,
+            PowellSabin::<f64>::with_mirror(mesh, scene.split, scene.mirror_line)
+                .map_err(|e| conflict("basis", e))?,
         ),
         BasisKind::Pl => Basis2d::Linear(Linear::<f64>::new(mesh)),
         one_d @ (BasisKind::Bspline | BasisKind::Pl1d) => {

@@ -390,10 +390,10 @@ fn unknown_field_cases() -> Vec<Case> {
     vec![
         case("unknown-top-level-field", BAR)
             .edit("dim = 2\n", "dim = 2\n@@colour = \"red\"\n")
-            .expect("colour: unknown field `colour`, expected one of `name`, `description`, `dim`, `basis`, `split`, `mass`, `mesh`, `material`, `body`, `initial_velocity`, `boundary`, `effect`, `time`, `reference`, `output`, `resolution`, `study`"),
+            .expect("colour: unknown field `colour`, expected one of `name`, `description`, `dim`, `basis`, `split`, `mirror_line`, `mass`, `mesh`, `material`, `body`, `initial_velocity`, `boundary`, `effect`, `time`, `reference`, `output`, `resolution`, `study`"),
         case("unknown-top-level-table", BAR)
             .edit("[study]", "[@@solver]")
-            .expect("unknown field `solver`, expected one of `name`, `description`, `dim`, `basis`, `split`, `mass`, `mesh`, `material`, `body`, `initial_velocity`, `boundary`, `effect`, `time`, `reference`, `output`, `resolution`, `study`"),
+            .expect("unknown field `solver`, expected one of `name`, `description`, `dim`, `basis`, `split`, `mirror_line`, `mass`, `mesh`, `material`, `body`, `initial_velocity`, `boundary`, `effect`, `time`, `reference`, `output`, `resolution`, `study`"),
         case("unknown-field-in-mesh", BAR)
             .edit("[mesh]", "@@[mesh]")
             .edit("blocks = [4, 1]", "blocks = [4, 1]\nblock = [4, 1]")
@@ -522,6 +522,9 @@ fn unknown_name_cases() -> Vec<Case> {
         case("unknown-split-point", BAR)
             .edit("split = \"incentre\"", "split = @@\"orthocentre\"")
             .expect("split: unknown split point `orthocentre` (known: incentre, centroid)"),
+        case("unknown-mirror-line", BAR)
+            .edit("split = \"incentre\"", "split = \"incentre\"\nmirror_line = @@\"diagonal\"")
+            .expect("mirror_line: unknown mirror line `diagonal` (known: vertical, horizontal)"),
         case("unknown-resolution-basis", BAR)
             .edit("basis = \"pl\"", "basis = @@\"quadratic\"")
             .expect("resolution[0].basis: unknown basis `quadratic` (known: ps, pl, bspline, pl1d)"),

@@ -8,8 +8,9 @@
 //! - every triple of hull lines whose half-planes bound a triangle.
 //!
 //! The candidate of smallest area wins, except where the PS points are
-//! mirror-symmetric about the vertical (else the horizontal) line through `V_i`:
-//! there the smallest candidate with the same mirror symmetry wins, so that a mesh
+//! mirror-symmetric about the vertical or the horizontal line through `V_i`:
+//! there the smallest candidate with the same mirror symmetry wins (the
+//! [`MirrorAxis`] asked for where the points have both), so that a mesh
 //! symmetric about a line gets a basis symmetric about it (the smallest triangle of
 //! a symmetric point set is often not symmetric, and which way it points would
 //! otherwise be decided by the order of the hull). On a straight stretch of boundary only
@@ -181,14 +182,44 @@ pub const CORNER_AREA_RATIO: f64 = 4.0;
 ///
 /// Where the PS points are mirror-symmetric about the vertical line through
 /// `vertex` (else about the horizontal one), only candidates with that symmetry
-/// compete, when there is one (the private `Mirror` says why).
+/// compete, when there is one (the private `Mirror` says why); where they are
+/// symmetric about both, [`control_triangle_with`] chooses which.
 ///
 /// Ties between candidates of equal area go to the first one found (hull lines in
 /// counter-clockwise order from the lowest-leftmost point), so the choice is
 /// deterministic. `None` if no candidate contains the points (cannot happen on a
 /// valid mesh).
 pub fn control_triangle(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Option<[Vec2; 3]> {
-    let t = choose(vertex, points, kind)?;
+    control_triangle_with(vertex, points, kind, MirrorAxis::Vertical)
+}
+
+/// The mirror line a control triangle keeps where the PS points of its vertex are
+/// mirror-symmetric about both axis-aligned lines through it (the interior
+/// vertices of the block grids: their octagon of PS points has both symmetries,
+/// and no triangle has two mirror lines). A basis is mirror-symmetric about a line
+/// of a symmetric mesh only if the triangles of the vertices on it keep that
+/// line, and the mass strategies that treat rows one by one (lumping, the
+/// extension) keep a scene's symmetry only on a symmetric basis: the axis is the
+/// scene's mirror line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MirrorAxis {
+    /// A line `x = const`: a scene symmetric left to right (gravity along `y`).
+    #[default]
+    Vertical,
+    /// A line `y = const`: a scene symmetric top to bottom (bodies striking each
+    /// other along `x` about a horizontal mid-line, gravity along `x` or none).
+    Horizontal,
+}
+
+/// [`control_triangle`], keeping the line `axis` where the PS points are
+/// symmetric about both axis-aligned lines through `vertex`.
+pub fn control_triangle_with(
+    vertex: Vec2,
+    points: &[Vec2],
+    kind: VertexKind,
+    axis: MirrorAxis,
+) -> Option<[Vec2; 3]> {
+    let t = choose(vertex, points, kind, axis)?;
     // Enlarge about the vertex (see CONTROL_TRIANGLE_MARGIN).
     Some(t.map(|q| vertex + (q - vertex) * (1.0 + CONTROL_TRIANGLE_MARGIN)))
 }
@@ -205,15 +236,15 @@ pub fn control_triangle(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Opti
 pub const CONTROL_TRIANGLE_MARGIN: f64 = 1e-11;
 
 /// The unenlarged choice of [`control_triangle`].
-fn choose(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Option<[Vec2; 3]> {
+fn choose(vertex: Vec2, points: &[Vec2], kind: VertexKind, axis: MirrorAxis) -> Option<[Vec2; 3]> {
     match kind {
-        VertexKind::Interior => smallest_candidate(vertex, points, None),
-        VertexKind::Straight(h) => smallest_candidate(vertex, points, Some(h)),
+        VertexKind::Interior => smallest_candidate(vertex, points, None, axis),
+        VertexKind::Straight(h) => smallest_candidate(vertex, points, Some(h), axis),
         VertexKind::Corner(a, b) => {
             let corner = corner_candidate(vertex, points, &a, &b);
             let along = [a, b]
                 .iter()
-                .filter_map(|h| smallest_candidate(vertex, points, Some(*h)))
+                .filter_map(|h| smallest_candidate(vertex, points, Some(*h), axis))
                 .min_by(|s, t| area(s).total_cmp(&area(t)));
             match (corner, along) {
                 (Some(c), Some(s)) if area(&c) > CORNER_AREA_RATIO * area(&s) => Some(s),
@@ -267,8 +298,9 @@ fn corner_candidate(
 /// vertex of valence 8 the smallest ones lean left or right), so where the points
 /// are symmetric the choice is made among symmetric candidates: the basis of a
 /// block dropped onto the middle of a floor is then mirror-symmetric, and the block
-/// does not come back turning. Vertical first: it is the mirror of a scene under
-/// gravity along `y`.
+/// does not come back turning. Where the points have both mirrors, the
+/// [`MirrorAxis`] asked for (vertical by default: the mirror of a scene under
+/// gravity along `y`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Mirror {
     /// The line `x = vertex.x`.
@@ -293,9 +325,13 @@ impl Mirror {
         })
     }
 
-    /// The mirror of the vertex's PS points, vertical first, if they have one.
-    fn of(vertex: Vec2, points: &[Vec2], tol: f64) -> Option<Mirror> {
-        [Mirror::Vertical, Mirror::Horizontal]
+    /// The mirror of the vertex's PS points, if they have one; `axis` first.
+    fn of(vertex: Vec2, points: &[Vec2], tol: f64, axis: MirrorAxis) -> Option<Mirror> {
+        let order = match axis {
+            MirrorAxis::Vertical => [Mirror::Vertical, Mirror::Horizontal],
+            MirrorAxis::Horizontal => [Mirror::Horizontal, Mirror::Vertical],
+        };
+        order
             .into_iter()
             .find(|m| m.maps_onto_itself(vertex, points, tol))
     }
@@ -303,11 +339,13 @@ impl Mirror {
 
 /// The smallest candidate (wedge or triple of hull lines) containing `points`; with
 /// `required`, only candidates having that line as one of theirs. Where the points
-/// have a [`Mirror`], the smallest candidate with the same symmetry, if any.
+/// have a [`Mirror`], the smallest candidate with the same symmetry, if any (`axis`
+/// where they have both).
 fn smallest_candidate(
     vertex: Vec2,
     points: &[Vec2],
     required: Option<HalfPlane>,
+    axis: MirrorAxis,
 ) -> Option<[Vec2; 3]> {
     let tol = tolerance(vertex, points);
     let hull = convex_hull(points);
@@ -325,7 +363,7 @@ fn smallest_candidate(
         })
     });
     let allowed = |ids: &[usize]| required.is_none_or(|r| ids.contains(&r));
-    let mirror = Mirror::of(vertex, points, tol);
+    let mirror = Mirror::of(vertex, points, tol, axis);
     let mut best: Option<([Vec2; 3], f64)> = None;
     let mut best_mirrored: Option<([Vec2; 3], f64)> = None;
     let mut consider = |t: [Vec2; 3]| {

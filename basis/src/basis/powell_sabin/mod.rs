@@ -44,7 +44,8 @@ use crate::scalar::Real;
 #[cfg(doc)]
 use bezier::bernstein;
 use bezier::{hermite_ordinates, MainTriangle};
-use control_triangle::{control_triangle, HalfPlane, VertexKind};
+pub use control_triangle::MirrorAxis;
+use control_triangle::{control_triangle_with, HalfPlane, VertexKind};
 use nalgebra::Vector2;
 
 /// The triplets of one vertex (`ps-splines.md` §3): `φ^q` has value `alpha[q]` and
@@ -195,6 +196,18 @@ impl<T: Real> PowellSabin<T> {
     /// are not valid; [`BasisError::NoControlTriangle`] if no control triangle can be
     /// found (not expected on a valid mesh).
     pub fn new(mesh: TriMesh, split: SplitPoint) -> Result<Self, BasisError> {
+        Self::with_mirror(mesh, split, MirrorAxis::Vertical)
+    }
+
+    /// [`PowellSabin::new`], with the control triangles of the vertices whose PS
+    /// points are mirror-symmetric about both axis-aligned lines through them
+    /// keeping the line `axis` ([`MirrorAxis`]): a scene symmetric about a
+    /// horizontal line of a block grid asks for [`MirrorAxis::Horizontal`].
+    pub fn with_mirror(
+        mesh: TriMesh,
+        split: SplitPoint,
+        axis: MirrorAxis,
+    ) -> Result<Self, BasisError> {
         let refinement = Refinement::new(&mesh, split)?;
         let nv = mesh.num_vertices();
         let mut control = Vec::with_capacity(nv);
@@ -205,8 +218,8 @@ impl<T: Real> PowellSabin<T> {
             let points = refinement.ps_offsets(&mesh, v);
             let kind = vertex_kind(&mesh, v);
             let origin = Vec2::zeros();
-            let local = control_triangle(origin, &points, kind)
-                .or_else(|| control_triangle(origin, &points, VertexKind::Interior))
+            let local = control_triangle_with(origin, &points, kind, axis)
+                .or_else(|| control_triangle_with(origin, &points, VertexKind::Interior, axis))
                 .ok_or(BasisError::NoControlTriangle { vertex: v })?;
             let tr = Triplets::new(origin, &local);
             debug_check_triplets(origin, &local, &tr);
@@ -942,32 +955,33 @@ mod tests {
         assert!(PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).is_ok());
     }
 
-    /// A grid symmetric about a line has a basis symmetric about it: every function
-    /// has a mirror image among the functions (the one whose control point is the
-    /// mirrored one, at the mirrored vertex) with the mirrored values and gradients.
-    /// Without the symmetric choice of `control_triangle::Mirror` the valence-8
-    /// vertices of the block grid get triangles leaning left or right, and a block
-    /// dropped onto the middle of a floor comes back turning.
-    #[test]
-    fn a_mirror_symmetric_grid_has_a_mirror_symmetric_basis() {
-        let mesh = generators::block_grid(0.0, 4.0, 0.0, 3.0, 4, 3).unwrap();
-        let ps = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
-        let mirror = |p: Vec2| Vec2::new(4.0 - p.x, p.y);
+    /// Whether `ps` on the block grid `[0, 4] × [0, 3]` is mirror-symmetric about
+    /// the line `x = 2` (`axis = 0`) or `y = 1.5` (`axis = 1`): every function has a
+    /// mirror image among the functions (the one whose control point is the
+    /// mirrored one, at the mirrored vertex) with the mirrored values and
+    /// gradients. `Err` names the first function that has none.
+    fn mirror_symmetric(ps: &PowellSabin<f64>, axis: usize) -> Result<(), String> {
+        let mirror = |p: Vec2| {
+            let mut m = p;
+            m[axis] = [4.0, 3.0][axis] - p[axis];
+            m
+        };
         let vertices = ps.mesh().vertices();
-        let image: Vec<usize> = (0..ps.num_functions())
-            .map(|i| {
-                let v = i / 3;
-                let w = vertices
-                    .iter()
-                    .position(|p| (p - mirror(vertices[v])).norm() < 1e-12)
-                    .unwrap();
-                let q = mirror(ps.function_point(i));
+        let mut image = Vec::with_capacity(ps.num_functions());
+        for i in 0..ps.num_functions() {
+            let v = i / 3;
+            let w = vertices
+                .iter()
+                .position(|p| (p - mirror(vertices[v])).norm() < 1e-12)
+                .ok_or(format!("vertex {v}: no mirror image"))?;
+            let q = mirror(ps.function_point(i));
+            image.push(
                 (3 * w..3 * w + 3)
                     .find(|&j| (ps.function_point(j) - q).norm() < 1e-12)
-                    .unwrap_or_else(|| panic!("function {i} at vertex {v}: no mirror image"))
-            })
-            .collect();
-        let (mut a, mut b) = (BasisEval::for_basis(&ps), BasisEval::for_basis(&ps));
+                    .ok_or(format!("function {i} at vertex {v}: no mirror image"))?,
+            );
+        }
+        let (mut a, mut b) = (BasisEval::for_basis(ps), BasisEval::for_basis(ps));
         for k in 0..400 {
             // A deterministic scatter over the domain (additive recurrence).
             let x = Vec2::new(
@@ -988,17 +1002,36 @@ mod tests {
                     .find(|&t| b.index[t] == j)
                     .map_or((0.0, Vec2::zeros()), |t| (b.phi[t], b.grad_phi[t]));
                 let ga = a.grad_phi[s];
-                assert!(
-                    (a.phi[s] - phi_b).abs() < 1e-13
-                        && (ga.x + gb.x).abs() < 1e-12
-                        && (ga.y - gb.y).abs() < 1e-12,
-                    "function {} at {x:?}: {} {ga:?} against its image {j}: {} {gb:?}",
-                    a.index[s],
-                    a.phi[s],
-                    phi_b
-                );
+                let gb = mirror(gb) - mirror(Vec2::zeros());
+                if (a.phi[s] - phi_b).abs() >= 1e-13 || (ga - gb).norm() >= 1e-12 {
+                    return Err(format!(
+                        "function {} at {x:?}: {} {ga:?} against its image {j}: {} {gb:?}",
+                        a.index[s], a.phi[s], phi_b
+                    ));
+                }
             }
         }
+        Ok(())
+    }
+
+    /// A grid symmetric about a line has a basis symmetric about it. The interior
+    /// vertices of the block grid (valence 8) have PS points symmetric about both
+    /// axis-aligned lines, and a triangle keeps one: the vertical by default, the
+    /// horizontal when asked for ([`MirrorAxis`]). Without the symmetric choice of
+    /// `control_triangle::Mirror` those vertices get triangles leaning left or
+    /// right, and a block dropped onto the middle of a floor comes back turning.
+    #[test]
+    fn a_mirror_symmetric_grid_has_a_basis_symmetric_about_the_axis_asked_for() {
+        let mesh = generators::block_grid(0.0, 4.0, 0.0, 3.0, 4, 3).unwrap();
+        let vertical = PowellSabin::<f64>::new(mesh.clone(), SplitPoint::Incentre).unwrap();
+        let horizontal =
+            PowellSabin::<f64>::with_mirror(mesh, SplitPoint::Incentre, MirrorAxis::Horizontal)
+                .unwrap();
+        mirror_symmetric(&vertical, 0).unwrap();
+        mirror_symmetric(&horizontal, 1).unwrap();
+        // Each keeps only its own line.
+        assert!(mirror_symmetric(&vertical, 1).is_err());
+        assert!(mirror_symmetric(&horizontal, 0).is_err());
     }
 
     #[test]
