@@ -426,6 +426,29 @@ pub fn body_contact_warning(scene: &Scene) -> Option<String> {
 /// bodies are sampled by about one particle per element or fewer.
 pub const SPARSE_SAMPLING: f64 = 1.5;
 
+/// The warning for a fixed `time.dt` that does not divide `time.t_end`: the run
+/// takes the nearest whole number of steps, so it ends before or after `t_end`
+/// (a step `courant` sets is shortened to end exactly there instead).
+fn end_time_warning(scene: &Scene, dt: f64, steps: usize) -> Option<String> {
+    let t_end = scene.time.t_end;
+    scene.time.dt?;
+    let ends = steps as f64 * dt;
+    ((ends - t_end).abs() > 1e-9 * t_end).then(|| {
+        format!(
+            "time.dt = {} does not divide t_end = {}: the run takes {} of {} and ends at t = {}, {:.1e} of t_end {}; for t_end itself use dt = t_end / {} = {:e}",
+            crate::scene::limits::echo_number(dt),
+            crate::scene::limits::echo_number(t_end),
+            crate::scene::limits::plural(steps, "step", "steps"),
+            crate::scene::limits::echo_number(dt),
+            crate::scene::limits::echo_number(ends),
+            (ends - t_end).abs() / t_end,
+            if ends > t_end { "after it" } else { "before it" },
+            steps,
+            t_end / steps as f64,
+        )
+    })
+}
+
 /// The warning for bodies sampled by `sampling` particles per occupied element at
 /// the start, if that is below [`SPARSE_SAMPLING`].
 pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
@@ -672,7 +695,7 @@ fn tracked_warnings<const D: usize>(
             let spacing = particles.volume0.get(p)?.powf(1.0 / D as f64);
             (distance > 2.0 * spacing).then(|| {
                 format!(
-                    "output.tracked[{k}] at {} lies {distance:.3e} from the particle it tracks (particle {p} at {}, the nearest; {:.1} particle spacings away): put the point inside a body",
+                    "output.tracked[{k}] at {} lies {distance:.3e} from the particle it tracks (particle {p} at {}, the nearest; {} particle spacings away): put the point inside a body",
                     crate::driver::point(&point[..D]),
                     crate::driver::point(&t.x0[..D]),
                     echo_fixed(distance / spacing, 1)
@@ -1066,6 +1089,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             max_rotation,
             warnings: warnings
                 .into_iter()
+                .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(self_weight.clone())
                 .chain(sparse_sampling_warning(tally.sampling))
                 .chain(

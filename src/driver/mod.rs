@@ -151,6 +151,9 @@ where
     pub particles: Particles<T, D>,
     material: Mat,
     mass: M,
+    /// `walled[i]`: a wall (`fix`) constrains function `i`, for the message of a
+    /// particle that leaves the mesh through a wall.
+    walled: Vec<bool>,
     constraints: Constraints<T, D>,
     effects: Vec<Box<dyn Effect<T, D>>>,
     pattern: SymmetricPattern,
@@ -311,6 +314,7 @@ where
             fixed: &fixed,
             support: support.as_ref(),
         });
+        let walled = on_wall(n, &fixed, &general);
         let inputs = StrategyInputs {
             needs,
             touches_empty: vec![false; if needs.empty_elements { n } else { 0 }],
@@ -384,6 +388,7 @@ where
             work: 0.0,
             dissipated: 0.0,
             constraints: Constraints::new(general, n),
+            walled,
             inputs,
             last_condition: None,
             phases: PhaseTimes::default(),
@@ -532,6 +537,15 @@ where
             let hint = if self.effects.iter().any(|e| e.walls_element(from)) {
                 format!(
                     "it moved {moved:.3e} in the last step at speed {speed:.3e} and went through a contact wall, whose springs were too soft for the load or the speed: lower `time.courant` (impacts on contact walls want 0.25 or less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                )
+            } else if self
+                .basis
+                .element_functions(from)
+                .iter()
+                .any(|&i| self.walled[i])
+            {
+                format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went through a wall (`fix`) on that side: a wall holds the velocity of the functions on it, not of each particle, and a particle that moves a large part of an element in one step can cross it: lower `time.courant` (or `time.dt`); if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
             } else {
                 format!(

@@ -212,6 +212,38 @@ fn a_one_step_summary_says_1_step() {
     );
 }
 
+/// A fixed `dt` that does not divide `t_end` ends the run at a whole number of
+/// steps, before or after `t_end`: the run says so and gives the step that divides
+/// it (a user found the end time moved by 20 % without a word); one that divides
+/// it says nothing.
+#[test]
+fn a_fixed_step_that_does_not_divide_the_end_time_is_warned_about() {
+    let warnings = |dt: &str, t_end: &str| {
+        let out = cli()
+            .args([
+                "run",
+                "vibrating-bar",
+                "--dt",
+                dt,
+                "--t-end",
+                t_end,
+                "--diag-every",
+                "0",
+            ])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let late = warnings("3e-4", "5e-4");
+    assert!(
+        late.contains("warning: time.dt = 0.0003 does not divide t_end = 0.0005: the run takes 2 steps of 0.0003 and ends at t = 0.0006, 2.0e-1 of t_end after it; for t_end itself use dt = t_end / 2 = 2.5e-4"),
+        "{late}"
+    );
+    assert!(warnings("7e-4", "1e-3").contains("ends at t = 0.0007, 3.0e-1 of t_end before it"));
+    assert!(!warnings("1e-4", "5e-4").contains("does not divide"));
+}
+
 /// A negative value of a numeric option is taken as its value (not as an option of
 /// its own, with clap's tip to write `-- -1`) and refused naming the option and the
 /// values it takes: every numeric option of every command.
@@ -350,6 +382,62 @@ fn a_particle_leaving_the_mesh_is_a_numerical_failure_with_status_1() {
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
         stderr.contains("step ") && stderr.contains("time.dt"),
+        "{stderr}"
+    );
+}
+
+/// A very soft block (E = 10, ρ = 1) falling 2 m onto a no-slip floor at
+/// `courant = 0.5` (a user's scene): a particle crosses the floor in one step. The
+/// message said "add a wall on that side" although the floor is one; it now says
+/// that the particle went through the wall, and what to lower.
+#[test]
+fn a_particle_that_crosses_a_wall_is_not_told_to_add_one() {
+    let dir = std::env::temp_dir().join(format!("psmpm-through-wall-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("soft.toml");
+    std::fs::write(
+        &file,
+        r#"name = "soft"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [8, 8]
+[material]
+model = "neo-hookean"
+young = 10.0
+poisson = 0.3
+density = 1.0
+[[body]]
+min = [1.5, 2.0]
+max = [2.5, 3.0]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.5
+t_end = 2.0
+"#,
+    )
+    .unwrap();
+    let out = cli()
+        .args(["run", file.to_str().unwrap(), "--diag-every", "0"])
+        .output()
+        .unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("left the mesh")
+            && stderr.contains("went through a wall (`fix`) on that side")
+            && stderr.contains("lower `time.courant`")
+            && !stderr.contains("add a wall"),
         "{stderr}"
     );
 }
