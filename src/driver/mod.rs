@@ -321,7 +321,7 @@ where
             particle_volume: vec![0.0; if needs.coverage { n } else { 0 }],
             particle_count: vec![0.0; if needs.coverage { n } else { 0 }],
             on_wall: if needs.coverage {
-                on_wall(n, &fixed, &general)
+                walled.clone()
             } else {
                 Vec::new()
             },
