@@ -359,8 +359,9 @@ pub struct Verdict {
     growth: f64,
     /// Largest growth of [`StepReport::total_centred`].
     growth_centred: f64,
-    /// The first step (and its time) at which the growth of the time-centred
-    /// total reached [`STABLE_ENERGY_GROWTH`] of the energy scale seen so far.
+    /// The step (and its time) since which the growth of the time-centred total
+    /// has stayed at or above [`STABLE_ENERGY_GROWTH`] of the energy scale seen so
+    /// far.
     pub growth_crossed: Option<(usize, f64)>,
     /// Largest condition estimate seen.
     pub max_condition: Option<f64>,
@@ -407,10 +408,15 @@ impl Verdict {
         self.growth_centred = self
             .growth_centred
             .max(r.total_centred + unearned - self.e0);
-        if self.growth_crossed.is_none()
-            && self.growth_centred > 0.0
-            && self.growth_centred >= STABLE_ENERGY_GROWTH * self.scale()
-        {
+        // The scale widens over the run (it starts at the round-off floor for a
+        // body thrown in pure translation): a crossing that a wider scale undoes is
+        // forgotten, so the step reported is the one since which the growth has
+        // stayed at or above the bound.
+        let above =
+            self.growth_centred > 0.0 && self.growth_centred >= STABLE_ENERGY_GROWTH * self.scale();
+        if !above {
+            self.growth_crossed = None;
+        } else if self.growth_crossed.is_none() {
             self.growth_crossed = Some((r.step, r.time));
         }
         if let Some(c) = r.condition {

@@ -470,8 +470,11 @@ fn a_plate_vibrating_in_free_space_gains_little_energy_and_less_with_the_step() 
         }
         drift.push(s.energy_drift);
     }
+    // 4.2e-2 of the plate's energy about its centre of mass (the sine mode's
+    // mean velocity, 2.5 m/s, is a steady translation the scale leaves out since
+    // 2026-12-05; 9.0e-3 of the former scale, which held it).
     assert!(
-        drift[0] < 1.5e-2,
+        drift[0] < 5e-2,
         "courant 0.5: energy drift {:.3e}",
         drift[0]
     );
