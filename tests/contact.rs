@@ -101,7 +101,13 @@ fn a_disk_rolls_on_a_contact_floor_and_is_braked_by_a_slip_floor() {
                 velocity.x
             );
         }
-        let slip = spin_history(&rolling_disk(basis, SLIP));
+        // At `courant = 0.25`: at 0.5 the PL disk on the slip floor gains 10 % of
+        // its energy about its centre of mass, UNSTABLE since the verdict's scale
+        // leaves out the steady translation (`docs/stability.md`, "A steady
+        // translation does not widen the scale"); 3.3e-2 at 0.25.
+        let mut slip_scene = rolling_disk(basis, SLIP);
+        slip_scene.time.courant = Some(0.25);
+        let slip = spin_history(&slip_scene);
         let least = slip
             .iter()
             .map(|h| h.0 / spin0)

@@ -470,8 +470,11 @@ fn a_plate_vibrating_in_free_space_gains_little_energy_and_less_with_the_step() 
         }
         drift.push(s.energy_drift);
     }
+    // 4.2e-2 of the plate's energy about its centre of mass (the sine mode's
+    // mean velocity, 2.5 m/s, is a steady translation the scale leaves out since
+    // 2026-12-05; 9.0e-3 of the former scale, which held it).
     assert!(
-        drift[0] < 1.5e-2,
+        drift[0] < 5e-2,
         "courant 0.5: energy drift {:.3e}",
         drift[0]
     );
@@ -649,4 +652,91 @@ t_end = 2.0
         "{:?}",
         whole.warnings
     );
+}
+
+/// A 1D PL bar (E = 100, ρ = 1, [1, 3], 4 particles per element of 0.25) vibrating
+/// (a stretching `∂v/∂x = 0.5`, 0.083 J) while it translates at `speed` across the
+/// mesh, to t = 8 at `courant = 0.25`; with `speed` 0 at rest, with `gradient` 0 a
+/// pure translation.
+fn translating_bar(speed: f64, gradient: f64) -> String {
+    format!(
+        r#"
+name = "translating-bar"
+dim = 1
+basis = "pl1d"
+[mesh]
+kind = "interval"
+x = [0.0, 12.0]
+elements = 48
+[material]
+model = "linear-elastic"
+young = 100.0
+density = 1.0
+[[body]]
+min = [1.0]
+max = [3.0]
+per_block = [4]
+[initial_velocity]
+kind = "linear"
+value = [{speed:?}]
+origin = [2.0]
+gradient = [[{gradient:?}]]
+[time]
+courant = 0.25
+t_end = 8.0
+"#
+    )
+}
+
+/// The verdict's energy scale does not hold a steady translation
+/// (`diagnostics::Verdict`; `docs/stability.md`, "A steady translation does not
+/// widen the scale"). The vibrating bar crossing the mesh at 1 m/s gains about half
+/// of its vibration energy (PL's grid crossing), 3.7e-2 of a scale that held the
+/// translation's 1 J, and was judged stable: UNSTABLE now. At rest it gains 0.5 %:
+/// stable. A pure translation (no vibration, internal energy at round-off) stays
+/// stable by the scale's round-off floor.
+#[test]
+fn a_bar_that_gains_vibration_energy_while_translating_is_unstable() {
+    let judge = |speed: f64, gradient: f64| {
+        let text = translating_bar(speed, gradient);
+        run(&Scene::from_toml(&text, "bar.toml").unwrap(), &mut |_| {}).unwrap()
+    };
+    let moving = judge(1.0, 0.5);
+    assert!(moving.failure.is_none(), "{moving:?}");
+    assert!(!moving.stable, "{moving:?}");
+    // The gain against the vibration energy alone: tens of percent.
+    assert!(moving.energy_growth_centred > 0.2, "{moving:?}");
+    let rest = judge(0.0, 0.5);
+    assert!(rest.stable, "{rest:?}");
+    assert!(rest.energy_growth_centred < 1e-2, "{rest:?}");
+    let translation = judge(1.0, 0.0);
+    assert!(translation.stable, "{translation:?}");
+    assert!(translation.energy_growth_centred < 1e-3, "{translation:?}");
+}
+
+/// Each body's translation is its own: two such bars flying apart at ±1 m/s, whose
+/// total momentum is zero, are judged by their vibration (UNSTABLE), not by the
+/// kinetic energy of their translations; at rest, stable.
+#[test]
+fn two_bars_flying_apart_are_judged_by_their_vibration() {
+    let judge = |speed: f64| {
+        let bar = |min: f64, v: f64| {
+            format!(
+                "[[body]]\nmin = [{min:?}]\nmax = [{:?}]\nper_block = [4]\n[body.initial_velocity]\nkind = \"linear\"\nvalue = [{v:?}]\norigin = [{:?}]\ngradient = [[0.5]]\n",
+                min + 2.0,
+                min + 1.0
+            )
+        };
+        let text = format!(
+            "name = \"two-bars\"\ndim = 1\nbasis = \"pl1d\"\n[mesh]\nkind = \"interval\"\nx = [0.0, 24.0]\nelements = 96\n[material]\nmodel = \"linear-elastic\"\nyoung = 100.0\ndensity = 1.0\n{}{}[time]\ncourant = 0.25\nt_end = 8.0\n",
+            bar(9.0, -speed),
+            bar(13.0, speed)
+        );
+        run(&Scene::from_toml(&text, "bars.toml").unwrap(), &mut |_| {}).unwrap()
+    };
+    let apart = judge(1.0);
+    assert!(apart.failure.is_none(), "{apart:?}");
+    assert!(!apart.stable, "{apart:?}");
+    let rest = judge(0.0);
+    assert!(rest.stable, "{rest:?}");
 }

@@ -203,6 +203,9 @@ where
     /// Per-chunk sums of the particle terms of the step report's energies
     /// (written by [`phases::update_particles`]).
     energy_terms: Vec<[f64; 8]>,
+    /// The end (one past the last particle) of each body's particles, the bodies
+    /// stored one after another ([`Driver::set_body_sizes`]); empty for one body.
+    body_ends: Vec<usize>,
     /// Per-chunk sums `Σ_p m_p v_pⁿ · Δv_p` of the velocity update (phase 4), for
     /// the time-centred kinetic energy.
     centred_terms: Vec<f64>,
@@ -374,6 +377,7 @@ where
             dissipative_force: scratch(effects.iter().any(|e| e.does_work() && e.dissipative())),
             adjust: scratch(!effects.is_empty()),
             energy_terms: vec![[0.0; 8]; phases::chunks(np)],
+            body_ends: Vec::new(),
             centred_terms: vec![0.0; phases::chunks(np)],
             previous_energy: None,
             affine_gradient: vec![SMatrix::zeros(); if momentum_corrects { np } else { 0 }],
@@ -435,6 +439,22 @@ where
         }
         self.constraints = Constraints::new(general, self.basis.num_functions());
         Ok(())
+    }
+
+    /// Tells the driver which particles make up each body: `sizes[b]` particles of
+    /// body `b`, following those of the bodies before it. The step report's
+    /// translational energy ([`StepReport::translational`]) is then that of each
+    /// body's translation, summed; without it (or with sizes that do not add up to
+    /// the number of particles, which are ignored) the particles are one body.
+    pub fn set_body_sizes(&mut self, sizes: &[usize]) {
+        self.body_ends.clear();
+        if sizes.len() > 1 && sizes.iter().sum::<usize>() == self.particles.len() {
+            let mut end = 0;
+            self.body_ends.extend(sizes.iter().map(|&n| {
+                end += n;
+                end
+            }));
+        }
     }
 
     /// Current time.

@@ -184,6 +184,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
             first += n;
         }
     }
+    driver.set_body_sizes(&body_sizes);
     let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt)?;
     if let (Some(critical), None, false) = (
         dt_critical,
