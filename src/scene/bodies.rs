@@ -458,7 +458,7 @@ impl Scene {
     /// About how many particles `body` gets: exact for boxes, the cells of the
     /// bounding box (an upper bound) for polygons and disks, 0 for a Gmsh body (its
     /// count is checked once the file is read).
-    pub(super) fn estimated_particles(&self, body: &Body) -> f64 {
+    pub(crate) fn estimated_particles(&self, body: &Body) -> f64 {
         let Some((lo, hi)) = body.bounds() else {
             return 0.0;
         };

@@ -41,7 +41,15 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     if scene.dim != 2 {
         return Err(conflict("dim", format!("the scene is {}D", scene.dim)).into());
     }
+    if let Some(elements) = super::memory::generated_elements(scene) {
+        super::memory::check(scene, &super::memory::Counts::from_scene(scene, elements))?;
+    }
     let mesh = triangulation(scene)?;
+    // The basis is the larger part of a mesh's memory: checked before it is built.
+    super::memory::check(
+        scene,
+        &super::memory::Counts::from_scene(scene, mesh.num_triangles()),
+    )?;
     let h = smallest_edge(&mesh);
     check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
@@ -70,6 +78,7 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
     let MeshSpec::Interval { x, elements } = scene.mesh else {
         return Err(conflict("mesh.kind", "a 1D scene needs an `interval` mesh").into());
     };
+    super::memory::check(scene, &super::memory::Counts::from_scene(scene, elements))?;
     let mesh = Mesh1d::uniform(x[0], x[1], elements).map_err(|e| value("mesh", e))?;
     let h = (x[1] - x[0]) / elements as f64;
     // In 1D the normal of a wall is the axis.

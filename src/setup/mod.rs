@@ -8,6 +8,7 @@
 //! [`crate::simulation`] runs what this builds.
 
 mod effects;
+mod memory;
 mod mesh;
 mod particles;
 mod regions;
@@ -130,6 +131,20 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     }
     let solution = Solution::new(scene);
     let mut lattice = particle_lattice(scene)?;
+    // The driver's arrays, checked against the memory the process may use.
+    let copies = if scene.body_contact() {
+        lattice.body_sizes.len().max(1)
+    } else {
+        1
+    };
+    memory::check(
+        scene,
+        &memory::Counts::placed(
+            scene,
+            &lattice.body_sizes,
+            domain.basis.num_elements() / copies,
+        ),
+    )?;
     let material = materials::<D>(scene, &lattice)?;
     let mut origin = [0.0; 2];
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);

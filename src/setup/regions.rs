@@ -261,15 +261,20 @@ fn lattice_field(b: usize, body: &Body) -> String {
     format!("body[{b}].{name}")
 }
 
-/// The error of a body whose particles would pass [`MAX_PARTICLES`].
-fn too_many(b: usize, body: &Body) -> SceneError {
-    let field = if body.shape == BodyShape::Gmsh {
+/// The field that sets the particle count of body `b` (its lattice's, or a Gmsh
+/// body's `per_triangle`).
+pub(crate) fn count_field(b: usize, body: &Body) -> String {
+    if body.shape == BodyShape::Gmsh {
         format!("body[{b}].per_triangle")
     } else {
         lattice_field(b, body)
-    };
+    }
+}
+
+/// The error of a body whose particles would pass [`MAX_PARTICLES`].
+fn too_many(b: usize, body: &Body) -> SceneError {
     SceneError::new(
-        field,
+        count_field(b, body),
         ErrorKind::Value,
         format!("the bodies up to body[{b}] hold more than {MAX_PARTICLES} particles, the limit"),
     )

@@ -934,3 +934,61 @@ fn a_scene_error_leaves_nothing_in_out() {
     assert!(!stderr.contains("time.courant"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A valid scene (9e6 PS particles, under the particle limit) that needs more
+/// memory than the process may use is refused before anything large is allocated,
+/// naming the file, line and field, the memory needed and the limit, instead of
+/// aborting at an allocation ("memory allocation of … bytes failed", status 134,
+/// as a user found with `ulimit -v 1500000`). The limit is set for the child alone.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_scene_that_cannot_fit_in_the_memory_allowed_is_refused_with_the_reason() {
+    let dir = std::env::temp_dir().join(format!("psmpm-memory-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("huge.toml");
+    std::fs::write(
+        &file,
+        r#"name = "huge"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [64, 64]
+[material]
+model = "linear-elastic"
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.0, 1.0]
+max = [3.0, 3.0]
+per_block = [94, 94]
+[time]
+courant = 0.5
+t_end = 1.0
+"#,
+    )
+    .unwrap();
+    let out = std::process::Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -v 1500000 && exec \"$0\" \"$@\"",
+            assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
+            "run",
+            file.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    for part in [
+        "huge.toml:17:13: body[0].per_block: the run would need about 3.7 GB (9048064 particles",
+        "this process may still use by its address-space limit (`ulimit -v`)",
+        "give fewer particles",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+}
