@@ -370,25 +370,32 @@ struct Tally {
 pub const SELF_WEIGHT_STRAIN: f64 = 0.5;
 
 /// The warning for particles whose weight would strain the bodies by more than
-/// [`SELF_WEIGHT_STRAIN`]: the largest `ρ_p |g| H / E_p` over the particles, `H`
-/// the extent of all particles along `g`, `ρ_p` and `E_p` each particle's.
+/// [`SELF_WEIGHT_STRAIN`]: the largest `ρ_p |g| H / E_p` over the particles, `ρ_p`
+/// and `E_p` each particle's, `H` the height of all the bodies along `g`: the
+/// extent of the particles' centres plus the mean spacing (`√V⁰_p`, `V⁰_p` in 1D)
+/// of the lowest and the highest particle, so that a lattice filling a box of
+/// height 1 measures 1, not the 1 less a spacing between its outer centres.
+/// `law_of(p)` names the particle's law, which the message speaks of.
 pub fn self_weight_warning<const D: usize>(
     gravity: Option<&[f64]>,
     particles: &Particles<f64, D>,
     material: &impl crate::materials::ParticleMaterials<f64, D>,
+    law_of: impl Fn(usize) -> crate::scene::MaterialModel,
 ) -> Option<String> {
+    use crate::scene::MaterialModel;
     let g = gravity?;
     let g_norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
     if g_norm.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || particles.is_empty() {
         return None;
     }
     let along = |p: usize| (0..D).map(|k| particles.x0[p][k] * g[k]).sum::<f64>() / g_norm;
-    let (low, high) = (0..particles.len())
-        .map(along)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), s| {
-            (l.min(s), h.max(s))
+    let spacing = |p: usize| particles.volume0[p].powf(1.0 / D as f64);
+    let ((low, p_low), (high, p_high)) = (0..particles.len())
+        .map(|p| (along(p), p))
+        .fold(((f64::INFINITY, 0), (f64::NEG_INFINITY, 0)), |(l, h), s| {
+            (if s.0 < l.0 { s } else { l }, if s.0 > h.0 { s } else { h })
         });
-    let height = high - low;
+    let height = high - low + 0.5 * (spacing(p_low) + spacing(p_high));
     let (strain, p) = (0..particles.len())
         .map(|p| {
             let e = material.elastic(p);
@@ -397,8 +404,17 @@ pub fn self_weight_warning<const D: usize>(
         .max_by(|a, b| a.0.total_cmp(&b.0))?;
     (strain > SELF_WEIGHT_STRAIN).then(|| {
         let e = material.elastic(p);
+        let law = match law_of(p) {
+            MaterialModel::LinearElastic => {
+                "and beyond what the `linear-elastic` law models".to_string()
+            }
+            MaterialModel::Corotational => {
+                "and beyond what the `corotational` law models".to_string()
+            }
+            MaterialModel::NeoHookean => "the `neo-hookean` law takes them, but a body crushed to a fraction of its height by its own weight is seldom what was meant".to_string(),
+        };
         format!(
-            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {}, H = {} along g, E = {}), far beyond small strains (and beyond what the `linear-elastic` and `corotational` laws model): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
+            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {}, H = {} along g, E = {}), far beyond small strains ({law}): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
             echo_number(e.density),
             echo_number(g_norm),
             echo_fixed(height, 4),
@@ -1050,6 +1066,18 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
         scene.gravity().as_deref(),
         &driver.particles,
         driver.material(),
+        |p| {
+            let mut first = 0;
+            let body = run
+                .body_sizes
+                .iter()
+                .position(|&n| {
+                    first += n;
+                    p < first
+                })
+                .unwrap_or(0);
+            scene.body_material(body).model
+        },
     );
     Outcome {
         summary: Summary {
@@ -1138,6 +1166,42 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
 mod tests {
     use super::*;
     use nalgebra::Vector2;
+
+    /// A neo-Hookean box of height 1 (a 10 × 10 lattice of spacing 0.1, centres
+    /// from 0.05 to 0.95) is measured 1 tall, and the warning speaks of its own law
+    /// (a user's: "H = 0.875" for a box 1 tall, and the `linear-elastic` and
+    /// `corotational` laws named for a neo-Hookean body).
+    #[test]
+    fn the_self_weight_warning_measures_the_body_and_names_its_law() {
+        use crate::material::{Elastic, NeoHookean};
+        use crate::scene::MaterialModel;
+        let x: Vec<Vector2<f64>> = (0..100)
+            .map(|i| Vector2::new(0.05 + 0.1 * (i % 10) as f64, 0.05 + 0.1 * (i / 10) as f64))
+            .collect();
+        let particles = Particles::<f64, 2>::new(x, vec![0.01; 100], 1.0);
+        let soft = NeoHookean::new(Elastic::new(10.0, 0.3, 1.0).unwrap(), 2);
+        let warn = |law: MaterialModel| {
+            self_weight_warning(Some(&[0.0, -10.0]), &particles, &soft, |_| law).unwrap()
+        };
+        let neo = warn(MaterialModel::NeoHookean);
+        assert!(neo.contains("ρ |g| H / E = 1.0e0"), "{neo}");
+        assert!(neo.contains("H = 1.0000 along g"), "{neo}");
+        assert!(neo.contains("the `neo-hookean` law takes them"), "{neo}");
+        assert!(!neo.contains("corotational"), "{neo}");
+        let linear = warn(MaterialModel::LinearElastic);
+        assert!(
+            linear.contains("beyond what the `linear-elastic` law models"),
+            "{linear}"
+        );
+        // Stiff enough (strain 0.4): no warning.
+        let stiff = NeoHookean::new(Elastic::new(25.0, 0.3, 1.0).unwrap(), 2);
+        assert!(
+            self_weight_warning(Some(&[0.0, -10.0]), &particles, &stiff, |_| {
+                MaterialModel::NeoHookean
+            })
+            .is_none()
+        );
+    }
 
     /// A 10 × 10 lattice of spacing 0.1 has no stray particle, jittered by up to a
     /// third of its spacing neither; a particle flung 0.25 away from it is stray,
