@@ -928,8 +928,15 @@ fn error<const D: usize, B: Basis<f64, D>>(
 /// 2.8e-2 at 0.25; a disk thrown at a no-slip post 7.7e-2, 3.0e-2, 1.1e-2 at 0.4,
 /// 0.2, 0.1: `docs/stability.md`), and with fewer particles than functions per
 /// element it is larger (9.5 % at 3.6 particles per occupied element, 3.8 % with
-/// four times as many, measured on the total).
+/// four times as many, measured on the total). The step suggested is the one at
+/// which a growth falling in proportion to the step, `growth` now, would be 4 %:
+/// the step times `0.04 / growth`, between a quarter and a half of it (a soft block
+/// growing 0.104 at `courant = 0.5` grew 5.4e-2 at the 0.25 that halving gave, and
+/// held at 0.125, a user found; a growth that rises faster than the step, an
+/// instability, is not helped by less than a quarter either).
+#[allow(clippy::too_many_arguments)]
 pub fn energy_growth_hint(
+    growth: f64,
     crossed: Option<(usize, f64)>,
     steps: usize,
     dt: f64,
@@ -945,21 +952,29 @@ pub fn energy_growth_hint(
         None => String::new(),
     };
     let critical = dt_critical.filter(|c| c.is_finite() && *c > 0.0);
+    let factor = if growth.is_finite() && growth > 0.0 {
+        (0.04 / growth).clamp(0.25, 0.5)
+    } else {
+        0.5
+    };
+    let why = format!(
+        "a growth of {growth:.2e} that falls in proportion to the step would be 4 % there; if it does not, lower it again"
+    );
     let step = match (critical, from_courant) {
         (Some(critical), true) => format!(
-            "the time step is {:.2} of the critical step estimated at the start: lower `time.courant` (to {:.2}, say; `--courant` on the command line) or `time.dt`",
+            "the time step is {:.2} of the critical step estimated at the start: lower `time.courant` (to {:.2}, say: {why}; `--courant` on the command line) or `time.dt`",
             dt / critical,
-            dt / critical / 2.0
+            dt / critical * factor
         ),
         (Some(critical), false) => format!(
-            "the time step `time.dt` = {dt:.3e} is {:.2} of the critical step {critical:.3e} estimated at the start: lower `time.dt` (to {:.3e}, say, half of it; `--dt` on the command line)",
+            "the time step `time.dt` = {dt:.3e} is {:.2} of the critical step {critical:.3e} estimated at the start: lower `time.dt` (to {:.3e}, say: {why}; `--dt` on the command line)",
             dt / critical,
-            dt / 2.0
+            dt * factor
         ),
         (None, true) => "lower `time.courant` (`--courant` on the command line)".to_string(),
         (None, false) => format!(
-            "lower `time.dt` (now {dt:.3e}; to {:.3e}, say, half of it; `--dt` on the command line)",
-            dt / 2.0
+            "lower `time.dt` (now {dt:.3e}; to {:.3e}, say: {why}; `--dt` on the command line)",
+            dt * factor
         ),
     };
     let sampling = if particles_per_element < functions_per_element as f64 {
@@ -1034,6 +1049,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let energy_growth_hint =
         (failure.is_none() && tally.verdict.energy_bound_broken()).then(|| {
             energy_growth_hint(
+                tally.verdict.centred_growth(),
                 tally.verdict.growth_crossed,
                 run.driver.steps(),
                 run.dt,
@@ -1240,31 +1256,49 @@ mod tests {
     /// `dt`, not `courant`, which it does not give.
     #[test]
     fn the_energy_growth_hint_fits_the_step_and_the_sampling() {
-        let sparse = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), true, 4.5, 9);
+        let sparse =
+            energy_growth_hint(0.06, Some((120, 0.25)), 400, 1e-3, Some(2e-3), true, 4.5, 9);
         for part in [
             "it reached the bound at t = 0.2500 (step 120 of 400)",
             "the time step is 0.50 of the critical step",
-            "lower `time.courant` (to 0.25, say",
+            "lower `time.courant` (to 0.25, say: a growth of 6.00e-2 that falls in proportion to the step would be 4 % there",
             "4.5 per occupied element at the end, for the 9 functions of each",
         ] {
             assert!(sparse.contains(part), "`{part}` not in: {sparse}");
         }
-        let dense = energy_growth_hint(None, 400, 1e-3, None, false, 12.0, 3);
+        let dense = energy_growth_hint(0.06, None, 400, 1e-3, None, false, 12.0, 3);
         assert!(!dense.contains("per occupied element"), "{dense}");
         assert!(
-            dense.contains("lower `time.dt` (now 1.000e-3; to 5.000e-4, say, half of it; `--dt`")
+            dense.contains("lower `time.dt` (now 1.000e-3; to 5.000e-4, say: a growth of 6.00e-2")
                 && !dense.contains("reached")
                 && !dense.contains("courant"),
             "{dense}"
         );
-        let fixed = energy_growth_hint(Some((120, 0.25)), 400, 1e-3, Some(2e-3), false, 12.0, 3);
+        // A growth of 0.104 (a user's soft block at `courant = 0.5`, which halving
+        // the step did not hold and a quarter did): the step times 0.04 / 0.104.
+        let fixed = energy_growth_hint(
+            0.104,
+            Some((120, 0.25)),
+            400,
+            1e-3,
+            Some(2e-3),
+            false,
+            12.0,
+            3,
+        );
         for part in [
             "the time step `time.dt` = 1.000e-3 is 0.50 of the critical step 2.000e-3",
-            "lower `time.dt` (to 5.000e-4, say, half of it; `--dt` on the command line)",
+            "lower `time.dt` (to 3.846e-4, say: a growth of 1.04e-1",
         ] {
             assert!(fixed.contains(part), "`{part}` not in: {fixed}");
         }
         assert!(!fixed.contains("courant"), "{fixed}");
+        // An instability growing far faster than the step: no less than a quarter.
+        let fast = energy_growth_hint(0.9, None, 400, 1e-3, Some(2e-3), true, 12.0, 3);
+        assert!(
+            fast.contains("lower `time.courant` (to 0.12, say"),
+            "{fast}"
+        );
     }
 
     /// A lattice is one piece, stretched by half its spacing too; torn in two it is

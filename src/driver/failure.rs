@@ -276,8 +276,17 @@ where
                 ),
                 _ => String::new(),
             };
+            // Lumping keeps a smooth basis's rows from coupling through the empty
+            // parts of the support; a linear element's few functions are not helped
+            // by it (a user's PL block at one particle per element blew apart with
+            // `lumped`), nor is a mass that is lumped already.
+            let lumped = if functions > D + 1 && self.mass.spec() != "lumped" {
+                ", or `lumped`"
+            } else {
+                ""
+            };
             return Some(format!(
-                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`), or `lumped`{step}"
+                "the element around it inverted (speed {speed:.3e}); it holds {held} for the {functions} functions of the element, too few to sample them: use more particles per element (`per_block` or `count`; `--particles`){lumped}{step}"
             ));
         }
         None
