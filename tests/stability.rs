@@ -577,7 +577,7 @@ t_end = 0.5
         reason.contains("the body collapsed: det F fell to")
             && reason.contains("`corotational` law")
             && reason.contains("neo-hookean")
-            && reason.contains("ρ |g| H / E = 1.9e0"),
+            && reason.contains("ρ |g| H / E = 2.0e0 (ρ = 1000, |g| = 9.81, H = 0.6250 along g"),
         "{reason}"
     );
     // Stopped when the collapse was seen, before the run ended.

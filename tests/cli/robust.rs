@@ -11,7 +11,7 @@ mod common;
 mod common_cli;
 
 use common::temp_dir;
-use common_cli::cli;
+use common_cli::{cli, SceneFile};
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::process::Stdio;
@@ -943,11 +943,8 @@ fn a_scene_error_leaves_nothing_in_out() {
 #[test]
 #[cfg(target_os = "linux")]
 fn a_scene_that_cannot_fit_in_the_memory_allowed_is_refused_with_the_reason() {
-    let dir = std::env::temp_dir().join(format!("psmpm-memory-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("huge.toml");
-    std::fs::write(
-        &file,
+    let file = SceneFile::new(
+        "huge",
         r#"name = "huge"
 dim = 2
 basis = "ps"
@@ -969,19 +966,17 @@ per_block = [94, 94]
 courant = 0.5
 t_end = 1.0
 "#,
-    )
-    .unwrap();
+    );
     let out = std::process::Command::new("sh")
         .args([
             "-c",
             "ulimit -v 1500000 && exec \"$0\" \"$@\"",
             assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
             "run",
-            file.to_str().unwrap(),
+            file.arg(),
         ])
         .output()
         .unwrap();
-    std::fs::remove_dir_all(&dir).ok();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [

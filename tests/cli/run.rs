@@ -3,7 +3,7 @@
 #[path = "../common/cli.rs"]
 mod common_cli;
 
-use common_cli::{assert_success, cli, stability_scene};
+use common_cli::{assert_success, cli, stability_scene, SceneFile};
 use serde_json::Value;
 
 #[test]
@@ -392,11 +392,8 @@ fn a_particle_leaving_the_mesh_is_a_numerical_failure_with_status_1() {
 /// that the particle went through the wall, and what to lower.
 #[test]
 fn a_particle_that_crosses_a_wall_is_not_told_to_add_one() {
-    let dir = std::env::temp_dir().join(format!("psmpm-through-wall-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("soft.toml");
-    std::fs::write(
-        &file,
+    let file = SceneFile::new(
+        "soft",
         r#"name = "soft"
 dim = 2
 basis = "ps"
@@ -424,13 +421,11 @@ g = [0.0, -9.81]
 courant = 0.5
 t_end = 2.0
 "#,
-    )
-    .unwrap();
+    );
     let out = cli()
-        .args(["run", file.to_str().unwrap(), "--diag-every", "0"])
+        .args(["run", file.arg(), "--diag-every", "0"])
         .output()
         .unwrap();
-    std::fs::remove_dir_all(&dir).ok();
     assert_eq!(out.status.code(), Some(1), "{out:?}");
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
@@ -934,11 +929,8 @@ fn the_summary_has_the_courant_number_and_the_critical_step() {
 /// only.
 #[test]
 fn an_inverted_linear_element_is_not_offered_lumping() {
-    let dir = std::env::temp_dir().join(format!("psmpm-pl-invert-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("drop.toml");
-    std::fs::write(
-        &file,
+    let file = SceneFile::new(
+        "pl-invert",
         r#"name = "drop"
 dim = 2
 basis = "pl"
@@ -966,20 +958,11 @@ fix = ["y"]
 courant = 0.5
 t_end = 1.0
 "#,
-    )
-    .unwrap();
+    );
     let out = cli()
-        .args([
-            "run",
-            file.to_str().unwrap(),
-            "--diag-every",
-            "0",
-            "--threads",
-            "1",
-        ])
+        .args(["run", file.arg(), "--diag-every", "0", "--threads", "1"])
         .output()
         .unwrap();
-    std::fs::remove_dir_all(&dir).ok();
     assert_eq!(out.status.code(), Some(1), "{out:?}");
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(

@@ -60,3 +60,33 @@ t_end = 2.0
 [reference]
 kind = "column-equilibrium"
 "#;
+
+/// A scene file written to a fresh directory of its own (named after `name` and
+/// the process), removed with the directory when dropped.
+pub struct SceneFile {
+    dir: std::path::PathBuf,
+    /// The file, `FILE_NAME.toml` in the directory.
+    pub path: std::path::PathBuf,
+}
+
+impl SceneFile {
+    /// Writes `text` to `name.toml` in a new directory `psmpm-NAME-PID`.
+    pub fn new(name: &str, text: &str) -> SceneFile {
+        let dir = std::env::temp_dir().join(format!("psmpm-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        SceneFile { dir, path }
+    }
+
+    /// The file's path as text, for an argument list.
+    pub fn arg(&self) -> &str {
+        self.path.to_str().unwrap()
+    }
+}
+
+impl Drop for SceneFile {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.dir).ok();
+    }
+}
