@@ -471,9 +471,9 @@ pub enum MassMatrix {
 /// A field affine on the neighbour and zero at `D + 1` of its points `ξ` not on a
 /// line is zero: nothing is left free, and the plain share would only damp. Without
 /// the rule the corners of a spinning square, sweeping a block grid at 4 × 4
-/// particles per block, left a third of the lumped elements with one or two
-/// particles, and the square lost 10 % of its angular momentum by t = 3
-/// (`docs/stability.md`, "A spinning square's angular momentum").
+/// particles per block, left up to 20 of its 28 elements with lumped pairs with
+/// one or two particles, and the square lost 10 % of its angular momentum by
+/// t = 3 (`docs/stability.md`, "A spinning square's angular momentum").
 ///
 /// A basis whose functions are affine on every element (PL, `functions_affine`)
 /// spans exactly the affine fields there: `grad phi_k · (ξ_i − ξ_j) = δ_ki − δ_kj`,
