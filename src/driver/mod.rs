@@ -86,6 +86,8 @@ struct StrategyInputs {
     live: Vec<bool>,
     /// Scratch of [`phases::add_affine_lumping`], one per element.
     element_affine: Vec<bool>,
+    /// Scratch of [`phases::add_affine_lumping`], one per function.
+    function_pinned: Vec<bool>,
 }
 
 impl StrategyInputs {
@@ -337,6 +339,11 @@ where
             live: Vec::new(),
             element_affine: if needs.correction == Correction::InMass {
                 vec![false; basis.num_elements()]
+            } else {
+                Vec::new()
+            },
+            function_pinned: if needs.correction == Correction::InMass {
+                vec![false; basis.num_functions()]
             } else {
                 Vec::new()
             },
@@ -633,6 +640,7 @@ where
                     &self.bins,
                     self.inputs.touching.as_ref().unwrap(),
                     &mut self.inputs.element_affine,
+                    &mut self.inputs.function_pinned,
                     &self.gather,
                     &mut self.local,
                     &self.particles.mass,

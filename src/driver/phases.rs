@@ -461,6 +461,20 @@ pub enum MassMatrix {
 /// location made among them does not matter (`element_affine`: scratch, one per
 /// element).
 ///
+/// An element that does not pass but shares functions with one that does is
+/// pinned by it, and keeps the whole correction too when those shared functions'
+/// points `ξ` span an affine field (the same spread test, [`pinned_by_neighbours`];
+/// `function_pinned`: scratch, one per function). Each particle of a passing
+/// element `f` with a lumped function `i` makes every field in the null space of
+/// `M_A` affine on `f` (`gᵀc = 0` for the pairs `(i, j)`) and vanish at the
+/// particle: with `D + 1` particles not on a line, zero on all of `f`'s functions.
+/// A field affine on the neighbour and zero at `D + 1` of its points `ξ` not on a
+/// line is zero: nothing is left free, and the plain share would only damp. Without
+/// the rule the corners of a spinning square, sweeping a block grid at 4 × 4
+/// particles per block, left up to 20 of its 28 elements with lumped pairs with
+/// one or two particles, and the square lost 10 % of its angular momentum by
+/// t = 3 (`docs/stability.md`, "A spinning square's angular momentum").
+///
 /// A basis whose functions are affine on every element (PL, `functions_affine`)
 /// spans exactly the affine fields there: `grad phi_k · (ξ_i − ξ_j) = δ_ki − δ_kj`,
 /// so `g ≡ 0` and the affine-preserving term adds nothing, whatever the
@@ -482,6 +496,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     bins: &Bins,
     touching: &Touching,
     element_affine: &mut [bool],
+    function_pinned: &mut [bool],
     gather: &Gather,
     local: &mut Local<T, D>,
     mass: &[T],
@@ -504,6 +519,15 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                 *affine = (!inside.is_empty() || !on.is_empty())
                     && determines_affine(inside.iter().chain(on), mass, x, element_scale[e]);
             });
+        pinned_by_neighbours(
+            evals,
+            bins,
+            element_affine,
+            function_pinned,
+            points,
+            element_scale,
+            lumped,
+        );
     }
     let element_affine = &*element_affine;
     local.par_elements(bins).for_each(|(e, (lm, g))| {
@@ -609,6 +633,79 @@ fn determines_affine<'a, T: Scalar, const D: usize>(
         let d = x[p] - mean;
         s += d * d.transpose() * (mass[p] / total);
     }
+    let bound = T::of(AFFINE_SPREAD) * scale;
+    det(&s) >= (0..D).fold(T::one(), |acc, _| acc * bound)
+}
+
+/// The elements that hold particles but do not determine an affine field
+/// themselves and are pinned by a neighbour that does ([`add_affine_lumping`]):
+/// `element_affine[e]` is set for those whose functions shared with a passing
+/// element (one whose particles see a lumped function) have points `ξ` that pass
+/// the spread test of [`determines_affine`] (equal weights). Only the elements
+/// that passed by their own particles pin (one ring, no chain). Nothing is done
+/// in a step where every element holding particles passes.
+fn pinned_by_neighbours<T: Scalar, const D: usize>(
+    evals: &Evaluations<T, D>,
+    bins: &Bins,
+    element_affine: &mut [bool],
+    function_pinned: &mut [bool],
+    points: &[SVector<T, D>],
+    element_scale: &[T],
+    lumped: &[bool],
+) {
+    let first = |e: usize| bins.particles(e).first().map(|&p| p as usize);
+    let degenerate = element_affine
+        .par_iter()
+        .enumerate()
+        .any(|(e, &affine)| !affine && first(e).is_some());
+    if !degenerate {
+        return;
+    }
+    function_pinned.iter_mut().for_each(|f| *f = false);
+    for (e, _) in element_affine.iter().enumerate().filter(|(_, &a)| a) {
+        let Some(p) = first(e) else { continue };
+        let functions = evals.functions(p);
+        if functions.iter().any(|&i| lumped[i as usize]) {
+            for &i in functions {
+                function_pinned[i as usize] = true;
+            }
+        }
+    }
+    let function_pinned = &*function_pinned;
+    element_affine
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(e, affine)| {
+            if *affine {
+                return;
+            }
+            let Some(p) = first(e) else { return };
+            let shared = evals
+                .functions(p)
+                .iter()
+                .map(|&i| i as usize)
+                .filter(|&i| function_pinned[i])
+                .map(|i| points[i]);
+            *affine = spans_affine(shared, element_scale[e]);
+        });
+}
+
+/// The points `ξ` (equal weights) pass the spread test of [`determines_affine`]:
+/// at least `D + 1`, with `det S ≥ (α s_e)^D` for their covariance `S`.
+fn spans_affine<T: Scalar, const D: usize>(
+    points: impl Iterator<Item = SVector<T, D>> + Clone,
+    scale: T,
+) -> bool {
+    let count = points.clone().count();
+    if count < D + 1 {
+        return false;
+    }
+    let n = T::of(count as f64);
+    let mean = points.clone().fold(SVector::<T, D>::zeros(), |m, q| m + q) / n;
+    let s = points.fold(SMatrix::<T, D, D>::zeros(), |s, q| {
+        let d = q - mean;
+        s + d * d.transpose() / n
+    });
     let bound = T::of(AFFINE_SPREAD) * scale;
     det(&s) >= (0..D).fold(T::one(), |acc, _| acc * bound)
 }
