@@ -463,7 +463,7 @@ pub enum MassMatrix {
 ///
 /// An element that does not pass but shares functions with one that does is
 /// pinned by it, and keeps the whole correction too when those shared functions'
-/// points `ξ` span an affine field (the same spread test, [`pinned_by_neighbours`];
+/// points `ξ` span an affine field (the same spread test, `pinned_by_neighbours`;
 /// `function_pinned`: scratch, one per function). Each particle of a passing
 /// element `f` with a lumped function `i` makes every field in the null space of
 /// `M_A` affine on `f` (`gᵀc = 0` for the pairs `(i, j)`) and vanish at the
