@@ -202,6 +202,17 @@ fn write_error(path: &Path, e: std::io::Error) -> CliError {
 }
 
 /// The frame of `particles` for `particles.svg` (1D positions on the x axis).
+/// Bytes per particle a [`Recorder`] holds at most: the two frames of the particle
+/// picture (position, value and size: 32 B each) and, for binary `.vtu` frames, the
+/// frame being written ([`psmpm::output::vtk::BINARY_BYTES_PER_PARTICLE`]).
+pub fn bytes_per_particle(encoding: VtuEncoding) -> f64 {
+    2.0 * 32.0
+        + match encoding {
+            VtuEncoding::Binary => psmpm::output::vtk::BINARY_BYTES_PER_PARTICLE,
+            VtuEncoding::Ascii => 0.0,
+        }
+}
+
 fn frame_of(particles: ParticlesRef<'_>, time: f64, field: ParticleField) -> ParticleFrame {
     match particles {
         ParticlesRef::Two(p) => ParticleFrame::of(p, time, field),
@@ -385,7 +396,16 @@ impl Recorder {
             ParticlesRef::One(p) => self.dir.write_particles(time, p),
             ParticlesRef::Two(p) => self.dir.write_particles(time, p),
         }
-        .map_err(output_error)?;
+        .map_err(|e| match &e {
+            OutputError::Write { source, .. }
+                if source.kind() == std::io::ErrorKind::OutOfMemory =>
+            {
+                CliError::Input(format!(
+                    "step {step}: {e}: `--vtu ascii` writes the frames without holding them in memory; otherwise give fewer particles or run where more memory is allowed"
+                ))
+            }
+            _ => output_error(e),
+        })?;
         self.last_frame = Some(step);
         Ok(())
     }
@@ -399,15 +419,20 @@ impl Recorder {
         tracked: &[Tracked],
         last: ParticlesRef<'_>,
     ) -> Result<Vec<String>, CliError> {
-        if let Some(e) = self.error.take() {
-            return Err(e);
-        }
+        // The diagnostics so far are kept even when the run's output failed.
         let path = self.dir.file(DIAGNOSTICS_FILE);
         if let Some(w) = self.diagnostics.take() {
-            w.into_inner()
-                .map_err(|e| write_error(&path, std::io::Error::other(e.error().to_string())))?
-                .sync_all()
-                .map_err(|e| write_error(&path, e))?;
+            let flushed = w
+                .into_inner()
+                .map_err(|e| write_error(&path, std::io::Error::other(e.error().to_string())))
+                .and_then(|f| f.sync_all().map_err(|e| write_error(&path, e)));
+            if let Some(e) = self.error.take() {
+                return Err(e);
+            }
+            flushed?;
+        }
+        if let Some(e) = self.error.take() {
+            return Err(e);
         }
         if self.last_frame != Some(self.last_step) {
             self.frame(self.last_step, summary.t_end, last)?;

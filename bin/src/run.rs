@@ -549,7 +549,13 @@ fn diag_every(s: &Scene, args: &RunArgs) -> usize {
 /// options control checked, before anything is created or run ([`crate::check`]).
 pub fn prepare(args: &RunArgs) -> Result<Scene, CliError> {
     check_threads(args.threads)?;
-    let s = scene(args)?;
+    let mut s = scene(args)?;
+    if args.out.is_some() {
+        s.output.output_bytes_per_particle = out::bytes_per_particle(match args.vtu {
+            Vtu::Binary => VtuEncoding::Binary,
+            Vtu::Ascii => VtuEncoding::Ascii,
+        });
+    }
     check_sizes(&s, args, diag_every(&s, args))?;
     Ok(s)
 }

@@ -174,7 +174,8 @@ pub fn is_frame(name: &str) -> bool {
 }
 
 /// Creates (truncates) the file at `path`, hands a buffered writer to `write`, and
-/// flushes it; any io error is reported as [`OutputError::Write`] naming `path`.
+/// flushes it; any io error is reported as [`OutputError::Write`] naming `path`, and
+/// the file, written in part, is removed.
 pub fn write_file(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
@@ -184,8 +185,14 @@ pub fn write_file(
         source,
     };
     let mut w = BufWriter::new(File::create(path).map_err(wrap)?);
-    write(&mut w).map_err(wrap)?;
-    w.flush().map_err(wrap)
+    let written = write(&mut w).and_then(|()| w.flush());
+    if let Err(e) = written {
+        // A half-written file would read as a truncated one: it is removed.
+        drop(w);
+        let _ = std::fs::remove_file(path);
+        return Err(wrap(e));
+    }
+    Ok(())
 }
 
 /// An output directory: `mesh.vtu`, `particles_NNNNN.vtu` frames written at a
@@ -313,5 +320,25 @@ impl OutputDir {
         let path = self.file(Self::PVD_FILE);
         write_file(&path, |w| write_pvd(w, &self.frames))?;
         Ok(path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_whose_writing_fails_is_removed() {
+        let dir = std::env::temp_dir().join(format!("psmpm-write-fails-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("half.vtu");
+        let err = write_file(&path, |w| {
+            w.write_all(b"<?xml")?;
+            Err(io::Error::new(io::ErrorKind::OutOfMemory, "no memory"))
+        })
+        .unwrap_err();
+        assert!(matches!(err, OutputError::Write { .. }), "{err}");
+        assert!(!path.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -81,6 +81,12 @@ pub enum VtuEncoding {
 /// does, slow down with the square of the number of blocks of an array).
 pub const BLOCK_SIZE: usize = 1 << 20;
 
+/// Bytes per particle a binary particle frame holds in memory while it is written,
+/// at most: its 177 raw bytes (20 `Float64` values, two `Int64` and one `UInt8`),
+/// compressed (zlib adds at most 0.1 % to floats that do not compress) and encoded in
+/// base64 (4 characters per 3 bytes). Two buffers of one block come on top.
+pub const BINARY_BYTES_PER_PARTICLE: f64 = 240.0;
+
 /// zlib level of the binary `.vtu`: the fastest; the floats of a simulation barely
 /// compress at any level, the zero padding (`z`, the stress' third row and column)
 /// compresses at all of them.
@@ -127,15 +133,22 @@ impl VtkValue for u8 {
 
 /// Writes the XML of one `.vtu` file and, for [`VtuEncoding::Binary`], gathers the
 /// compressed arrays that [`Vtu::finish`] appends after it.
+///
+/// The binary arrays are compressed and encoded one block at a time, so that a frame
+/// holds only its encoded text ([`BINARY_BYTES_PER_PARTICLE`] at most) besides two
+/// buffers of one block; every buffer grows fallibly, a frame too large for the
+/// memory left being an [`io::ErrorKind::OutOfMemory`] error rather than an abort.
 struct Vtu<W: Write> {
     w: W,
     encoding: VtuEncoding,
     /// The `<AppendedData>` text so far (binary: base64).
     appended: Vec<u8>,
-    /// One array's raw bytes (binary; reused).
+    /// One block of an array's raw bytes (binary; reused).
     raw: Vec<u8>,
+    /// The compressed bytes not yet encoded: fewer than three carried from the last
+    /// block, then the block just compressed (binary; reused).
+    compressed: Vec<u8>,
 }
-
 impl<W: Write> Vtu<W> {
     /// Writes the XML declaration and opens the `UnstructuredGrid`.
     fn new(mut w: W, encoding: VtuEncoding) -> io::Result<Self> {
@@ -155,6 +168,7 @@ impl<W: Write> Vtu<W> {
             encoding,
             appended: Vec::new(),
             raw: Vec::new(),
+            compressed: Vec::new(),
         })
     }
 
@@ -200,16 +214,100 @@ impl<W: Write> Vtu<W> {
                     " format=\"appended\" offset=\"{}\"/>",
                     self.appended.len()
                 )?;
-                self.raw.clear();
-                self.raw.reserve(n * per_line * std::mem::size_of::<V>());
-                for i in 0..n {
-                    for k in 0..per_line {
-                        value(i, k).push_bytes(&mut self.raw);
-                    }
-                }
-                append_compressed(&mut self.appended, &self.raw)
+                self.appended_array(n, per_line, value)
             }
         }
+    }
+
+    /// Appends the array of `n` lines of `per_line` values `value(i, k)` as VTK's
+    /// zlib compressor does, in base64: the `UInt64` header `[blocks, BLOCK_SIZE,
+    /// size of the last block if partial (else 0), compressed size of each block]`,
+    /// then the zlib streams of the blocks, each of the two encoded on its own. The
+    /// header's place is kept (its length is known from the number of blocks) and
+    /// filled once the blocks are compressed.
+    fn appended_array<V: VtkValue>(
+        &mut self,
+        n: usize,
+        per_line: usize,
+        mut value: impl FnMut(usize, usize) -> V,
+    ) -> io::Result<()> {
+        let raw_len = n * per_line * std::mem::size_of::<V>();
+        let blocks = raw_len.div_ceil(BLOCK_SIZE);
+        let header_bytes = 8 * (3 + blocks);
+        let header_at = self.appended.len();
+        let header_text = base64_len(header_bytes);
+        grow(&mut self.appended, header_text)?;
+        self.appended.resize(header_at + header_text, 0);
+        let mut header: Vec<u64> = Vec::new();
+        header
+            .try_reserve_exact(3 + blocks)
+            .map_err(|_| out_of_memory(header_bytes))?;
+        header.extend([
+            blocks as u64,
+            BLOCK_SIZE as u64,
+            (raw_len % BLOCK_SIZE) as u64,
+        ]);
+        self.compressed.clear();
+        self.raw.clear();
+        grow(&mut self.raw, BLOCK_SIZE.min(raw_len))?;
+        // `BLOCK_SIZE` is a multiple of every value's size: a block ends on a value.
+        for i in 0..n {
+            for k in 0..per_line {
+                value(i, k).push_bytes(&mut self.raw);
+                if self.raw.len() == BLOCK_SIZE {
+                    header.push(self.compress_block()?);
+                }
+            }
+        }
+        if !self.raw.is_empty() {
+            header.push(self.compress_block()?);
+        }
+        self.encode(true)?;
+        let header: Vec<u8> = header.iter().flat_map(|h| h.to_le_bytes()).collect();
+        base64::Engine::encode_slice(
+            &BASE64,
+            header,
+            &mut self.appended[header_at..header_at + header_text],
+        )
+        .map_err(io::Error::other)?;
+        Ok(())
+    }
+
+    /// Compresses the block in `raw` onto `compressed`, encodes what it can and
+    /// returns the block's compressed size.
+    fn compress_block(&mut self) -> io::Result<u64> {
+        let carried = self.compressed.len();
+        // zlib's bound on a block's compressed size (`compressBound`), and a margin.
+        grow(
+            &mut self.compressed,
+            self.raw.len() + self.raw.len() / 1000 + 64,
+        )?;
+        let mut z =
+            flate2::write::ZlibEncoder::new(&mut self.compressed, flate2::Compression::new(LEVEL));
+        z.write_all(&self.raw)?;
+        z.finish()?;
+        self.raw.clear();
+        let size = (self.compressed.len() - carried) as u64;
+        self.encode(false)?;
+        Ok(size)
+    }
+
+    /// Encodes `compressed` onto `appended`: all of it with padding at the end of an
+    /// array (`last`), else its whole groups of three bytes, the rest carried.
+    fn encode(&mut self, last: bool) -> io::Result<()> {
+        let whole = if last {
+            self.compressed.len()
+        } else {
+            self.compressed.len() / 3 * 3
+        };
+        let text = base64_len(whole);
+        grow(&mut self.appended, text)?;
+        let at = self.appended.len();
+        self.appended.resize(at + text, 0);
+        base64::Engine::encode_slice(&BASE64, &self.compressed[..whole], &mut self.appended[at..])
+            .map_err(io::Error::other)?;
+        self.compressed.drain(..whole);
+        Ok(())
     }
 
     /// A `Float64` data array.
@@ -255,35 +353,28 @@ impl<W: Write> Vtu<W> {
     }
 }
 
-/// Appends `raw` compressed as VTK's zlib compressor does, in base64: the `UInt64`
-/// header `[blocks, BLOCK_SIZE, size of the last block if partial (else 0),
-/// compressed size of each block]`, then the zlib streams of the blocks, each of
-/// the two encoded on its own.
-fn append_compressed(appended: &mut Vec<u8>, raw: &[u8]) -> io::Result<()> {
-    use base64::Engine as _;
-    let blocks: Vec<Vec<u8>> = raw
-        .chunks(BLOCK_SIZE)
-        .map(|chunk| {
-            let mut z = flate2::write::ZlibEncoder::new(
-                Vec::with_capacity(chunk.len() / 2),
-                flate2::Compression::new(LEVEL),
-            );
-            z.write_all(chunk)?;
-            z.finish()
-        })
-        .collect::<io::Result<_>>()?;
-    let mut header = vec![
-        blocks.len() as u64,
-        BLOCK_SIZE as u64,
-        (raw.len() % BLOCK_SIZE) as u64,
-    ];
-    header.extend(blocks.iter().map(|b| b.len() as u64));
-    let header: Vec<u8> = header.iter().flat_map(|h| h.to_le_bytes()).collect();
-    let engine = &base64::engine::general_purpose::STANDARD;
-    let mut text = engine.encode(header);
-    engine.encode_string(blocks.concat(), &mut text);
-    appended.extend_from_slice(text.as_bytes());
-    Ok(())
+/// The base64 alphabet and padding of the appended data.
+const BASE64: base64::engine::GeneralPurpose = base64::engine::general_purpose::STANDARD;
+
+/// Length of the padded base64 text of `bytes` bytes.
+fn base64_len(bytes: usize) -> usize {
+    bytes.div_ceil(3) * 4
+}
+
+/// Makes room in `buffer` for `more` bytes, or says that the memory is lacking.
+fn grow(buffer: &mut Vec<u8>, more: usize) -> io::Result<()> {
+    buffer.try_reserve(more).map_err(|_| out_of_memory(more))
+}
+
+/// The error of a frame that does not fit in the memory left.
+fn out_of_memory(more: usize) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::OutOfMemory,
+        format!(
+            "no memory left for {} MB more of a compressed frame",
+            more.div_ceil(1_000_000)
+        ),
+    )
 }
 
 // ---------------------------------------------------------------------------
@@ -451,6 +542,64 @@ mod tests {
         let err =
             write_mesh_vtu(Vec::new(), &mesh, Some(("f", &[1.0])), VtuEncoding::Ascii).unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
+    }
+
+    /// The values of the appended `Float64` array at `offset` of a binary `.vtu`
+    /// text, decoded as a reader does (header, then the zlib blocks).
+    fn decode_f64_array(appended: &[u8], offset: usize) -> Vec<f64> {
+        use base64::Engine as _;
+        use std::io::Read as _;
+        let text = &appended[offset..];
+        let first = BASE64.decode(&text[..32]).unwrap();
+        let blocks = u64::from_le_bytes(first[..8].try_into().unwrap()) as usize;
+        let header_text = base64_len(8 * (3 + blocks));
+        let header = BASE64.decode(&text[..header_text]).unwrap();
+        let word = |k: usize| u64::from_le_bytes(header[8 * k..8 * k + 8].try_into().unwrap());
+        let compressed: usize = (0..blocks).map(|b| word(3 + b) as usize).sum();
+        let body = &text[header_text..header_text + base64_len(compressed)];
+        let body = BASE64.decode(body).unwrap();
+        let (mut raw, mut at) = (Vec::new(), 0);
+        for b in 0..blocks {
+            let size = word(3 + b) as usize;
+            flate2::read::ZlibDecoder::new(&body[at..at + size])
+                .read_to_end(&mut raw)
+                .unwrap();
+            at += size;
+        }
+        assert_eq!(word(1) as usize, BLOCK_SIZE);
+        assert_eq!(word(2) as usize, raw.len() % BLOCK_SIZE);
+        raw.chunks(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    }
+
+    #[test]
+    fn binary_arrays_of_many_blocks_read_back_exactly() {
+        // 2 × 10⁵ particles: the 9-component stress spans 14 blocks, the last partial.
+        let n = 200_000;
+        let x: Vec<_> = (0..n).map(|i| Vector1::new(i as f64 / n as f64)).collect();
+        let mut p = Particles::<f64, 1>::new(x, vec![1.0 / n as f64; n], 3.0);
+        for (i, s) in p.sigma.iter_mut().enumerate() {
+            s[(0, 0)] = (i as f64).sin();
+        }
+        let mut bytes = Vec::new();
+        write_particles_vtu(&mut bytes, &p, VtuEncoding::Binary).unwrap();
+        let text = String::from_utf8(bytes).unwrap();
+        let appended = text
+            .split_once("encoding=\"base64\">\n   _")
+            .unwrap()
+            .1
+            .as_bytes();
+        let offset_of = |name: &str| -> usize {
+            let tag = text.split_once(&format!("Name=\"{name}\"")).unwrap().1;
+            let value = tag.split_once("offset=\"").unwrap().1;
+            value[..value.find('"').unwrap()].parse().unwrap()
+        };
+        let stress = decode_f64_array(appended, offset_of("stress"));
+        assert_eq!(stress.len(), 9 * n);
+        assert!((0..n).all(|i| stress[9 * i] == (i as f64).sin() && stress[9 * i + 4] == 0.0));
+        let mass = decode_f64_array(appended, offset_of("mass"));
+        assert_eq!(mass, p.mass);
     }
 
     #[test]

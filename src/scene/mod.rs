@@ -707,6 +707,11 @@ pub struct OutputSpec {
     /// solves for the factorising strategies, 30 products for `extended`).
     #[serde(default)]
     pub condition: bool,
+    /// Bytes per particle the front end holds while it writes the run's output
+    /// (particle frames, pictures), counted in the memory check of the set-up; not
+    /// read from the file (0 for a run that writes none).
+    #[serde(skip)]
+    pub output_bytes_per_particle: f64,
 }
 
 /// An error in a scene, located in its file when it came from one.

@@ -256,7 +256,9 @@ pub(crate) fn check_against(
     let Some(room) = room else {
         return Ok(());
     };
-    let footprint = Footprint::of(scene.basis, scene.mass);
+    let mut footprint = Footprint::of(scene.basis, scene.mass);
+    let output = scene.output.output_bytes_per_particle.max(0.0);
+    footprint.per_particle += output;
     let particles: f64 = counts.bodies.iter().map(|b| b.1).sum();
     let per_element = footprint.per_element(counts.basis_built);
     let element_bytes = counts.elements * per_element;
@@ -296,11 +298,16 @@ pub(crate) fn check_against(
         field,
         ErrorKind::Value,
         format!(
-            "the run would need about {}{} ({} particles at {} B each and {} {element} at {} B each, `{}` basis, `{}` mass{}), more than the {} this process may still use by {}: {fix}, or run where more memory is allowed",
+            "the run would need about {}{} ({} particles at {} B each{}, {} {element} at {} B each, `{}` basis, `{}` mass{}), more than the {} this process may still use by {}: {fix}, or run where more memory is allowed",
             bytes(need),
             if counts.basis_built { " besides its mesh and basis" } else { "" },
             echo_number(particles),
             footprint.per_particle,
+            if output > 0.0 {
+                format!(", {output} of them to write the output")
+            } else {
+                String::new()
+            },
             echo_number(counts.elements),
             per_element,
             scene.basis.name(),

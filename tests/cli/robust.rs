@@ -986,4 +986,53 @@ t_end = 1.0
     ] {
         assert!(stderr.contains(part), "{part:?} not in {stderr}");
     }
+
+    // With `--out`, the buffers of the compressed frames count too: 1.44e6
+    // particles that fit in 1 GB without output are refused with it (they aborted
+    // at the first frame before).
+    let file = SceneFile::new(
+        "framed",
+        r#"name = "framed"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [0.0, 2.0]
+blocks = [8, 8]
+[material]
+young = 1e5
+poisson = 0.3
+density = 100.0
+[[body]]
+min = [0.75, 1.0]
+max = [1.25, 1.5]
+count = [1200, 1200]
+[time]
+courant = 0.4
+t_end = 0.8
+"#,
+    );
+    let dir = std::env::temp_dir().join(format!("psmpm-framed-out-{}", std::process::id()));
+    let out = std::process::Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -v 1000000 && exec \"$0\" \"$@\"",
+            assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
+            "run",
+            file.arg(),
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    for part in [
+        "framed.toml:16:9: body[0].count: the run would need about 1.0 GB (1440000 particles at 704 B each, 304 of them to write the output, 256 triangles",
+        "by its address-space limit (`ulimit -v`)",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
