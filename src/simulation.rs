@@ -475,6 +475,22 @@ pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
     })
 }
 
+/// Particles per occupied element at the start above which a run warns that the
+/// mesh, not the particles, sets its error: B4's error on h = 0.25 falls from 16 to
+/// 260 particles per element and then holds (1.96e-4 at 260, 1.9644e-4 at 1040;
+/// `docs/results.md`); the ladder study itself runs at 1040–1130.
+pub const DENSE_SAMPLING: f64 = 2500.0;
+
+/// The warning for bodies sampled by `sampling` particles per occupied element at
+/// the start, if that is above [`DENSE_SAMPLING`].
+pub fn dense_sampling_warning(sampling: f64) -> Option<String> {
+    (sampling > DENSE_SAMPLING).then(|| {
+        format!(
+            "the bodies are sampled by {sampling:.0} particles per occupied element at the start: the step's cost grows with the particles, but beyond a few hundred per element the error is set by the mesh (B4 on h = 0.25: 1.96e-4 at 260, 1.96e-4 at 1040); for accuracy refine the mesh (`blocks` or `edge_length`) and give a few dozen particles per element (`per_block`, `per_triangle`, `count` or `spacing`; `--particles`)"
+        )
+    })
+}
+
 /// How far, in its own spacing `√V⁰_p` (`V⁰_p` in 1D), a particle's nearest
 /// neighbour must be for it to count as stray ([`stray_particles`]).
 pub const STRAY_DISTANCE: f64 = 2.0;
@@ -1136,6 +1152,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(self_weight.clone())
                 .chain(sparse_sampling_warning(tally.sampling))
+                .chain(dense_sampling_warning(tally.sampling))
                 .chain(
                     (scene.basis == crate::bases::BasisKind::Ps)
                         .then(|| ps_sampling_warning(tally.sampling))
@@ -1187,6 +1204,17 @@ mod tests {
     /// from 0.05 to 0.95) is measured 1 tall, and the warning speaks of its own law
     /// (a user's: "H = 0.875" for a box 1 tall, and the `linear-elastic` and
     /// `corotational` laws named for a neo-Hookean body).
+    #[test]
+    fn sampling_far_above_the_studies_is_warned_about() {
+        assert!(
+            dense_sampling_warning(1130.0).is_none(),
+            "the B4 ladder's sampling"
+        );
+        let w = dense_sampling_warning(250_000.0).unwrap();
+        assert!(w.contains("250000 particles per occupied element"), "{w}");
+        assert!(w.contains("refine the mesh"), "{w}");
+    }
+
     #[test]
     fn the_self_weight_warning_measures_the_body_and_names_its_law() {
         use crate::material::{Elastic, NeoHookean};

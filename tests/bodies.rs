@@ -525,11 +525,24 @@ fn a_1d_scene_has_intervals_only() {
     let mut scene = Scene::builtin("vibrating-bar-1d").unwrap();
     scene.initial_velocity = psmpm::scene::InitialVelocity::RigidRotation {
         omega: 1.0,
-        centre: [0.0, 0.0],
+        centre: vec![0.0, 0.0],
     };
     let e = scene.validate().unwrap_err();
     assert_eq!(e.field, "initial_velocity.kind", "{e}");
     assert!(e.message.contains("needs a 2D scene"), "{e}");
+    // With a 1D centre, as a user of a 1D scene writes it: the same reason, not a
+    // length error.
+    let mut text = Scene::builtin("vibrating-bar-1d").unwrap().to_toml();
+    let at = text.find("[[body]]").unwrap();
+    text.insert_str(
+        at + "[[body]]\n".len(),
+        "initial_velocity = { kind = \"rigid-rotation\", omega = 1.0, centre = [1.0] }\n",
+    );
+    let e = Scene::from_toml(&text, "bar.toml").unwrap_err();
+    assert!(
+        e.message.contains("a rigid rotation needs a 2D scene"),
+        "{e}"
+    );
 }
 
 /// The rotation warning of a run with a spinning disk of law `disk` next to a block

@@ -47,12 +47,13 @@ pub struct CompareArgs {
     format: Format,
 }
 
-/// The variants of a comparison, in output order.
+/// The variants of a comparison of the scene read from `file`, in output order.
 pub fn variants(
     base: &Scene,
     bases: &[String],
     masses: &[String],
     overrides: &Overrides,
+    file: &str,
 ) -> Result<Vec<Scene>, CliError> {
     let bases: Vec<BasisKind> = if bases.is_empty() {
         BasisKind::ALL
@@ -94,7 +95,7 @@ pub fn variants(
         for &m in &masses {
             let mut s = with_basis.clone();
             s.mass = m;
-            out.push(overrides.apply(s)?);
+            out.push(overrides.apply(s, file)?);
         }
     }
     Ok(out)
@@ -164,7 +165,7 @@ const COLUMNS: [&str; 12] = [
 /// ([`crate::check`]).
 pub fn prepare(args: &CompareArgs) -> Result<Vec<Scene>, CliError> {
     let base = read_scene(&args.scene)?;
-    let scenes = variants(&base, &args.basis, &args.mass, &args.overrides)?;
+    let scenes = variants(&base, &args.basis, &args.mass, &args.overrides, &args.scene)?;
     if args.jobs == Some(0) {
         return Err(CliError::Input("--jobs must be at least 1".into()));
     }

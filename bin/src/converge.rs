@@ -358,7 +358,7 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
         Against::FinestLevel
     };
     let masses: Vec<String> = args.mass.iter().cloned().collect();
-    let bases = variants(&base, &args.basis, &masses, &args.overrides)?;
+    let bases = variants(&base, &args.basis, &masses, &args.overrides, &args.scene)?;
     let levels = bases
         .iter()
         .map(|scene| {

@@ -67,8 +67,9 @@ pub struct Overrides {
 const GMSH_BODIES_ONLY: &str = "every body is a Gmsh body (`shape = \"gmsh\"`), whose particles `per_triangle` and `subdivide` set; --particles sets the particles per block of box, polygon and disk bodies";
 
 impl Overrides {
-    /// Applies the overrides to `s` and validates it.
-    pub fn apply(&self, mut s: Scene) -> Result<Scene, CliError> {
+    /// Applies the overrides to `s`, read from `file` (a scene file or a built-in
+    /// name), and validates it.
+    pub fn apply(&self, mut s: Scene, file: &str) -> Result<Scene, CliError> {
         let dim = s.dim;
         let one_d = |flag: &str, text: &str, second: usize| {
             if dim == 1 && second != 1 {
@@ -146,16 +147,16 @@ impl Overrides {
             s.output.condition = true;
         }
         s.validate()
-            .map_err(|e| CliError::Input(self.name_flags(&e)))?;
+            .map_err(|e| CliError::Input(self.name_flags(&e, file)))?;
         Ok(s)
     }
 
     /// A validation error after the overrides, prefixed by the flags (and values)
-    /// that set the field.
-    fn name_flags(&self, e: &psmpm::scene::SceneError) -> String {
+    /// that set the field, else located in the scene file `file`.
+    fn name_flags(&self, e: &psmpm::scene::SceneError, file: &str) -> String {
         let flags = self.flags_of(e);
         if flags.is_empty() {
-            e.to_string()
+            locate(file, e)
         } else {
             format!("{}: {e}", flags.join(" "))
         }
@@ -167,18 +168,26 @@ impl Overrides {
         let mut flags = Vec::new();
         // The tracked history grows with the steps, which the time flags set.
         let history = field == "output.tracked" && e.message.contains("tracked points over");
-        if field.starts_with("time.") || history {
+        // The step's flags set `time.dt` and `time.courant`, and with the end time
+        // the number of steps (an end time shorter than one step, the history);
+        // `--t-end` sets only that. An error on a field no flag set is located in
+        // the file instead.
+        let steps = history || (field == "time.t_end" && e.message.contains("time step"));
+        if (field.starts_with("time.") && field != "time.t_end") || steps {
             if let Some(dt) = self.dt {
                 flags.push(format!("--dt {dt:?}"));
             }
             if let Some(c) = self.courant {
                 flags.push(format!("--courant {c:?}"));
             }
+        }
+        if field == "time.t_end" || history {
             if let Some(t) = self.t_end {
                 flags.push(format!("--t-end {t:?}"));
             }
         }
-        if field.starts_with("mesh.") {
+        // The critical step depends on the mesh.
+        if field.starts_with("mesh.") || (field == "time.dt" && e.message.contains("critical")) {
             if let Some(b) = &self.blocks {
                 flags.push(format!("--blocks {}", echo(b)));
             }
@@ -379,7 +388,7 @@ fn scene(args: &RunArgs) -> Result<Scene, CliError> {
     if let Some(m) = &args.mass {
         s.mass = MassKind::parse(m).map_err(|m| CliError::Input(format!("--mass: {m}")))?;
     }
-    args.overrides.apply(s)
+    args.overrides.apply(s, &args.scene)
 }
 
 /// A diagnostics row of `--format json`: the columns of `diagnostics.csv` as keys.

@@ -511,7 +511,7 @@ pub enum InitialVelocity {
         /// Angular velocity `ω`.
         omega: f64,
         /// Centre of rotation `c`.
-        centre: [f64; 2],
+        centre: Vec<f64>,
     },
     /// A linear field `v = v0 + G (x − x0)`: `value` at `origin`, plus `gradient`.
     Linear {

@@ -1486,11 +1486,39 @@ fn a_run_that_fails_numerically_exits_with_1_and_names_the_step() {
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
         stderr.starts_with(
-            "error: vibrating-bar with --dt 100.0 --t-end 1000.0: time.dt: the time step 100 is above the critical step 4.32"
+            "error: vibrating-bar with --dt 100.0: time.dt: the time step 100 is above the critical step 4.32"
         ),
         "{stderr}"
     );
     assert!(stderr.contains("--allow-above-critical"), "{stderr}");
+    // A flag that does not set the field leaves the error located in the file.
+    let file = common_cli::SceneFile::new(
+        "big-step",
+        &psmpm::scene::Scene::builtin("vibrating-bar")
+            .unwrap()
+            .to_toml()
+            .lines()
+            .map(|l| {
+                if l.starts_with("dt = ") {
+                    "dt = 1.0"
+                } else {
+                    l
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+    );
+    let out = cli()
+        .args(["run", file.arg(), "--t-end", "1000"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert!(
+        stderr.contains("big-step.toml:") && stderr.contains(": time.dt: the time step 1 is above"),
+        "{stderr}"
+    );
     // Run anyway: it fails at step 1 and says why.
     let out = cli()
         .args(["run", "vibrating-bar", "--dt", "100", "--t-end", "1000"])
