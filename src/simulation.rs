@@ -508,7 +508,7 @@ impl Spin {
     /// The spin of `particles`.
     pub fn of<const D: usize>(particles: &Particles<f64, D>) -> Spin {
         let total: f64 = particles.mass.iter().sum();
-        if D != 2 || !(total > 0.0) {
+        if D != 2 || total.is_nan() || total <= 0.0 {
             return Spin::default();
         }
         let (mut xc, mut vc) = ([0.0; 2], [0.0; 2]);
