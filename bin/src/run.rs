@@ -181,7 +181,11 @@ impl Overrides {
                 flags.push(format!("--courant {c:?}"));
             }
         }
-        if field == "time.t_end" || history {
+        // The number of steps (`t_end / dt`) is `--t-end`'s too.
+        if field == "time.t_end"
+            || history
+            || (field.starts_with("time.") && e.message.contains("t_end"))
+        {
             if let Some(t) = self.t_end {
                 flags.push(format!("--t-end {t:?}"));
             }
