@@ -1302,10 +1302,6 @@ mod tests {
     use super::*;
     use nalgebra::Vector2;
 
-    /// A neo-Hookean box of height 1 (a 10 × 10 lattice of spacing 0.1, centres
-    /// from 0.05 to 0.95) is measured 1 tall, and the warning speaks of its own law
-    /// (a user's: "H = 0.875" for a box 1 tall, and the `linear-elastic` and
-    /// `corotational` laws named for a neo-Hookean body).
     #[test]
     fn sampling_far_above_the_studies_is_warned_about() {
         assert!(
@@ -1317,6 +1313,10 @@ mod tests {
         assert!(w.contains("refine the mesh"), "{w}");
     }
 
+    /// A neo-Hookean box of height 1 (a 10 × 10 lattice of spacing 0.1, centres
+    /// from 0.05 to 0.95) is measured 1 tall, and the warning speaks of its own law
+    /// (a user's: "H = 0.875" for a box 1 tall, and the `linear-elastic` and
+    /// `corotational` laws named for a neo-Hookean body).
     #[test]
     fn the_self_weight_warning_measures_the_body_and_names_its_law() {
         use crate::material::{Elastic, NeoHookean};

@@ -201,7 +201,6 @@ fn write_error(path: &Path, e: std::io::Error) -> CliError {
     })
 }
 
-/// The frame of `particles` for `particles.svg` (1D positions on the x axis).
 /// Bytes per particle a [`Recorder`] holds at most: the two frames of the particle
 /// picture (position, value and size: 32 B each) and, for binary `.vtu` frames, the
 /// frame being written ([`psmpm::output::vtk::BINARY_BYTES_PER_PARTICLE`]).
@@ -213,6 +212,7 @@ pub fn bytes_per_particle(encoding: VtuEncoding) -> f64 {
         }
 }
 
+/// The frame of `particles` for `particles.svg` (1D positions on the x axis).
 fn frame_of(particles: ParticlesRef<'_>, time: f64, field: ParticleField) -> ParticleFrame {
     match particles {
         ParticlesRef::Two(p) => ParticleFrame::of(p, time, field),
@@ -419,21 +419,19 @@ impl Recorder {
         tracked: &[Tracked],
         last: ParticlesRef<'_>,
     ) -> Result<Vec<String>, CliError> {
-        // The diagnostics so far are kept even when the run's output failed.
+        // The diagnostics so far are kept even when the run's output failed (whose
+        // error comes first).
         let path = self.dir.file(DIAGNOSTICS_FILE);
-        if let Some(w) = self.diagnostics.take() {
-            let flushed = w
-                .into_inner()
-                .map_err(|e| write_error(&path, std::io::Error::other(e.error().to_string())))
-                .and_then(|f| f.sync_all().map_err(|e| write_error(&path, e)));
-            if let Some(e) = self.error.take() {
-                return Err(e);
-            }
-            flushed?;
-        }
+        let flushed = self.diagnostics.take().map_or(Ok(()), |w| {
+            w.into_inner()
+                .map_err(|e| write_error(&path, std::io::Error::other(e.error().to_string())))?
+                .sync_all()
+                .map_err(|e| write_error(&path, e))
+        });
         if let Some(e) = self.error.take() {
             return Err(e);
         }
+        flushed?;
         if self.last_frame != Some(self.last_step) {
             self.frame(self.last_step, summary.t_end, last)?;
         }

@@ -281,6 +281,15 @@ pub enum Vtu {
     Ascii,
 }
 
+impl From<Vtu> for VtuEncoding {
+    fn from(vtu: Vtu) -> VtuEncoding {
+        match vtu {
+            Vtu::Binary => VtuEncoding::Binary,
+            Vtu::Ascii => VtuEncoding::Ascii,
+        }
+    }
+}
+
 /// Parses `AxB`.
 pub fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
     let bad = || CliError::Input(format!("{what} must look like 4x1, got `{}`", echo(text)));
@@ -564,10 +573,7 @@ pub fn prepare(args: &RunArgs) -> Result<Scene, CliError> {
     check_threads(args.threads)?;
     let mut s = scene(args)?;
     if args.out.is_some() {
-        s.output.output_bytes_per_particle = out::bytes_per_particle(match args.vtu {
-            Vtu::Binary => VtuEncoding::Binary,
-            Vtu::Ascii => VtuEncoding::Ascii,
-        });
+        s.output.output_bytes_per_particle = out::bytes_per_particle(args.vtu.into());
     }
     check_sizes(&s, args, diag_every(&s, args))?;
     Ok(s)
@@ -588,10 +594,7 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             let options = out::OutOptions {
                 every: args.out_every,
                 overwrite: args.overwrite,
-                encoding: match args.vtu {
-                    Vtu::Binary => VtuEncoding::Binary,
-                    Vtu::Ascii => VtuEncoding::Ascii,
-                },
+                encoding: args.vtu.into(),
                 picture: ParticleField::parse(&args.picture, s.dim)
                     .map_err(|e| CliError::Input(format!("--picture: {e}")))?,
             };

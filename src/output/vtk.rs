@@ -149,6 +149,7 @@ struct Vtu<W: Write> {
     /// block, then the block just compressed (binary; reused).
     compressed: Vec<u8>,
 }
+
 impl<W: Write> Vtu<W> {
     /// Writes the XML declaration and opens the `UnstructuredGrid`.
     fn new(mut w: W, encoding: VtuEncoding) -> io::Result<Self> {
