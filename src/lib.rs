@@ -59,6 +59,7 @@
 
 pub use psmpm_basis as basis;
 
+pub mod arrangement;
 pub mod bases;
 pub mod body_contact;
 pub mod contact;

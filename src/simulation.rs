@@ -19,6 +19,10 @@
 //! body force does not change the verdict: [`crate::diagnostics::Verdict`]), and
 //! every condition estimate (when requested) stays below [`STABLE_CONDITION`].
 
+pub use crate::arrangement::{
+    fragments, pieces, pieces_warning, stray_particles, stray_warning, Fragments, STRAY_DISTANCE,
+    STRAY_WARNING,
+};
 use crate::body_contact::PerBody;
 use crate::diagnostics::Verdict;
 use crate::driver::{PhaseTimes, StepError, StepReport};
@@ -126,6 +130,11 @@ pub struct Summary {
     /// Not in the JSON summary (the warning carries it when it matters).
     #[serde(skip)]
     pub max_rotation: f64,
+    /// How far the particles left the arrangement they started in at the end
+    /// ([`crate::arrangement::irregularity`]). Not in the JSON summary (the warning
+    /// carries it when it matters).
+    #[serde(skip)]
+    pub irregularity: crate::arrangement::Irregularity,
     /// Warnings about the run, each once: the paper's non-objective law
     /// (`linear-elastic`) under a rotation above [`crate::material::ROTATION_WARNING`].
     /// In the JSON summary only when there is one.
@@ -572,166 +581,6 @@ pub fn spin_loss_warning(scene: &Scene, start: Spin, end: Spin) -> Option<String
         )
     })
 }
-
-/// How far, in its own spacing `√V⁰_p` (`V⁰_p` in 1D), a particle's nearest
-/// neighbour must be for it to count as stray ([`stray_particles`]).
-pub const STRAY_DISTANCE: f64 = 2.0;
-
-/// Calls `pair(p, q)` for each particle `q` within [`STRAY_DISTANCE`] times the
-/// spacing `√V⁰_p` of particle `p` (`V⁰_p` in 1D): a hash grid of cells of that
-/// distance (the largest particle's), the 3^D cells around each particle. `false`
-/// when the particles have no size to measure by.
-fn neighbours<const D: usize>(
-    particles: &Particles<f64, D>,
-    mut pair: impl FnMut(usize, usize),
-) -> bool {
-    let spacing = |p: usize| particles.volume0[p].powf(1.0 / D as f64);
-    let reach = (0..particles.len()).map(spacing).fold(0.0, f64::max) * STRAY_DISTANCE;
-    if !(reach > 0.0 && reach.is_finite()) {
-        return false;
-    }
-    let cell = |p: usize| -> [i64; D] {
-        std::array::from_fn(|k| (particles.x[p][k] / reach).floor() as i64)
-    };
-    let mut grid: std::collections::HashMap<[i64; D], Vec<usize>> = Default::default();
-    for p in 0..particles.len() {
-        grid.entry(cell(p)).or_default().push(p);
-    }
-    for p in 0..particles.len() {
-        let (c, r) = (cell(p), STRAY_DISTANCE * spacing(p));
-        for n in 0..3usize.pow(D as u32) {
-            let key: [i64; D] =
-                std::array::from_fn(|k| c[k] + ((n / 3usize.pow(k as u32)) % 3) as i64 - 1);
-            for &q in grid.get(&key).map_or(&[][..], |v| &v[..]) {
-                if q != p && (particles.x[q] - particles.x[p]).norm() <= r {
-                    pair(p, q);
-                }
-            }
-        }
-    }
-    true
-}
-
-/// What the neighbour relation of the particles (a particle and those within
-/// [`STRAY_DISTANCE`] times its spacing) says of them, from one pass over it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Fragments {
-    /// Particles with no other particle within [`STRAY_DISTANCE`] times their own
-    /// spacing: none in a body sampled on a lattice or jittered in its cells; one
-    /// for each particle a body that came apart flung off alone.
-    pub stray: usize,
-    /// The sizes of the pieces the particles form, largest first: the connected
-    /// sets of the relation, counting those of at least 3 particles and
-    /// [`STRAY_WARNING`] of all. One per body on a lattice, stretched by up to
-    /// about twice its spacing; two for a body torn in two.
-    pub pieces: Vec<usize>,
-}
-
-/// The [`Fragments`] of `particles`: the neighbour relation walked once, marking
-/// the particles with a neighbour and joining the pieces (union–find). The pieces
-/// are those of each body: `body_sizes` are the numbers of particles of the bodies,
-/// whose particles follow each other in that order (empty: one body), and
-/// neighbours of different bodies are not joined, so bodies that start in contact
-/// and part stay one piece each, while a body torn in two is two.
-pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[usize]) -> Fragments {
-    fn root(parent: &mut [usize], mut a: usize) -> usize {
-        while parent[a] != a {
-            parent[a] = parent[parent[a]];
-            a = parent[a];
-        }
-        a
-    }
-    let n = particles.len();
-    // The body of each particle, where there are several (no buffer for one: the
-    // run's peak memory per particle counts it).
-    let mut body = Vec::new();
-    if body_sizes.len() > 1 && body_sizes.iter().sum::<usize>() == n {
-        body = vec![0u32; n];
-        let mut first = 0;
-        for (b, &size) in body_sizes.iter().enumerate() {
-            body[first..first + size].fill(b as u32);
-            first += size;
-        }
-    }
-    let mut near = vec![false; n];
-    let mut parent: Vec<usize> = (0..n).collect();
-    let measured = neighbours(particles, |p, q| {
-        near[p] = true;
-        if !body.is_empty() && body[p] != body[q] {
-            return;
-        }
-        let (a, b) = (root(&mut parent, p), root(&mut parent, q));
-        if a != b {
-            parent[a.max(b)] = a.min(b);
-        }
-    });
-    if !measured {
-        return Fragments {
-            stray: 0,
-            pieces: Vec::new(),
-        };
-    }
-    let mut size = vec![0usize; n];
-    for p in 0..n {
-        size[root(&mut parent, p)] += 1;
-    }
-    let least = 3.max((STRAY_WARNING * n as f64).ceil() as usize);
-    let mut pieces: Vec<usize> = size.into_iter().filter(|&s| s >= least).collect();
-    pieces.sort_unstable_by(|a, b| b.cmp(a));
-    Fragments {
-        stray: near.iter().filter(|&&n| !n).count(),
-        pieces,
-    }
-}
-
-/// [`Fragments::stray`] of `particles`.
-pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
-    fragments(particles, &[]).stray
-}
-
-/// [`Fragments::pieces`] of `particles`, taken as one body.
-pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
-    fragments(particles, &[]).pieces
-}
-
-/// The warning for a run whose particles form more [`pieces`] at the end (`end`,
-/// their sizes) than at the start (`start`): a body came apart, torn where it was
-/// stretched or broken at an impact, which an energy verdict of stable does not
-/// show (a soft neo-Hookean block hanging from a no-slip ceiling at 4 × 4 particles
-/// per block tore below its top rows and fell, its energy bounded).
-pub fn pieces_warning(start: usize, end: &[usize], particles: usize) -> Option<String> {
-    (end.len() > start).then(|| {
-        let shares: Vec<String> = end
-            .iter()
-            .take(4)
-            .map(|&s| format!("{:.0} %", 100.0 * s as f64 / particles as f64))
-            .collect();
-        let more = if end.len() > 4 { ", …" } else { "" };
-        format!(
-            "the particles form {} pieces at the end ({start} at the start), holding {}{more} of them: a body came apart (torn where it was stretched, or broken at an impact), which the energy verdict does not show: look at the particles (`--out`); a body torn where it stretches needs more particles per element there (`per_block`, `count` or `spacing`), one broken at an impact also a smaller `courant`",
-            end.len(),
-            shares.join(", ")
-        )
-    })
-}
-
-/// The warning for a run that ends with `end` stray particles
-/// ([`stray_particles`]) of `particles`, `start` of them at
-/// the start: when at least [`STRAY_WARNING`] of the particles (and 3) became stray,
-/// the bodies came apart, which an energy verdict of stable does not show (a soft
-/// neo-Hookean disk, E = 2e3, dropped onto a contact floor at 4 particles per
-/// triangle, ended with its particles scattered).
-pub fn stray_warning(start: usize, end: usize, particles: usize) -> Option<String> {
-    let new = end.saturating_sub(start);
-    (new >= 3 && new as f64 >= STRAY_WARNING * particles as f64).then(|| {
-        format!(
-            "{end} of the {particles} particles ended stray ({start} at the start): no other particle within {STRAY_DISTANCE} times their own spacing; the bodies came apart (fragments or single particles flung off), which the energy verdict does not show: look at the particles (`--out`), and for a soft body use more particles per element (`per_block`, `count` or `spacing`) and a smaller `courant`"
-        )
-    })
-}
-
-/// The share of the particles that must become stray for [`stray_warning`].
-pub const STRAY_WARNING: f64 = 0.01;
 
 /// Particles per occupied triangle at the start below which a PS run warns that its
 /// error can grow with refinement.
@@ -1184,6 +1033,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
         ),
     );
     let at_end = fragments(&driver.particles, &run.body_sizes);
+    let irregularity = crate::arrangement::irregularity(&driver.particles, &run.body_sizes);
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
@@ -1237,6 +1087,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 None => e.to_string(),
             }),
             max_rotation,
+            irregularity,
             warnings: warnings
                 .into_iter()
                 .chain(end_time_warning(scene, run.dt, run.steps))
@@ -1262,6 +1113,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .chain(body_contact_warning(scene))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
+                .chain(crate::arrangement::irregularity_warning(
+                    &irregularity,
+                    scene.basis == crate::bases::BasisKind::Ps,
+                    tally.sampling,
+                ))
                 .chain(stray_warning(
                     tally.stray_at_start,
                     at_end.stray,
@@ -1349,37 +1205,6 @@ mod tests {
         );
     }
 
-    /// A 10 × 10 lattice of spacing 0.1 has no stray particle, jittered by up to a
-    /// third of its spacing neither; a particle flung 0.25 away from it is stray,
-    /// and the warning asks for 1 % of the particles and 3.
-    #[test]
-    fn a_particle_flung_off_a_lattice_is_stray() {
-        let lattice = |jitter: f64, flung: usize| {
-            let x: Vec<Vector2<f64>> = (0..100)
-                .map(|i| {
-                    let (a, b) = ((i % 10) as f64, (i / 10) as f64);
-                    let wobble = jitter * (((i * 7919) % 13) as f64 / 6.0 - 1.0);
-                    let mut x = Vector2::new(0.1 * a + wobble, 0.1 * b - wobble);
-                    if i < flung {
-                        x.y = -0.25 - 0.3 * i as f64;
-                    }
-                    x
-                })
-                .collect();
-            Particles::<f64, 2>::new(x, vec![0.01; 100], 1.0)
-        };
-        assert_eq!(stray_particles(&lattice(0.0, 0)), 0);
-        assert_eq!(stray_particles(&lattice(0.033, 0)), 0);
-        assert_eq!(stray_particles(&lattice(0.0, 1)), 1);
-        assert_eq!(stray_particles(&lattice(0.0, 3)), 3);
-        assert!(stray_warning(0, 2, 100).is_none());
-        assert!(stray_warning(0, 3, 1000).is_none());
-        assert!(stray_warning(0, 3, 100)
-            .unwrap()
-            .contains("3 of the 100 particles"));
-        assert!(stray_warning(3, 5, 100).is_none());
-    }
-
     /// The hint of an energy growth says when the bound was crossed, the Courant
     /// number and half of it, and asks for more particles only where an element
     /// holds fewer than its functions. A scene with a fixed `dt` is told to lower
@@ -1428,49 +1253,6 @@ mod tests {
         assert!(
             fast.contains("lower `time.courant` (to 0.12, say"),
             "{fast}"
-        );
-    }
-
-    /// A lattice is one piece, stretched by half its spacing too; torn in two it is
-    /// two, and the warning gives their shares; a few particles flung off are not a
-    /// piece (they are stray).
-    #[test]
-    fn a_lattice_torn_in_two_is_two_pieces() {
-        let lattice = |stretch: f64, gap: f64, flung: usize| {
-            let x: Vec<Vector2<f64>> = (0..100)
-                .map(|i| {
-                    let (a, b) = ((i % 10) as f64, (i / 10) as f64);
-                    let mut x = Vector2::new(
-                        0.1 * a,
-                        0.1 * stretch * b + if b >= 7.0 { gap } else { 0.0 },
-                    );
-                    if i < flung {
-                        x.x = -0.5 - 0.3 * i as f64;
-                    }
-                    x
-                })
-                .collect();
-            Particles::<f64, 2>::new(x, vec![0.01; 100], 1.0)
-        };
-        assert_eq!(pieces(&lattice(1.0, 0.0, 0)), vec![100]);
-        assert_eq!(pieces(&lattice(1.5, 0.0, 0)), vec![100]);
-        assert_eq!(pieces(&lattice(1.0, 0.5, 0)), vec![70, 30]);
-        assert_eq!(pieces(&lattice(1.0, 0.0, 2)), vec![98]);
-        assert!(pieces_warning(1, &[100], 100).is_none());
-        // The rows from 7 on as a body of their own (30 particles after the 70 of
-        // the first): two pieces touching at the start, and still two once they
-        // part, since pieces are counted per body; a body torn is one more.
-        let two_bodies = |gap: f64| fragments(&lattice(1.0, gap, 0), &[70, 30]).pieces;
-        assert_eq!(two_bodies(0.0), vec![70, 30]);
-        assert_eq!(two_bodies(0.5), vec![70, 30]);
-        let mut torn = lattice(1.0, 0.0, 0);
-        (0..20).for_each(|p| torn.x[p].y -= 0.5);
-        assert_eq!(fragments(&torn, &[70, 30]).pieces, vec![50, 30, 20]);
-        assert_eq!(fragments(&torn, &[]).pieces, vec![80, 20]);
-        let warning = pieces_warning(1, &[70, 30], 100).unwrap();
-        assert!(
-            warning.contains("2 pieces at the end (1 at the start), holding 70 %, 30 %"),
-            "{warning}"
         );
     }
 }

@@ -734,6 +734,75 @@ t_end = 2.0
     );
 }
 
+/// A soft neo-Hookean block (E = 3e3, ρ = 100, ρ g H / E = 0.25) dropped 0.125
+/// onto a slip floor, as a user wrote it: with PS at 4 × 4 particles per block (4 per
+/// triangle) its columns of particles buckle into a zig-zag and voids open, with its
+/// energy bounded; the run says so and asks for 9 per triangle. With 6 × 6 per
+/// block it keeps its lattice, and so does PL at 4 × 4; nothing is said.
+#[test]
+fn a_soft_block_whose_particles_go_irregular_is_warned_about() {
+    let text = r#"
+name = "soft-drop"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [0.0, 1.5]
+blocks = [8, 6]
+[material]
+model = "neo-hookean"
+young = 3e3
+poisson = 0.3
+density = 100.0
+[[body]]
+min = [0.5, 0.125]
+max = [1.5, 0.875]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["normal"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.25
+t_end = 2.0
+"#;
+    let irregular = |s: &psmpm::simulation::Summary| {
+        s.warnings
+            .iter()
+            .find(|w| w.contains("out of their neighbours' arrangement"))
+            .cloned()
+    };
+    let ps = run(
+        &Scene::from_toml(text, "soft-drop.toml").unwrap(),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(ps.failure.is_none() && ps.stable, "{ps:?}");
+    let warning = irregular(&ps).unwrap_or_else(|| panic!("{:?}", ps.warnings));
+    assert!(warning.contains("give 9 or more per triangle"), "{warning}");
+    assert!(
+        ps.irregularity.irregular * 20 >= ps.irregularity.measured,
+        "{:?}",
+        ps.irregularity
+    );
+    for (from, to) in [
+        ("per_block = [4, 4]", "per_block = [6, 6]"),
+        (r#"basis = "ps""#, r#"basis = "pl""#),
+    ] {
+        let s = run(
+            &Scene::from_toml(&text.replace(from, to), "soft-drop.toml").unwrap(),
+            &mut |_| {},
+        )
+        .unwrap();
+        assert!(s.failure.is_none(), "{to}: {s:?}");
+        assert_eq!(irregular(&s), None, "{to}");
+        assert_eq!(s.irregularity.irregular, 0, "{to}: {:?}", s.irregularity);
+    }
+}
+
 /// A 1D PL bar (E = 100, ρ = 1, [1, 3], 4 particles per element of 0.25) vibrating
 /// (a stretching `∂v/∂x = 0.5`, 0.083 J) while it translates at `speed` across the
 /// mesh, to t = 8 at `courant = 0.25`; with `speed` 0 at rest, with `gradient` 0 a

@@ -46,6 +46,7 @@ use crate::progress::Progress;
 use crate::run::read_scene;
 use crate::table::{sci, Table};
 use crate::Format;
+use psmpm::bases::BasisKind;
 use psmpm::mass::MassKind;
 use psmpm::scene::{Component, InitialVelocity, Reference, Scene};
 use psmpm::simulation::{self, RunError, Summary, STABLE_CONDITION, STABLE_ENERGY_GROWTH};
@@ -77,6 +78,12 @@ pub struct StabilityArgs {
     /// Mass strategies, comma-separated, as `--mass` of `mpm-cli run` reads them.
     #[arg(long, value_delimiter = ',', default_value = DEFAULT_MASS)]
     mass: Vec<String>,
+    /// Bases, comma-separated (`ps,pl`; `bspline,pl1d` for the 1D cases): each case
+    /// runs with those of its dimension, on its own mesh and particles (default:
+    /// the basis of the case's file). A case with no basis of its dimension in the
+    /// list runs with its own, and standard error says so.
+    #[arg(long, value_delimiter = ',')]
+    basis: Vec<String>,
     /// Directory of the case files (default: the repository's scenes/stability).
     #[arg(long, value_name = "DIR")]
     dir: Option<PathBuf>,
@@ -100,6 +107,8 @@ pub struct StabilityArgs {
 pub struct Cell {
     /// Case name (its file's stem).
     pub case: String,
+    /// Basis.
+    pub basis: &'static str,
     /// Mass strategy, as the run names it (`deactivate:0.01`).
     pub mass: String,
     /// The verdict of the run (no failure, energy growth and condition bounded).
@@ -433,6 +442,7 @@ fn run_cell(case: &str, scene: &Scene, on_step: &mut dyn FnMut()) -> Result<Cell
         error.filter(|e| measure == "slide" && e.partial_cmp(&SLIDE_BOUND) != Some(Ordering::Less));
     Ok(Cell {
         case: case.to_string(),
+        basis: summary.basis,
         mass: summary.mass.clone(),
         stable: summary.stable && off.is_none(),
         completed: summary.failure.is_none(),
@@ -515,8 +525,9 @@ pub fn run_matrix(
     Ok(out)
 }
 
-const COLUMNS: [&str; 14] = [
+const COLUMNS: [&str; 15] = [
     "case",
+    "basis",
     "mass",
     "stable",
     "error",
@@ -545,12 +556,13 @@ pub fn print(cells: &[Cell], format: Format, jobs: usize) {
         }
         Format::Csv => {
             println!(
-                "case,mass,stable,completed,reason,measure,error,roughness,roughness_rms,max_condition,lumped,deactivated,functions,particles,steps,dt,t_end,energy_growth,us_per_step,seconds"
+                "case,basis,mass,stable,completed,reason,measure,error,roughness,roughness_rms,max_condition,lumped,deactivated,functions,particles,steps,dt,t_end,energy_growth,us_per_step,seconds"
             );
             let o = |x: Option<f64>| x.map_or_else(String::new, |v| v.to_string());
             for c in cells {
                 let record = [
                     c.case.clone(),
+                    c.basis.to_string(),
                     c.mass.clone(),
                     c.stable.to_string(),
                     c.completed.to_string(),
@@ -579,6 +591,7 @@ pub fn print(cells: &[Cell], format: Format, jobs: usize) {
             for c in cells {
                 table.push(vec![
                     c.case.clone(),
+                    c.basis.to_string(),
                     c.mass.clone(),
                     match (c.stable, c.completed) {
                         (true, _) => "yes",
@@ -633,10 +646,36 @@ pub fn stability(args: StabilityArgs) -> Result<(), CliError> {
     }
     let dir = args.dir.clone().unwrap_or_else(default_dir);
     let all = list_cases(&dir)?;
+    let bases: Vec<BasisKind> = args
+        .basis
+        .iter()
+        .map(|b| BasisKind::parse(b.trim()).map_err(|e| CliError::Input(format!("--basis: {e}"))))
+        .collect::<Result<_, _>>()?;
     let mut cases = Vec::new();
     for (name, path) in select(&args.cases, &all)? {
         let scene = read_scene(&path.to_string_lossy())?;
-        cases.push((name, scene));
+        let of_dim: Vec<BasisKind> = bases
+            .iter()
+            .copied()
+            .filter(|b| b.dim() == scene.dim)
+            .collect();
+        if of_dim.is_empty() {
+            if !bases.is_empty() {
+                eprintln!(
+                    "note: case {name} is {}D and --basis names no {}D basis: it runs with its own, {}",
+                    scene.dim,
+                    scene.dim,
+                    scene.basis.name()
+                );
+            }
+            cases.push((name, scene));
+            continue;
+        }
+        for basis in of_dim {
+            let mut s = scene.clone();
+            s.basis = basis;
+            cases.push((name.clone(), s));
+        }
     }
     let pool = crate::run::thread_pool(args.threads)?;
     let cells = run_matrix(&cases, &masses, jobs, &pool)?;

@@ -158,7 +158,7 @@ fn the_same_cells_on_one_and_two_threads_and_in_every_format() {
         .unwrap();
     let table = String::from_utf8(table.stdout).unwrap();
     let header: Vec<&str> = table.lines().next().unwrap().split_whitespace().collect();
-    assert_eq!(header[..4], ["case", "mass", "stable", "error"]);
+    assert_eq!(header[..5], ["case", "basis", "mass", "stable", "error"]);
     let csv = cli()
         .args([
             "stability",
@@ -221,4 +221,34 @@ fn a_block_that_does_not_slide_is_not_stable() {
     );
     assert_eq!(default["stable"], true, "{default}");
     assert!(default["error"].as_f64().unwrap() < 1e-3, "{default}");
+}
+
+/// `--basis ps,pl` runs each case with both bases on its own mesh and particles,
+/// basis by basis within the case; the JSON names each cell's basis, and a name
+/// that is no basis is refused.
+#[test]
+fn a_case_runs_with_each_basis_given() {
+    let cells = json(&[
+        "stability",
+        "--cases",
+        "b2-nx2",
+        "--basis",
+        "ps,pl",
+        "--mass",
+        "lumped",
+        "--format",
+        "json",
+    ]);
+    let cells = cells.as_array().unwrap();
+    let bases: Vec<&str> = cells.iter().map(|c| c["basis"].as_str().unwrap()).collect();
+    assert_eq!(bases, ["ps", "pl"]);
+    assert_eq!(cells[0]["particles"], cells[1]["particles"]);
+    assert!(cells[0]["functions"].as_u64() > cells[1]["functions"].as_u64());
+    let out = cli()
+        .args(["stability", "--cases", "b2-nx2", "--basis", "quartic"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--basis"), "{err}");
 }
