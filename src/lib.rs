@@ -16,7 +16,8 @@
 //! - [`setup`]: a scene turned into mesh, basis, particles with their initial states
 //!   (velocity, geostatic stress), effects and the one concrete driver;
 //!   [`simulation`]: the run loop with its observers, the summary and stability
-//!   verdict;
+//!   verdict; [`arrangement`]: how the particles lie at the end (stray particles,
+//!   bodies in pieces, an arrangement gone irregular), which the verdict does not see;
 //! - [`studies`]: the checks of the method, apart from it: the seeds' exact solutions
 //!   ([`studies::exact`]), the 1D updated-Lagrangian FEM reference ([`studies::ulfem`]),
 //!   L² projection onto a basis, benchmark B1 ([`studies::projection`]), and the
