@@ -595,7 +595,7 @@ pub const PS_SAMPLING: f64 = 3.0;
 pub fn ps_sampling_warning(sampling: f64) -> Option<String> {
     (SPARSE_SAMPLING..PS_SAMPLING).contains(&sampling).then(|| {
         format!(
-            "the bodies are sampled by {sampling:.2} particles per occupied triangle at the start, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle (`per_block` 4 × 4 on block meshes, `count` or `spacing`; `--particles`)"
+            "the bodies are sampled by {sampling:.2} particles per occupied triangle at the start, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle (`per_block` 4 × 4 on block meshes, `count` or `spacing`; `--particles`); a body whose edges cut triangles fills those in part, which lowers this average below what its lattice gives inside: place its edges on block lines, or give more per block"
         )
     })
 }

@@ -10,6 +10,7 @@ use crate::error::CliError;
 use crate::run::{read_scene, Overrides};
 use crate::table::{fixed2, sci, Table};
 use crate::Format;
+use psmpm::bases::BasisKind;
 use psmpm::output::chart::{line_plot, Axis, LinePlot, Scale, Series, SeriesStyle};
 use psmpm::particles::Particles;
 use psmpm::scene::limits::echo;
@@ -399,6 +400,8 @@ fn study(
     let mut rows: Vec<Level> = Vec::new();
     let mut diagnoses: Vec<Diagnosis> = Vec::new();
     let mut notes: Vec<String> = Vec::new();
+    // What `run` warns about, per level (on standard error, before the table).
+    let mut warnings: Vec<String> = Vec::new();
     let progress =
         crate::progress::Progress::new(scenes.iter().map(Vec::len).sum::<usize>() as u64, "runs");
     for variant in scenes {
@@ -407,8 +410,25 @@ fn study(
         for (level, s) in variant.into_iter().enumerate() {
             let (summary, particles) = run_level(args, level, &s)?;
             progress.inc(1);
+            warnings.extend(
+                summary
+                    .warnings
+                    .iter()
+                    .map(|w| format!("warning ({} level {level}): {w}", summary.basis)),
+            );
             levels.push((s, summary));
             finals.push(particles);
+        }
+        if let (Against::FinestLevel, Some((_, last))) = (against, levels.last()) {
+            if last.failure.is_none() && !last.stable {
+                notes.push(format!(
+                    "{}: the finest level, against which every error of this basis is \
+                     measured, is not stable ({}): its errors measure the distance to that \
+                     run, not to the solution",
+                    last.basis,
+                    crate::run::unstable_reason(last),
+                ));
+            }
         }
         let finest = match against {
             Against::Exact => None,
@@ -526,6 +546,9 @@ fn study(
         }
     }
     progress.finish();
+    for warning in &warnings {
+        eprintln!("{warning}");
+    }
     let target = args.target_error.map(|e| Target {
         error: e,
         reaches: reaches(&rows, e),
@@ -602,6 +625,16 @@ fn verdict(
     double_particles: Option<f64>,
 ) -> String {
     let lowers = |r: Option<f64>| r.is_some_and(|r| r < 1.0 - LIMITING_GAIN);
+    // PL's gradient jumps across element edges; the 2D PS and the 1D B-spline
+    // bases are smooth.
+    let smooth = matches!(scene.basis, BasisKind::Ps | BasisKind::Bspline);
+    let crossing = if smooth {
+        ""
+    } else {
+        "; with a C⁰ basis such as PL also the error of particles that crossed element \
+         edges during the run, which their stress keeps (a smooth basis, ps or bspline, \
+         avoids it)"
+    };
     let time = if scene.time.courant.is_some() {
         "a smaller `courant` (--courant, or --dt)"
     } else {
@@ -630,21 +663,29 @@ fn verdict(
              force): {particles}"
         ),
         (false, false) if double_particles.is_some_and(|r| r > 1.0 + LIMITING_GAIN) => {
-            "more particles raise the error: the error of particles crossing element edges \
-             (largest for a C⁰ basis such as PL), not h, dt or quadrature; a smooth basis \
-             (ps, bspline) avoids it"
-                .into()
+            if smooth {
+                "more particles raise the error, so neither h, dt nor quadrature limits it: \
+                 the reference's own error may (against the finest level, that level's; give \
+                 the scene a `[reference]` where one exists)"
+                    .into()
+            } else {
+                "more particles raise the error: the error of particles crossing element \
+                 edges (largest for a C⁰ basis such as PL), not h, dt or quadrature; a smooth \
+                 basis (ps, bspline) avoids it"
+                    .into()
+            }
         }
-        (false, false) if !not_the_step.is_empty() => "nor do more particles lower it: it \
-             has reached a floor that refinement does not remove (for example the reference's \
-             own assumptions, such as small strain, the finest level's error, or an error that \
-             changes with the instants at which particles cross element edges)"
-            .into(),
-        (false, false) => "neither a smaller time step nor more particles lower the error: it \
-                           has reached a floor that refinement does not remove (for example \
-                           the reference's own assumptions, such as small strain, or the \
-                           finest level's error)"
-            .into(),
+        (false, false) if !not_the_step.is_empty() => format!(
+            "nor do more particles lower it: it has reached a floor that refinement does not \
+             remove (for example the reference's own assumptions, such as small strain, the \
+             finest level's error, or an error that changes with the instants at which \
+             particles cross element edges){crossing}"
+        ),
+        (false, false) => format!(
+            "neither a smaller time step nor more particles lower the error: it has reached a \
+             floor that refinement does not remove (for example the reference's own \
+             assumptions, such as small strain, or the finest level's error){crossing}"
+        ),
     };
     format!("{not_the_step}{limits}")
 }

@@ -326,6 +326,11 @@ impl Recorder {
     }
 
     /// Records the initial state (`r.step == 0`) or a step.
+    /// Whether writing has failed (the error is returned by [`finish`](Self::finish)).
+    pub fn failed(&self) -> bool {
+        self.error.is_some()
+    }
+
     pub fn observe(&mut self, r: &StepReport, particles: ParticlesRef<'_>) {
         if self.error.is_some() {
             return;
@@ -429,7 +434,13 @@ impl Recorder {
                 .map_err(|e| write_error(&path, e))
         });
         if let Some(e) = self.error.take() {
-            return Err(e);
+            // The diagnostics written in part are named too.
+            return Err(match (e, flushed) {
+                (CliError::Input(first), Err(CliError::Input(then))) => CliError::Input(format!(
+                    "{first}; and {then}: `{DIAGNOSTICS_FILE}` holds the steps before it only in part"
+                )),
+                (e, _) => e,
+            });
         }
         flushed?;
         if self.last_frame != Some(self.last_step) {

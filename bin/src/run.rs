@@ -616,6 +616,12 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     let mut observer = |r: &StepReport, particles: ParticlesRef<'_>| {
         if let Some(recorder) = recorder.as_mut() {
             recorder.observe(r, particles);
+            // A file that cannot be written (a full disk) ends the run at once:
+            // the rest of it would be lost too.
+            if recorder.failed() {
+                stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                return;
+            }
         }
         if r.step == 0 {
             if every_from_run && r.dt > 0.0 {
@@ -638,10 +644,13 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
                     let _ = writeln!(std::io::stderr(), "# {line}");
                 }
                 // stderr of csv holds `# key=value` lines only (the summary's dt and
-                // dt_critical come at the end).
+                // dt_critical come at the end). The ratio of the step taken to the
+                // critical one, before the first step: not `courant`, which the
+                // summary gives as asked (the step taken is shortened to divide
+                // the end time).
                 Format::Csv => {
                     if let Some(c) = r.dt_critical.filter(|c| c.is_finite() && *c > 0.0) {
-                        let _ = writeln!(std::io::stderr(), "# courant={}", r.dt / c);
+                        let _ = writeln!(std::io::stderr(), "# dt_over_critical={}", r.dt / c);
                     }
                 }
             }
@@ -678,7 +687,7 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
         (Err(e), _) => Err(run_error(&args.scene, &args.overrides, e)),
         (Ok(_), Some(message)) => Err(CliError::Input(message)),
     };
-    let (summary, tracked, last) = match checked {
+    let (mut summary, tracked, last) = match checked {
         Ok(o) => o,
         Err(error) => {
             if let Some(recorder) = recorder {
@@ -689,6 +698,15 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     };
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
+    }
+    // A file that could not be written stopped the run (not a signal).
+    if summary.interrupted && recorder.as_ref().is_some_and(|r| r.failed()) {
+        summary.interrupted = false;
+        summary.failure = Some(format!(
+            "after step {} (t = {}): an output file could not be written (the error follows)",
+            summary.steps,
+            short(summary.t_end)
+        ));
     }
     let written = recorder.map(|r| {
         let dir = r.path().to_path_buf();

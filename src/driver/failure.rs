@@ -323,7 +323,12 @@ where
     /// The error of a failed mass solve, with what the strategy reported.
     pub(super) fn mass_failure(&self, source: MassError) -> StepError {
         let treated = self.last_report.treated();
-        let hint = if let Some(cause) = self.singular_mass_cause() {
+        let hint = if let MassError::NothingActive { largest, .. } = source {
+            format!(
+                "the threshold is absolute, in the scene's units of mass: give one below {} (`deactivate:THRESHOLD`; the thesis' 1e-2 is for its columns), or use the default mass strategy, which needs none",
+                crate::scene::limits::echo_number(largest)
+            )
+        } else if let Some(cause) = self.singular_mass_cause() {
             cause
         } else if treated > 0 {
             // The strategy already treats functions (extension, lumped rows or

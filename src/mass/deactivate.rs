@@ -23,7 +23,10 @@ impl<T: Scalar> Deactivate<T> {
 
 impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
     fn spec(&self) -> String {
-        format!("deactivate:{}", self.threshold)
+        format!(
+            "deactivate:{}",
+            crate::scene::limits::echo_number(self.threshold)
+        )
     }
     fn prepare(&mut self, setup: &MassSetup) {
         self.solver.prepare(setup);
@@ -35,13 +38,22 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
         _context: StepContext,
     ) -> Result<MassReport, MassError> {
         let mut report = MassReport::default();
+        let mut largest = 0.0f64;
         for i in 0..pattern.dim() {
             let d = values[pattern.diagonal_position(i)];
+            largest = largest.max(d.to_f64());
             let empty = d <= T::zero();
             let deactivated = !empty && d.to_f64() < self.threshold;
             self.solver.inactive[i] = empty || deactivated;
             report.deactivated += deactivated as usize;
             report.active += !self.solver.inactive[i] as usize;
+        }
+        if report.active == 0 && report.deactivated > 0 {
+            return Err(MassError::NothingActive {
+                threshold: self.threshold,
+                // Three digits: enough to choose a threshold below it.
+                largest: format!("{largest:.2e}").parse().unwrap_or(largest),
+            });
         }
         self.solver.factorize(pattern, values)?;
         Ok(report)

@@ -44,6 +44,7 @@ pub use lumped::Lumped;
 pub use partial::{LumpRule, Partial};
 pub use support::SupportFacts;
 
+use crate::scene::limits::echo_number;
 use crate::sparse::{NotPositiveDefinite, Scalar, SymmetricPattern};
 use std::sync::Arc;
 
@@ -56,6 +57,15 @@ pub enum MassError {
     /// The factorisation met a non-positive pivot.
     #[error("non-positive pivot at row {} of the reordered matrix", .0.row)]
     NotPositiveDefinite(#[from] NotPositiveDefinite),
+    /// Every function with mass lies below the deactivation threshold: the system
+    /// has no unknown left and nothing would move.
+    #[error("every function with mass is below the deactivation threshold {} (the largest M_ii is {}), so nothing would move", echo_number(*.threshold), echo_number(*.largest))]
+    NothingActive {
+        /// The threshold on `M_ii`.
+        threshold: f64,
+        /// The largest diagonal entry of `M`.
+        largest: f64,
+    },
     /// An iterative solve did not reach its tolerance.
     #[error("the iterative solve stalled at relative residual {residual:.1e} after {iterations} iterations")]
     NotConverged {
@@ -265,25 +275,38 @@ impl MassKind {
     /// The form [`MassKind::parse`] reads back (`partial:0.1`, `extended:0.3`).
     pub fn spec(self) -> String {
         match self {
-            MassKind::Partial(LumpRule::Threshold(tau)) => format!("partial:{tau}"),
-            MassKind::Partial(LumpRule::Coverage(c)) => format!("partial-coverage:{c}"),
-            MassKind::Deactivate { threshold } => format!("deactivate:{threshold}"),
+            MassKind::Partial(LumpRule::Threshold(tau)) => format!("partial:{}", echo_number(tau)),
+            MassKind::Partial(LumpRule::Coverage(c)) => {
+                format!("partial-coverage:{}", echo_number(c))
+            }
+            MassKind::Deactivate { threshold } => format!("deactivate:{}", echo_number(threshold)),
             MassKind::Extended { coverage } if coverage != DEFAULT_COVERAGE => {
-                format!("extended:{coverage}")
+                format!("extended:{}", echo_number(coverage))
             }
             MassKind::ExtendedHybrid {
                 extend,
                 lump,
                 correction,
                 walls,
-            } if walls > 0.0 => format!("{}:{extend}:{lump}:{walls}", correction.hybrid_name()),
+            } if walls > 0.0 => format!(
+                "{}:{}:{}:{}",
+                correction.hybrid_name(),
+                echo_number(extend),
+                echo_number(lump),
+                echo_number(walls)
+            ),
             MassKind::ExtendedHybrid {
                 extend,
                 lump,
                 correction,
                 ..
             } if (extend, lump) != (DEFAULT_HYBRID_EXTEND, DEFAULT_HYBRID_LUMP) => {
-                format!("{}:{extend}:{lump}", correction.hybrid_name())
+                format!(
+                    "{}:{}:{}",
+                    correction.hybrid_name(),
+                    echo_number(extend),
+                    echo_number(lump)
+                )
             }
             MassKind::Fmpm { order } => format!("fmpm:{order}"),
             other => other.name().to_string(),

@@ -262,6 +262,31 @@ fn deactivation_removes_small_rows_and_lumped_matches_row_sums() {
     assert!(rhs.iter().all(|&y| y == 0.0 || (y - 1.0).abs() < 1e-14));
 }
 
+/// A threshold above every row's mass (`deactivate:1e300`) left no unknown: the
+/// body hung still, judged stable. Now the factorisation refuses, naming the
+/// largest `M_ii`; and the strategy's name shows the threshold in short form.
+#[test]
+fn a_threshold_that_deactivates_every_function_is_an_error() {
+    let c = column_mass();
+    let mut deact = prepared(&c, MassKind::Deactivate { threshold: 1e300 });
+    match deact.factorize(&c.pattern, &c.values, context(&c)) {
+        Err(MassError::NothingActive { threshold, largest }) => {
+            assert_eq!(threshold, 1e300);
+            assert!(largest > 0.0 && largest < 1.0, "{largest}");
+        }
+        other => panic!("expected NothingActive, got {:?}", other.err()),
+    }
+    assert_eq!(deact.spec(), "deactivate:1e300");
+    assert_eq!(
+        MassKind::Deactivate { threshold: 1e300 }.spec(),
+        "deactivate:1e300"
+    );
+    assert_eq!(
+        MassKind::Partial(LumpRule::Threshold(1e-300)).spec(),
+        "partial:1e-300"
+    );
+}
+
 /// `deactivate:1e400` parses to infinity: the message said the threshold must be
 /// positive; every strategy parameter read as a number now says it is not finite
 /// and gives the range.

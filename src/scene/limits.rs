@@ -124,6 +124,26 @@ pub fn echo(text: &str) -> String {
     out
 }
 
+/// Names of the mesh (tags, physical groups) as a message lists them: each
+/// [`echo`]ed in backticks, at most 20 of them and then how many more; for no
+/// name at all, what a mesh file needs to have one.
+pub fn echo_tags(tags: &[String]) -> String {
+    if tags.is_empty() {
+        return "none (a .msh file tags boundary edges with physical curve groups; \
+                format 4.1 lists them in `$Entities`)"
+            .to_string();
+    }
+    let mut shown: Vec<String> = tags
+        .iter()
+        .take(20)
+        .map(|t| format!("`{}`", echo(t)))
+        .collect();
+    if tags.len() > 20 {
+        shown.push(format!("and {} more", tags.len() - 20));
+    }
+    shown.join(", ")
+}
+
 /// A number as it is echoed in messages: Rust's shortest round-trip digits, in
 /// exponent notation outside `1e-4 ≤ |x| < 1e16`, so that no value (`1e-320`,
 /// `1e300`) is printed as hundreds of digits.
@@ -176,6 +196,17 @@ mod tests {
         assert_eq!(echo_number(1e-320), "1e-320");
         assert_eq!(echo_number(-2.5e300), "-2.5e300");
         assert_eq!(echo_number(1e15), "1000000000000000");
+    }
+
+    #[test]
+    fn mesh_tags_are_listed_escaped_and_bounded() {
+        assert_eq!(
+            echo_tags(&["a".into(), "b\u{1b}".into()]),
+            "`a`, `b\\u{1b}`"
+        );
+        let many: Vec<String> = (0..25).map(|i| i.to_string()).collect();
+        assert!(echo_tags(&many).ends_with("`19`, and 5 more"));
+        assert!(echo_tags(&[]).contains("$Entities"));
     }
 
     #[test]

@@ -103,7 +103,9 @@ pub struct Scene {
     /// are mirror-symmetric about both axis-aligned lines through it (the interior
     /// vertices of the block grids), `vertical` or `horizontal`: the scene's own
     /// mirror line, so that the mass strategies keep its symmetry
-    /// ([`psmpm_basis::basis::powell_sabin::MirrorAxis`]). Ignored by the other bases.
+    /// ([`psmpm_basis::basis::powell_sabin::MirrorAxis`]). PL: with `horizontal`, a
+    /// particle on an element edge is held by the triangle
+    /// [`psmpm_basis::TriMesh::triangle_kept_at`] keeps. Ignored by the 1D bases.
     #[serde(
         default,
         with = "names::mirror_line_name",

@@ -385,8 +385,13 @@ impl Scene {
                 return Err(bad(
                     "time.dt",
                     format!(
-                        "t_end / dt = {:?} / {dt:?} = {steps:.3e} steps is above the limit of {MAX_STEPS}",
-                        self.time.t_end
+                        "t_end / dt = {:?} / {dt:?} = {} steps is above the limit of {MAX_STEPS}",
+                        self.time.t_end,
+                        if steps < 1e12 {
+                            format!("{}", steps.round())
+                        } else {
+                            format!("{steps:.3e}")
+                        }
                     ),
                 ));
             }

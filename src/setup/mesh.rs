@@ -59,7 +59,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
             PowellSabin::<f64>::with_mirror(mesh, scene.split, scene.mirror_line)
                 .map_err(|e| conflict("basis", e))?,
         ),
-        BasisKind::Pl => Basis2d::Linear(Linear::<f64>::new(mesh)),
+        BasisKind::Pl => Basis2d::Linear(Linear::<f64>::with_mirror(mesh, scene.mirror_line)),
         one_d @ (BasisKind::Bspline | BasisKind::Pl1d) => {
             return Err(conflict("basis", format!("`{}` is a 1D basis", one_d.name())).into())
         }
@@ -172,8 +172,9 @@ fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
                 format!("boundary[{b}].tag"),
                 ErrorKind::Unknown,
                 format!(
-                    "unknown boundary tag `{}`; the mesh has tags {tags:?}",
-                    crate::scene::limits::echo(&bc.tag)
+                    "unknown boundary tag `{}`; the mesh has tags {}",
+                    crate::scene::limits::echo(&bc.tag),
+                    crate::scene::limits::echo_tags(tags)
                 ),
             )
             .into());
@@ -243,9 +244,9 @@ fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Vec<WallGeometry>, Run
                 field.clone(),
                 ErrorKind::Unknown,
                 format!(
-                    "unknown boundary tag `{}`; the mesh has tags {:?}",
+                    "unknown boundary tag `{}`; the mesh has tags {}",
                     crate::scene::limits::echo(tag),
-                    mesh.tags()
+                    crate::scene::limits::echo_tags(mesh.tags())
                 ),
             )
         })?;

@@ -149,7 +149,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     let mut origin = [0.0; 2];
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
     let mut particles = particles::place::<D>(scene, &lattice);
-    particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles);
+    particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles)?;
     let effects = build_effects(scene, &particles, &domain.contacts, &domain.basis)?;
     // The lattice's positions and volumes are in `particles` now: free them before
     // the driver allocates (they would otherwise count in the run's peak memory).
@@ -417,9 +417,11 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                     "time.t_end",
                     ErrorKind::Conflict,
                     format!(
-                        "is shorter than one time step (t_end = {}, courant = {} gives dt = {step:e})",
+                        "is shorter than one time step (t_end = {}, courant = {} gives dt = {step:.3e}): give `t_end` of at least {}, or a fixed `dt` below it (the critical step grows as h √(ρ / E): E = {} here)",
                         echo_number(t_end),
-                        echo_number(c)
+                        echo_number(c),
+                        echo_number(format!("{step:.2e}").parse().unwrap_or(step)),
+                        echo_number(scene.material.young)
                     ),
                 )
                 .into());

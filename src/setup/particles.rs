@@ -259,7 +259,7 @@ pub(crate) fn apply_initial_states<const D: usize>(
     solution: Option<Solution>,
     origin: [f64; 2],
     particles: &mut Particles<f64, D>,
-) {
+) -> Result<(), SceneError> {
     let mut first = 0;
     for (b, &n) in lattice.body_sizes.iter().enumerate() {
         // A body's own sine mode spans its own extent, the scene's that of the
@@ -282,7 +282,7 @@ pub(crate) fn apply_initial_states<const D: usize>(
         }
         first += n;
     }
-    initial_stress(scene, lattice, particles);
+    initial_stress(scene, lattice, particles)
 }
 
 /// The velocity `kind` gives at `x0` (the second entry 0 in 1D); `extent` is the
@@ -365,11 +365,16 @@ fn weight_above(density: &impl Fn(f64) -> f64, y: f64, surface: f64) -> f64 {
 /// a soft one) the vertical stress is the weight of what lies above the particle,
 /// `g ∫_y^surface ρ(x, s) ds`, `ρ` the density of the body at `(x, s)` (zero
 /// outside every body; [`weight_above`]).
+///
+/// A free surface below the highest particle is refused (the particles above it
+/// would start without stress, silently), and so is one whose stress at the lowest
+/// particle exceeds the Young's modulus of its body (crushed at once: a surface
+/// far off, or in other units).
 fn initial_stress<const D: usize>(
     scene: &Scene,
     lattice: &Lattice,
     particles: &mut Particles<f64, D>,
-) {
+) -> Result<(), SceneError> {
     let densities: Vec<f64> = (0..scene.bodies.len())
         .map(|b| scene.body_material(b).density)
         .collect();
@@ -392,10 +397,51 @@ fn initial_stress<const D: usize>(
             .find(|(r, _)| r.as_ref().is_some_and(|r| r.contains(point)))
             .map_or(0.0, |(_, &rho)| rho)
     };
-    for spec in &scene.effects {
+    for (i, spec) in scene.effects.iter().enumerate() {
         if let EffectSpec::GeostaticStress { surface, k0 } = spec {
             let g = scene.gravity().map_or(0.0, |g| g[D - 1]);
-            for (p, b) in lattice.body_of_particles().into_iter().enumerate() {
+            let field = format!("effect[{i}].surface");
+            let bodies = lattice.body_of_particles();
+            let (top, bottom) = particles
+                .x0
+                .iter()
+                .fold((f64::NEG_INFINITY, f64::INFINITY), |(top, bottom), x| {
+                    (top.max(x[D - 1]), bottom.min(x[D - 1]))
+                });
+            let axis = if D == 1 { "x" } else { "y" };
+            if *surface < top {
+                return Err(SceneError::new(
+                    field,
+                    ErrorKind::Conflict,
+                    format!(
+                        "the free surface {axis} = {} lies below the highest particle ({axis} = {}): the particles above it would start without stress; give the top of the bodies, or a height above it for a load on them",
+                        echo_number(*surface),
+                        echo_number(top)
+                    ),
+                ));
+            }
+            for (p, &b) in bodies.iter().enumerate() {
+                if particles.x0[p][D - 1] != bottom {
+                    continue;
+                }
+                let material = scene.body_material(b);
+                let stress = material.density * g.abs() * (surface - bottom);
+                if stress.is_nan() || stress > material.young {
+                    return Err(SceneError::new(
+                        field,
+                        ErrorKind::Value,
+                        format!(
+                            "the geostatic stress at the lowest particle ({axis} = {}), ρ g (surface − {axis}) = {}, exceeds the Young's modulus {} of body[{b}]: it would be crushed at once; is `surface` {} in the scene's units, and near the highest particle ({axis} = {})?",
+                            echo_number(bottom),
+                            crate::scene::limits::echo_fixed(stress, 1),
+                            echo_number(material.young),
+                            echo_number(*surface),
+                            echo_number(top)
+                        ),
+                    ));
+                }
+            }
+            for (p, b) in bodies.into_iter().enumerate() {
                 let x0 = particles.x0[p];
                 let depth = surface - x0[D - 1];
                 // The mean density above the particle (its own body's when all are
@@ -420,4 +466,5 @@ fn initial_stress<const D: usize>(
             }
         }
     }
+    Ok(())
 }

@@ -173,7 +173,11 @@ pub(crate) fn fill_surface(
                 if listed.is_empty() {
                     "none".to_string()
                 } else {
-                    listed.join(", ")
+                    listed
+                        .iter()
+                        .map(|name| crate::scene::limits::echo(name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 }
             ),
         )
@@ -262,10 +266,15 @@ fn lattice_field(b: usize, body: &Body) -> String {
 }
 
 /// The field that sets the particle count of body `b` (its lattice's, or a Gmsh
-/// body's `per_triangle`).
+/// body's `subdivide` where given, else its `per_triangle`).
 pub(crate) fn count_field(b: usize, body: &Body) -> String {
     if body.shape == BodyShape::Gmsh {
-        format!("body[{b}].per_triangle")
+        let name = if body.subdivide.is_some() {
+            "subdivide"
+        } else {
+            "per_triangle"
+        };
+        format!("body[{b}].{name}")
     } else {
         lattice_field(b, body)
     }

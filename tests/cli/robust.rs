@@ -980,7 +980,7 @@ t_end = 1.0
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
-        "huge.toml:17:13: body[0].per_block: the run would need about 3.7 GB (9048064 particles",
+        "huge.toml:17:13: body[0].per_block: the run would need about 4.9 GB (9048064 particles",
         "this process may still use by its address-space limit (`ulimit -v`)",
         "give fewer particles",
     ] {
@@ -1029,7 +1029,7 @@ t_end = 0.8
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
-        "framed.toml:16:9: body[0].count: the run would need about 1.0 GB (1440000 particles at 704 B each, 304 of them to write the output, 256 triangles",
+        "framed.toml:16:9: body[0].count: the run would need about 1.3 GB (1440000 particles at 754 B each, 304 of them to write the output, 256 triangles",
         "by its address-space limit (`ulimit -v`)",
     ] {
         assert!(stderr.contains(part), "{part:?} not in {stderr}");

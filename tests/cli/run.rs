@@ -590,6 +590,17 @@ fn a_courant_scene_prints_about_20_rows() {
     let rows = String::from_utf8_lossy(&out.stdout).lines().count() - 1;
     assert!(steps > 1000, "{steps} steps");
     assert!((19..=21).contains(&rows), "{rows} rows for {steps} steps");
+    // Each `# key=value` line names its own key: `courant` (as asked) once, the
+    // ratio of the step taken to the critical one apart (it was a second `courant`).
+    let mut keys: Vec<&str> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("# ")?.split_once('=').map(|(k, _)| k))
+        .collect();
+    let all = keys.len();
+    keys.sort_unstable();
+    keys.dedup();
+    assert_eq!(keys.len(), all, "a key repeats in {stderr}");
+    assert!(keys.contains(&"dt_over_critical"), "{stderr}");
 }
 
 /// The table of a Courant-number scene is bounded once its steps are known: too

@@ -5,9 +5,17 @@
 //! is C⁰ (gradients jump across edges, the source of grid-crossing noise in MPM),
 //! non-negative, a partition of unity, and reproduces linear functions with the
 //! vertices as [`function_point`](Basis::function_point)s.
+//!
+//! Since the gradient jumps, a point on a shared edge or vertex takes the gradient
+//! of the triangle that holds it. Point location's choice (the lowest-numbered
+//! triangle, then the first on the walk from the previous one) keeps vertical
+//! mirror lines on the block grids; for a scene symmetric about a horizontal line
+//! ([`MirrorAxis::Horizontal`]) [`TriMesh::triangle_kept_at`] keeps one by the
+//! mesh's geometry instead, so that the scene stays symmetric where its particles
+//! lie on grid diagonals.
 
 use super::{Basis, BasisError, BasisEval, Constraint, Point};
-use crate::mesh::{TriMesh, Vec2};
+use crate::mesh::{MirrorAxis, TriMesh, Vec2};
 use crate::scalar::Real;
 use nalgebra::Vector2;
 
@@ -20,11 +28,21 @@ pub struct Linear<T: Real = f64> {
     /// Flattened vertex → triangles map (CSR).
     support_offsets: Vec<usize>,
     support: Vec<usize>,
+    /// The mirror line kept by the choice of triangle for a point on an edge.
+    mirror: MirrorAxis,
 }
 
 impl<T: Real> Linear<T> {
-    /// Builds the basis on `mesh`.
+    /// Builds the basis on `mesh`, keeping vertical mirror lines
+    /// ([`with_mirror`](Self::with_mirror)).
     pub fn new(mesh: TriMesh) -> Self {
+        Self::with_mirror(mesh, MirrorAxis::Vertical)
+    }
+
+    /// Builds the basis on `mesh` for a scene whose mirror line runs along `axis`:
+    /// with [`MirrorAxis::Horizontal`] a point on a shared edge or vertex is held
+    /// by the triangle [`TriMesh::triangle_kept_at`] keeps.
+    pub fn with_mirror(mesh: TriMesh, axis: MirrorAxis) -> Self {
         let affine = (0..mesh.num_triangles())
             .map(|t| {
                 let [p1, p2, p3] = mesh.triangle_points(t);
@@ -52,6 +70,7 @@ impl<T: Real> Linear<T> {
             affine,
             support_offsets,
             support,
+            mirror: axis,
         }
     }
 
@@ -75,8 +94,15 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
         3
     }
     fn locate(&self, x: &Point<T, 2>, hint: Option<usize>) -> Option<usize> {
-        self.mesh
-            .locate(Vec2::new(x.x.to_f64(), x.y.to_f64()), hint)
+        let p = Vec2::new(x.x.to_f64(), x.y.to_f64());
+        let t = self.mesh.locate(p, hint)?;
+        Some(match self.mirror {
+            // Location's own choice (the lowest-numbered triangle, then the walk's
+            // first) keeps vertical mirror lines on the block grids
+            // (`tests/symmetry.rs`), and scenes keep the results they had.
+            MirrorAxis::Vertical => t,
+            MirrorAxis::Horizontal => self.mesh.triangle_kept_at(t, p, self.mirror),
+        })
     }
     fn other_elements_at(&self, element: usize, x: &Point<T, 2>, visit: &mut dyn FnMut(usize)) {
         self.mesh

@@ -470,11 +470,102 @@ impl TriMesh {
             _ => {}
         }
     }
+    /// The triangle that holds `p` (located in `t`) for a basis whose gradient jumps
+    /// across edges (PL): `t` itself unless `p` lies on an edge or vertex, within
+    /// [`locate::INSIDE_TOLERANCE`], where every triangle whose closure holds `p`
+    /// is a candidate and one is kept by a rule of the mesh's geometry alone, so
+    /// that the choice does not depend on round-off or on the walk's path and
+    /// commutes with mirrors about lines along `axis`.
+    ///
+    /// With `d` the offset of a candidate's centroid from the shared feature (the
+    /// edge's midpoint, or the vertex), the candidate reaching farthest across the
+    /// mirror axis's direction wins: for a vertical axis the largest `|d_y| − |d_x|`,
+    /// for a horizontal one the largest `|d_x| − |d_y|` (both unchanged by either
+    /// mirror). On the diagonals of the `four-triangles` grid this keeps the left or
+    /// right triangle of the block for a vertical axis (its centroid lies above or
+    /// below the half-diagonal's midpoint, rather than beside it), the bottom or top
+    /// one for a horizontal axis; at a block centre the bottom one for a vertical
+    /// axis, the left one for a horizontal one. Ties (up to `1e-9` of the offsets) go to the lower centroid along the
+    /// axis (`y` for a vertical axis, also unchanged by the mirror), then to the
+    /// lower index. A point on a vertex of the mirror line itself (a grid corner on
+    /// it) has candidates that are mirror images of each other: no choice keeps
+    /// the symmetry there.
+    pub fn triangle_kept_at(&self, t: usize, p: Vec2, axis: MirrorAxis) -> usize {
+        let l = self.barycentric(t, p);
+        let on: [bool; 3] = std::array::from_fn(|k| l[k] <= locate::INSIDE_TOLERANCE);
+        let vertices = self.triangles[t];
+        let feature = match on.iter().filter(|&&o| o).count() {
+            1 => {
+                let m = on.iter().position(|&o| o).unwrap();
+                let (a, b) = (vertices[(m + 1) % 3], vertices[(m + 2) % 3]);
+                (self.vertices[a] + self.vertices[b]) * 0.5
+            }
+            2 => self.vertices[vertices[on.iter().position(|&o| !o).unwrap()]],
+            _ => return t,
+        };
+        // (primary key, secondary key) of a candidate: larger primary, then lower
+        // secondary, wins.
+        let key = |n: usize| {
+            let [a, b, c] = self.triangle_points(n);
+            let centroid = (a + b + c) / 3.0;
+            let d = centroid - feature;
+            match axis {
+                MirrorAxis::Vertical => (d.y.abs() - d.x.abs(), centroid.y, d.norm()),
+                MirrorAxis::Horizontal => (d.x.abs() - d.y.abs(), centroid.x, d.norm()),
+            }
+        };
+        let mut best = t;
+        let mut best_key = key(t);
+        self.other_triangles_at(t, p, &mut |n| {
+            if self
+                .barycentric(n, p)
+                .iter()
+                .any(|&l| l < -locate::INSIDE_TOLERANCE)
+            {
+                return;
+            }
+            let k = key(n);
+            let tolerance = 1e-9 * k.2.max(best_key.2);
+            let wins = if (k.0 - best_key.0).abs() > tolerance {
+                k.0 > best_key.0
+            } else if (k.1 - best_key.1).abs() > tolerance {
+                k.1 < best_key.1
+            } else {
+                n < best
+            };
+            if wins {
+                best = n;
+                best_key = k;
+            }
+        });
+        best
+    }
     /// Barycentric coordinates of `p` in triangle `t` (they sum to one).
     pub fn barycentric(&self, t: usize, p: Vec2) -> [f64; 3] {
         let [a, b, c] = self.triangle_points(t);
         barycentric(a, b, c, p)
     }
+}
+
+/// An axis-aligned mirror line a scene is symmetric about, which the discrete
+/// choices of a basis keep where the mesh alone allows either of two mirror
+/// lines. The interior vertices of the block grids have PS points symmetric about
+/// both axis-aligned lines through them, and no triangle has two mirror lines: a
+/// PS control triangle keeps the axis asked for
+/// (`basis::powell_sabin::control_triangle`). A point on a shared edge or vertex
+/// lies in several triangles, and the PL gradient there depends on which one
+/// holds it: [`TriMesh::triangle_kept_at`] picks one by a rule that commutes with
+/// mirrors about lines along this axis. The mass strategies that treat rows one
+/// by one (lumping, the extension) keep a scene's symmetry only on a symmetric
+/// basis: the axis is the scene's mirror line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MirrorAxis {
+    /// A line `x = const`: a scene symmetric left to right (gravity along `y`).
+    #[default]
+    Vertical,
+    /// A line `y = const`: a scene symmetric top to bottom (bodies striking each
+    /// other along `x` about a horizontal mid-line, gravity along `x` or none).
+    Horizontal,
 }
 
 /// The signed area of triangle (a, b, c), positive when counter-clockwise.
@@ -504,6 +595,65 @@ pub fn bounding_box(points: &[Vec2]) -> (Vec2, Vec2) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On the `four-triangles` grid, a point on a diagonal or at a block centre is
+    /// held by the same triangle whichever triangle around it location found, and
+    /// the mirror image of the point about a line along the axis (a block edge or
+    /// a block centre line) is held by the mirror image of that triangle.
+    #[test]
+    fn the_triangle_kept_on_an_edge_is_the_mirror_image_of_the_partners() {
+        let mesh = generators::block_grid(0.0, 4.0, 0.0, 2.0, 16, 8).unwrap();
+        let centroid = |t: usize| {
+            let [a, b, c] = mesh.triangle_points(t);
+            (a + b + c) / 3.0
+        };
+        for axis in [MirrorAxis::Vertical, MirrorAxis::Horizontal] {
+            let index = match axis {
+                MirrorAxis::Vertical => 0,
+                MirrorAxis::Horizontal => 1,
+            };
+            let mut checked = 0;
+            for (i, j) in (0..16).flat_map(|i| (0..8).map(move |j| (i, j))) {
+                let corner = Vec2::new(0.25 * i as f64, 0.25 * j as f64);
+                // Lattice points of 4 × 4 per block on both diagonals, and the centre.
+                let offset = |k: usize| 0.25 * (k as f64 + 0.5) / 4.0;
+                let mut points: Vec<Vec2> = (0..4)
+                    .flat_map(|k| {
+                        [
+                            corner + Vec2::new(offset(k), offset(k)),
+                            corner + Vec2::new(offset(k), offset(3 - k)),
+                        ]
+                    })
+                    .collect();
+                points.push(corner + Vec2::new(0.125, 0.125));
+                for p in points {
+                    let mut around = vec![mesh.locate(p, None).unwrap()];
+                    mesh.other_triangles_at(around[0], p, &mut |n| around.push(n));
+                    assert!(around.len() > 1, "{p:?} is on an edge");
+                    let kept: Vec<usize> = around
+                        .iter()
+                        .map(|&t| mesh.triangle_kept_at(t, p, axis))
+                        .collect();
+                    assert!(kept.iter().all(|&k| k == kept[0]), "{p:?}: {kept:?}");
+                    // The mirror about the grid's middle line along the axis.
+                    let mut image = p;
+                    image[index] = [4.0, 2.0][index] - p[index];
+                    let found = mesh.locate(image, None).unwrap();
+                    let partner = mesh.triangle_kept_at(found, image, axis);
+                    let mut mirrored = centroid(kept[0]);
+                    mirrored[index] = [4.0, 2.0][index] - mirrored[index];
+                    assert!(
+                        (centroid(partner) - mirrored).norm() < 1e-12,
+                        "{axis:?} {p:?}: kept {} and {} for its image",
+                        kept[0],
+                        partner
+                    );
+                    checked += 1;
+                }
+            }
+            assert_eq!(checked, 16 * 8 * 9);
+        }
+    }
 
     fn square() -> (Vec<Vec2>, Vec<[usize; 3]>) {
         (

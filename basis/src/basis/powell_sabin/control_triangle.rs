@@ -19,6 +19,7 @@
 //! homogeneous Dirichlet condition on a straight boundary fixes exactly the
 //! coefficients of the control points on it (`ps-splines.md` §5).
 
+pub use crate::mesh::MirrorAxis;
 use crate::mesh::Vec2;
 
 /// A line `n · x = c` bounding the half-plane `n · x ≤ c` (`n` a unit outward normal).
@@ -191,24 +192,6 @@ pub const CORNER_AREA_RATIO: f64 = 4.0;
 /// valid mesh).
 pub fn control_triangle(vertex: Vec2, points: &[Vec2], kind: VertexKind) -> Option<[Vec2; 3]> {
     control_triangle_with(vertex, points, kind, MirrorAxis::Vertical)
-}
-
-/// The mirror line a control triangle keeps where the PS points of its vertex are
-/// mirror-symmetric about both axis-aligned lines through it (the interior
-/// vertices of the block grids: their octagon of PS points has both symmetries,
-/// and no triangle has two mirror lines). A basis is mirror-symmetric about a line
-/// of a symmetric mesh only if the triangles of the vertices on it keep that
-/// line, and the mass strategies that treat rows one by one (lumping, the
-/// extension) keep a scene's symmetry only on a symmetric basis: the axis is the
-/// scene's mirror line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum MirrorAxis {
-    /// A line `x = const`: a scene symmetric left to right (gravity along `y`).
-    #[default]
-    Vertical,
-    /// A line `y = const`: a scene symmetric top to bottom (bodies striking each
-    /// other along `x` about a horizontal mid-line, gravity along `x` or none).
-    Horizontal,
 }
 
 /// [`control_triangle`], keeping the line `axis` where the PS points are

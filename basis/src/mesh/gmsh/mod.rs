@@ -58,6 +58,28 @@ pub const MAX_PHYSICAL_NAMES: usize = 100_000;
 /// Most tags of one element (format 2.2) or physical tags of one curve (format 4.1).
 pub const MAX_TAGS: usize = 1_000;
 
+/// Most characters of the file's text echoed in a message.
+pub const MAX_SHOWN_CHARS: usize = 80;
+
+/// Text of the file as a message shows it: control characters escaped (`\u{1b}`)
+/// and cut to [`MAX_SHOWN_CHARS`] characters with an ellipsis, so that a binary or
+/// one-line file neither garbles the terminal nor floods it.
+pub fn shown(text: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in text.chars().enumerate() {
+        if n == MAX_SHOWN_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// An error reading a `.msh` file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GmshError {
@@ -145,18 +167,23 @@ impl<'a> Reader<'a> {
         let f: Vec<&str> = line.split_whitespace().collect();
         if f.len() < n || (!at_least && f.len() != n) {
             return Err(self.error(format!(
-                "expected {}{n} value{} in {what}, found {}: `{line}`",
+                "expected {}{n} value{} in {what}, found {}: `{}`",
                 if at_least { "at least " } else { "" },
                 if n == 1 { "" } else { "s" },
-                f.len()
+                f.len(),
+                shown(line)
             )));
         }
         Ok(f)
     }
 
     fn int(&self, s: &str, what: &str) -> Result<i64, GmshError> {
-        s.parse::<i64>()
-            .map_err(|_| self.error(format!("expected an integer for {what}, found `{s}`")))
+        s.parse::<i64>().map_err(|_| {
+            self.error(format!(
+                "expected an integer for {what}, found `{}`",
+                shown(s)
+            ))
+        })
     }
 
     fn count(&self, s: &str, what: &str) -> Result<usize, GmshError> {
@@ -212,7 +239,10 @@ impl<'a> Reader<'a> {
     fn float(&self, s: &str, what: &str) -> Result<f64, GmshError> {
         match s.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(self.error(format!("expected a finite number for {what}, found `{s}`"))),
+            _ => Err(self.error(format!(
+                "expected a finite number for {what}, found `{}`",
+                shown(s)
+            ))),
         }
     }
 
@@ -220,7 +250,7 @@ impl<'a> Reader<'a> {
         let end = format!("$End{section}");
         let line = self.next(&end)?;
         if line != end {
-            return Err(self.error(format!("expected {end}, found `{line}`")));
+            return Err(self.error(format!("expected {end}, found `{}`", shown(line))));
         }
         Ok(())
     }
@@ -395,7 +425,8 @@ pub fn parse_msh_with_surfaces(
                     "4.1" => 41,
                     other => {
                         return Err(r.error(format!(
-                            "unsupported .msh format version {other} (supported: 4.1 and 2.2 ASCII)"
+                            "unsupported .msh format version {} (supported: 4.1 and 2.2 ASCII)",
+                            shown(other)
                         )))
                     }
                 });
@@ -408,7 +439,8 @@ pub fn parse_msh_with_surfaces(
             }
             _ if version.is_none() => {
                 return Err(r.error(format!(
-                    "expected $MeshFormat at the start of the file, found `{header}`"
+                    "expected $MeshFormat at the start of the file, found `{}`",
+                    shown(header)
                 )));
             }
             "$PhysicalNames" => {
@@ -463,7 +495,12 @@ pub fn parse_msh_with_surfaces(
                     }
                 }
             }
-            other => return Err(r.error(format!("expected a section header, found `{other}`"))),
+            other => {
+                return Err(r.error(format!(
+                    "expected a section header, found `{}`",
+                    shown(other)
+                )))
+            }
         }
     }
     build_mesh(c, source)
