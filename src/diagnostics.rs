@@ -12,6 +12,9 @@ use nalgebra::{SMatrix, SVector};
 /// Largest growth of the time-centred total energy ([`StepReport::total_centred`],
 /// relative to the energy scale of the run) for a run to count as stable.
 pub const STABLE_ENERGY_GROWTH: f64 = 0.05;
+/// How many terms a particle adds to [`energies`] ([`terms_of`]).
+pub const TERMS: usize = 9;
+
 /// Largest condition estimate of the solved mass system for a stable run.
 pub const STABLE_CONDITION: f64 = 1e8;
 
@@ -29,6 +32,12 @@ pub struct StepReport {
     pub dt_critical: Option<f64>,
     /// Kinetic energy `Σ ½ m_p |v_p|²`.
     pub kinetic: f64,
+    /// Kinetic energy of the motion, `Σ ½ m_p |v̂_p|²` with `v̂_p` the velocity
+    /// re-projected onto the basis at the particle, the one that moved it in the
+    /// step (paper eq. (30)). `v_p` carries from step to step what the basis does
+    /// not see (after an impact above all), so `kinetic` can exceed it by much:
+    /// that part of `kinetic` moves no particle. The initial state's is `kinetic`.
+    pub kinetic_motion: f64,
     /// Strain energy `Σ V_p⁰ W(F_p)`.
     pub strain: f64,
     /// Potential energy of the effects (gravity).
@@ -134,6 +143,9 @@ impl StepReport {
 pub struct Energies {
     /// Kinetic energy.
     pub kinetic: f64,
+    /// Kinetic energy of the velocity that moved the particles
+    /// ([`StepReport::kinetic_motion`]).
+    pub kinetic_motion: f64,
     /// Strain energy (with the first-order work of an initial stress).
     pub strain: f64,
     /// Potential energy of the effects.
@@ -157,7 +169,7 @@ pub fn energies<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
 ) -> Energies {
     let chunk = crate::driver::phases::CHUNK;
     let partials = (0..parts.len().div_ceil(chunk)).map(|c| {
-        let mut sum = [0.0; 8];
+        let mut sum = [0.0; TERMS];
         for p in c * chunk..((c + 1) * chunk).min(parts.len()) {
             accumulate_terms(&mut sum, &particle_terms(parts, material, p));
         }
@@ -173,9 +185,10 @@ pub fn particle_terms<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     parts: &Particles<T, D>,
     material: &Mat,
     p: usize,
-) -> [f64; 8] {
+) -> [f64; TERMS] {
     terms_of(
         parts.mass[p],
+        &parts.v[p],
         &parts.v[p],
         parts.volume0[p],
         &parts.f[p],
@@ -184,21 +197,22 @@ pub fn particle_terms<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     )
 }
 
-/// The [`particle_terms`] of a particle of mass `m`, velocity `v`, initial volume
-/// `volume0`, deformation gradient `f`, initial stress `sigma0` and strain energy
-/// density `w = W(F)`.
+/// The [`particle_terms`] of a particle of mass `m`, velocity `v`, moved by the
+/// velocity `v_motion`, of initial volume `volume0`, deformation gradient `f`,
+/// initial stress `sigma0` and strain energy density `w = W(F)`.
 #[inline]
 pub fn terms_of<T: Scalar, const D: usize>(
     m: T,
     v: &SVector<T, D>,
+    v_motion: &SVector<T, D>,
     volume0: T,
     f: &SMatrix<T, D, D>,
     sigma0: &SMatrix<T, D, D>,
     w: T,
-) -> [f64; 8] {
+) -> [f64; TERMS] {
     let m = m.to_f64();
     let speed2 = v.norm_squared().to_f64();
-    let mut terms = [0.0; 8];
+    let mut terms = [0.0; TERMS];
     terms[0] = 0.5 * m * speed2;
     terms[1] = speed2.sqrt();
     terms[2] = volume0.to_f64() * w.to_f64();
@@ -212,6 +226,7 @@ pub fn terms_of<T: Scalar, const D: usize>(
     for k in 0..D {
         terms[6 + k] = m * v[k].to_f64();
     }
+    terms[8] = 0.5 * m * v_motion.norm_squared().to_f64();
     terms
 }
 
@@ -219,7 +234,7 @@ pub fn terms_of<T: Scalar, const D: usize>(
 /// speed) as a maximum, the others summed. Partial sums of consecutive particles,
 /// read in their order, give [`energies_from_terms`] a fixed summation order.
 #[inline]
-pub fn accumulate_terms(sum: &mut [f64; 8], terms: &[f64; 8]) {
+pub fn accumulate_terms(sum: &mut [f64; TERMS], terms: &[f64; TERMS]) {
     for (k, (s, t)) in sum.iter_mut().zip(terms).enumerate() {
         if k == 1 {
             *s = s.max(*t);
@@ -231,11 +246,12 @@ pub fn accumulate_terms(sum: &mut [f64; 8], terms: &[f64; 8]) {
 
 /// [`energies`] from the [`particle_terms`] of every particle, in particle order.
 pub fn energies_from_terms<T: Scalar, const D: usize>(
-    terms: impl Iterator<Item = [f64; 8]>,
+    terms: impl Iterator<Item = [f64; TERMS]>,
     parts: &Particles<T, D>,
     effects: &[Box<dyn Effect<T, D>>],
 ) -> Energies {
     let (mut kinetic, mut strain, mut mass, mut max_speed) = (0.0, 0.0, 0.0, 0.0f64);
+    let mut kinetic_motion = 0.0;
     let mut momentum = [0.0; 2];
     for t in terms {
         kinetic += t[0];
@@ -248,9 +264,11 @@ pub fn energies_from_terms<T: Scalar, const D: usize>(
         for k in 0..D {
             momentum[k] += t[6 + k];
         }
+        kinetic_motion += t[8];
     }
     Energies {
         kinetic,
+        kinetic_motion,
         strain,
         potential: effects
             .iter()

@@ -56,7 +56,7 @@ use std::path::{Path, PathBuf};
 
 /// A row of `diagnostics.csv` (and of `run --format csv`): floats in Rust's
 /// shortest round-trip `{:e}` form.
-pub fn diagnostics_record(r: &StepReport) -> [String; 21] {
+pub fn diagnostics_record(r: &StepReport) -> [String; 22] {
     let float = |x: f64| format!("{x:e}");
     let worst = r.mass_report.worst_coverage;
     let at = |k: usize| {
@@ -87,11 +87,12 @@ pub fn diagnostics_record(r: &StepReport) -> [String; 21] {
         at(0),
         at(1),
         r.condition.map_or_else(String::new, float),
+        float(r.kinetic_motion),
     ]
 }
 
 /// Columns of `diagnostics.csv`.
-pub const DIAGNOSTICS_COLUMNS: [&str; 21] = [
+pub const DIAGNOSTICS_COLUMNS: [&str; 22] = [
     "step",
     "time",
     "kinetic",
@@ -113,6 +114,7 @@ pub const DIAGNOSTICS_COLUMNS: [&str; 21] = [
     "worst_x",
     "worst_y",
     "condition",
+    "kinetic_motion",
 ];
 
 /// File names.

@@ -433,6 +433,7 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         json!(at(0)),
         json!(at(1)),
         json!(r.condition),
+        json!(r.kinetic_motion),
     ];
     serde_json::Value::Object(
         out::DIAGNOSTICS_COLUMNS

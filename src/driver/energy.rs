@@ -128,6 +128,7 @@ where
             dt: self.dt.to_f64(),
             dt_critical: self.dt_critical,
             kinetic: e.kinetic,
+            kinetic_motion: e.kinetic_motion,
             strain: e.strain,
             potential: e.potential,
             work: self.work,

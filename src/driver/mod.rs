@@ -37,6 +37,7 @@ pub use failure::{SetupError, StepError, NEARLY_SINGULAR};
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
 
+use crate::diagnostics::TERMS;
 use crate::effect::{Effect, ParticleBasis, StepState};
 use crate::mass::{
     Constraints, Correction, MassReport, MassSetup, MassStrategy, Needs, StepContext, SupportFacts,
@@ -204,7 +205,7 @@ where
     functions_affine: bool,
     /// Per-chunk sums of the particle terms of the step report's energies
     /// (written by [`phases::update_particles`]).
-    energy_terms: Vec<[f64; 8]>,
+    energy_terms: Vec<[f64; TERMS]>,
     /// The end (one past the last particle) of each body's particles, the bodies
     /// stored one after another ([`Driver::set_body_sizes`]); empty for one body.
     body_ends: Vec<usize>,
@@ -383,7 +384,7 @@ where
             work_force: scratch(effects.iter().any(|e| e.does_work())),
             dissipative_force: scratch(effects.iter().any(|e| e.does_work() && e.dissipative())),
             adjust: scratch(!effects.is_empty()),
-            energy_terms: vec![[0.0; 8]; phases::chunks(np)],
+            energy_terms: vec![[0.0; TERMS]; phases::chunks(np)],
             body_ends: Vec::new(),
             centred_terms: vec![0.0; phases::chunks(np)],
             previous_energy: None,

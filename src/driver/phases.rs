@@ -930,7 +930,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
     dt: T,
     material: &Mat,
     parts: &mut Particles<T, D>,
-    energy: &mut [[f64; 8]],
+    energy: &mut [[f64; crate::diagnostics::TERMS]],
 ) -> Result<(), UpdateFailure> {
     // Empty when no particle has an initial stress (then it is zero).
     let sigma0 = &parts.sigma0;
@@ -953,7 +953,7 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
         .enumerate()
         .filter_map(
             |(c, ((fs, sigma, volume, x, u), (volume0, v, mass, energy)))| {
-                *energy = [0.0; 8];
+                *energy = [0.0; crate::diagnostics::TERMS];
                 for q in 0..fs.len() {
                     let p = c * CHUNK + q;
                     let mut grad_v = SMatrix::<T, D, D>::zeros();
@@ -982,8 +982,9 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
                     x[q] += v_hat * dt;
                     u[q] += v_hat * dt;
                     let w = material.energy_density(p, &f);
-                    let terms =
-                        crate::diagnostics::terms_of(mass[q], &v[q], volume0[q], &f, &s0, w);
+                    let terms = crate::diagnostics::terms_of(
+                        mass[q], &v[q], &v_hat, volume0[q], &f, &s0, w,
+                    );
                     crate::diagnostics::accumulate_terms(energy, &terms);
                     if !x[q].iter().all(|c| c.to_f64().is_finite())
                         || !v[q].iter().all(|c| c.to_f64().is_finite())

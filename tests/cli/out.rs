@@ -171,7 +171,8 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             "worst_function",
             "worst_x",
             "worst_y",
-            "condition"
+            "condition",
+            "kinetic_motion"
         ]
     );
     // docs/scenes.md lists exactly these columns, in this order.

@@ -140,6 +140,15 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
+    /// An error at 1-based `line`.
+    fn error_at(&self, line: usize, message: impl Into<String>) -> GmshError {
+        GmshError::Syntax {
+            file: self.file.to_string(),
+            line: line.max(1),
+            message: message.into(),
+        }
+    }
+
     fn error(&self, message: impl Into<String>) -> GmshError {
         GmshError::Syntax {
             file: self.file.to_string(),
@@ -681,7 +690,7 @@ $Nodes
 0 1 0
 $EndNodes
 $Elements
-7 9 1 9
+7 8 1 9
 0 1 15 1
 9 10
 1 1 1 1

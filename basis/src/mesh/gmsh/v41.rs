@@ -66,7 +66,8 @@ pub(super) fn read_nodes(r: &mut Reader, c: &mut Contents) -> Result<(), GmshErr
         false,
     )?;
     let blocks = r.bounded(f[0], "the number of node blocks", MAX_ENTITY_BLOCKS)?;
-    r.bounded(f[1], "the number of nodes", MAX_NODES)?;
+    let declared = r.bounded(f[1], "the number of nodes", MAX_NODES)?;
+    let (header, before) = (r.pos, c.node_total);
     for _ in 0..blocks {
         let f = r.fields(
             "a $Nodes entity block header (entityDim entityTag parametric numNodesInBlock)",
@@ -95,6 +96,13 @@ pub(super) fn read_nodes(r: &mut Reader, c: &mut Contents) -> Result<(), GmshErr
             c.add_node(r, id, xyz)?;
         }
     }
+    let held = c.node_total - before;
+    if held != declared {
+        return Err(r.error_at(
+            header,
+            format!("the $Nodes header announces {declared} nodes, its blocks hold {held}"),
+        ));
+    }
     Ok(())
 }
 
@@ -106,7 +114,8 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
         false,
     )?;
     let blocks = r.bounded(f[0], "the number of element blocks", MAX_ENTITY_BLOCKS)?;
-    r.bounded(f[1], "the number of elements", MAX_ELEMENTS)?;
+    let declared = r.bounded(f[1], "the number of elements", MAX_ELEMENTS)?;
+    let (header, before) = (r.pos, c.element_total);
     for _ in 0..blocks {
         let f = r.fields(
             "a $Elements entity block header (entityDim entityTag elementType numElementsInBlock)",
@@ -133,6 +142,13 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             let f = r.fields("an element (tag nodes…)", 2, true)?;
             c.add_element(r, kind, &f[1..], physical)?;
         }
+    }
+    let held = c.element_total - before;
+    if held != declared {
+        return Err(r.error_at(
+            header,
+            format!("the $Elements header announces {declared} elements, its blocks hold {held}"),
+        ));
     }
     Ok(())
 }
@@ -213,12 +229,12 @@ mod tests {
                 "the number of nodes in the block is 10000001, above the limit of 10000000".into(),
             ),
             (
-                "7 9 1 9",
+                "7 8 1 9",
                 "7 20000001 1 9".into(),
                 "the number of elements is 20000001, above the limit of 20000000".into(),
             ),
             (
-                "7 9 1 9",
+                "7 8 1 9",
                 "1000001 9 1 9".into(),
                 "the number of element blocks is 1000001, above the limit of 1000000".into(),
             ),
@@ -233,6 +249,25 @@ mod tests {
                 "1 0 0 0 1 0 0 1 7 2 1 -2",
                 "1 0 0 0 1 0 0 1001 7 2 1 -2".into(),
                 "the number of physical tags is 1001, above the limit of 1000".into(),
+            ),
+        ] {
+            let (line, msg) =
+                syntax_line(&GOOD_41.replacen(&format!("\n{from}\n"), &format!("\n{to}\n"), 1));
+            assert_eq!(line, line_of(GOOD_41, from), "{to}");
+            assert_eq!(msg, message);
+        }
+        // Headers whose totals disagree with their blocks (a user's files: 30 nodes
+        // announced for 25, 999 elements for 36), named at the header.
+        for (from, to, message) in [
+            (
+                "2 5 10 40",
+                "2 6 10 40",
+                "the $Nodes header announces 6 nodes, its blocks hold 5",
+            ),
+            (
+                "7 8 1 9",
+                "7 999 1 9",
+                "the $Elements header announces 999 elements, its blocks hold 8",
             ),
         ] {
             let (line, msg) =
