@@ -63,7 +63,7 @@ pub const MAX_MESH_FILE_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest scene file read, in bytes.
 pub const MAX_SCENE_FILE_BYTES: u64 = 4 * 1024 * 1024;
 /// Most characters of user text echoed in a message (longer text is cut).
-pub const MAX_ECHO_CHARS: usize = 80;
+pub const MAX_ECHO_CHARS: usize = psmpm_basis::mesh::gmsh::MAX_SHOWN_CHARS;
 
 /// Reads the regular file `path` of at most `limit` bytes. Devices, FIFOs and
 /// sockets are refused before they are opened (so that `/dev/zero` or a FIFO can
@@ -107,21 +107,11 @@ pub const MAX_NAME_CHARS: usize = 200;
 pub const MAX_DESCRIPTION_CHARS: usize = 2000;
 
 /// User text as it is echoed in messages: control characters escaped (`\n`,
-/// `\u{1b}`, …) and cut to [`MAX_ECHO_CHARS`] characters with an ellipsis.
+/// `\u{1b}`, …) and cut to [`MAX_ECHO_CHARS`] characters with an ellipsis, as
+/// the Gmsh reader shows a mesh file's text
+/// ([`psmpm_basis::mesh::gmsh::shown`]).
 pub fn echo(text: &str) -> String {
-    let mut out = String::new();
-    for (n, c) in text.chars().enumerate() {
-        if n == MAX_ECHO_CHARS {
-            out.push('…');
-            break;
-        }
-        if c.is_control() {
-            out.extend(c.escape_debug());
-        } else {
-            out.push(c);
-        }
-    }
-    out
+    psmpm_basis::mesh::gmsh::shown(text)
 }
 
 /// Names of the mesh (tags, physical groups) as a message lists them: each

@@ -61,9 +61,9 @@ pub const MAX_TAGS: usize = 1_000;
 /// Most characters of the file's text echoed in a message.
 pub const MAX_SHOWN_CHARS: usize = 80;
 
-/// Text of the file as a message shows it: control characters escaped (`\u{1b}`)
-/// and cut to [`MAX_SHOWN_CHARS`] characters with an ellipsis, so that a binary or
-/// one-line file neither garbles the terminal nor floods it.
+/// Text of a file (a mesh, a scene) as a message shows it: control characters
+/// escaped (`\u{1b}`) and cut to [`MAX_SHOWN_CHARS`] characters with an ellipsis,
+/// so that a binary or one-line file neither garbles the terminal nor floods it.
 pub fn shown(text: &str) -> String {
     let mut out = String::new();
     for (n, c) in text.chars().enumerate() {
