@@ -420,7 +420,8 @@ pub fn self_weight_warning<const D: usize>(
 ) -> Option<String> {
     use crate::scene::MaterialModel;
     let g = gravity?;
-    let g_norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
+    // `hypot`: `|g|` of a huge `g` (1e300) is itself, not an overflow to infinity.
+    let g_norm = g.iter().fold(0.0f64, |a, c| a.hypot(*c));
     if g_norm.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || particles.is_empty() {
         return None;
     }

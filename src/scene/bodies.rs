@@ -2,7 +2,9 @@
 //! lattice, its material and initial velocity (its own or the scene's), and the
 //! number of particles of all bodies, bounded before any is made.
 
-use super::limits::{echo_number, plural, MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS};
+use super::limits::{
+    echo_number, plural, MAX_OUTLINE_CORNERS, MAX_PARTICLES, MAX_POLYGON_TESTS, MAX_SPEED,
+};
 use super::{
     bad, conflict, Body, BodyShape, ErrorKind, InitialVelocity, MaterialSpec, MeshSpec, Scene,
     SceneError,
@@ -398,11 +400,29 @@ impl Scene {
                 None => Ok(()),
             }
         };
+        // A speed no continuum moves at (its kinetic energy may not even be a
+        // number): a unit slip, named before the run fails at its first step.
+        let speed = |f: String, s: f64| -> Result<(), SceneError> {
+            if s > MAX_SPEED {
+                return Err(bad(
+                    f,
+                    format!(
+                        "a speed of {} m/s is beyond continuum mechanics (the limit is {MAX_SPEED:e}, a third of the speed of light): give it in m/s",
+                        echo_number(s)
+                    ),
+                ));
+            }
+            Ok(())
+        };
         match v {
-            InitialVelocity::Uniform { value } => vector(sub("value"), value)?,
+            InitialVelocity::Uniform { value } => {
+                vector(sub("value"), value)?;
+                speed(sub("value"), value.iter().fold(0.0f64, |a, c| a.hypot(*c)))?;
+            }
             InitialVelocity::SineMode { v0 } if !v0.is_finite() => {
                 return Err(bad(sub("v0"), format!("must be finite, got {v0}")));
             }
+            InitialVelocity::SineMode { v0 } => speed(sub("v0"), v0.abs())?,
             InitialVelocity::Exact {} if self.reference.is_none() => {
                 return Err(conflict(
                     sub("kind"),

@@ -58,6 +58,9 @@ pub const MAX_FRAMES: usize = 100_000;
 pub const MAX_TABLE_ROWS: usize = 100_000;
 /// Most threads `--threads` may ask for.
 pub const MAX_THREADS: usize = 1024;
+/// Largest initial speed of a body, m/s (a third of the speed of light: beyond it a
+/// value is a unit slip, not a continuum's motion).
+pub const MAX_SPEED: f64 = 1e8;
 /// Largest Gmsh mesh file read, in bytes.
 pub const MAX_MESH_FILE_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest scene file read, in bytes.

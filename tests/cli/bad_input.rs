@@ -821,6 +821,9 @@ fn inconsistent_cases() -> Vec<Case> {
         case("geostatic-stress-without-gravity", BAR)
             .edit("[time]", "[[effect]]\nkind = @@\"geostatic-stress\"\nsurface = 1.0\n\n[time]")
             .expect("effect[0].kind: geostatic stress needs a gravity effect"),
+        case("initial-speed-beyond-continuum-mechanics", BAR)
+            .edit("[initial_velocity]\nkind = \"exact\"", "[initial_velocity]\nkind = \"uniform\"\nvalue = @@[1e200, 0.0]")
+            .expect("initial_velocity.value: a speed of 1e200 m/s is beyond continuum mechanics (the limit is 1e8, a third of the speed of light): give it in m/s"),
         case("geostatic-surface-below-the-body", BAR)
             .edit("[time]", "[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n\n[[effect]]\nkind = \"geostatic-stress\"\nsurface = @@0.5\n\n[time]")
             .expect("effect[1].surface: the free surface y = 0.5 lies below the highest particle (y = 0.875): the particles above it would start without stress; give the top of the bodies, or a height above it for a load on them"),
