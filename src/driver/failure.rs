@@ -440,9 +440,7 @@ pub(crate) fn point(x: &[f64]) -> String {
             if c == 0.0 || !c.is_finite() {
                 return format!("{c}");
             }
-            // Six significant digits, read back so that `{}` prints the shortest form.
-            let rounded: f64 = format!("{c:.5e}").parse().unwrap_or(c);
-            crate::scene::limits::echo_number(rounded)
+            crate::scene::limits::echo_significant(c, 6)
         })
         .collect();
     format!("[{}]", coordinates.join(", "))

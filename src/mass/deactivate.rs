@@ -52,7 +52,7 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
             return Err(MassError::NothingActive {
                 threshold: self.threshold,
                 // Three digits: enough to choose a threshold below it.
-                largest: format!("{largest:.2e}").parse().unwrap_or(largest),
+                largest: crate::scene::limits::significant(largest, 3),
             });
         }
         self.solver.factorize(pattern, values)?;

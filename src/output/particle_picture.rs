@@ -330,8 +330,7 @@ fn short_time(t: f64) -> String {
     if t == 0.0 || !t.is_finite() {
         return format!("{t}");
     }
-    let rounded: f64 = format!("{t:.5e}").parse().unwrap_or(t);
-    format!("{rounded}")
+    format!("{}", crate::scene::limits::significant(t, 6))
 }
 
 #[cfg(test)]

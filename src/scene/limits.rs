@@ -148,6 +148,17 @@ pub fn echo_number(x: f64) -> String {
     }
 }
 
+/// `x` rounded to `digits` significant digits (at least 1), so that `{}` prints it
+/// without the noise of the last bits (`0.0526996739197737` to 3: `0.0527`).
+pub fn significant(x: f64, digits: usize) -> f64 {
+    format!("{x:.*e}", digits.max(1) - 1).parse().unwrap_or(x)
+}
+
+/// [`echo_number`] of `x` rounded to `digits` significant digits ([`significant`]).
+pub fn echo_significant(x: f64, digits: usize) -> String {
+    echo_number(significant(x, digits))
+}
+
 /// `n` with the noun that agrees with it, for messages: `1 entry`, `2 entries`,
 /// `0 entries`.
 pub fn plural(n: usize, one: &str, many: &str) -> String {
@@ -200,6 +211,14 @@ mod tests {
         let many: Vec<String> = (0..25).map(|i| i.to_string()).collect();
         assert!(echo_tags(&many).ends_with("`19`, and 5 more"));
         assert!(echo_tags(&[]).contains("$Entities"));
+    }
+
+    #[test]
+    fn numbers_are_rounded_to_significant_digits() {
+        assert_eq!(significant(0.0526996739197737, 3), 0.0527);
+        assert_eq!(echo_significant(1886.97, 4), "1887");
+        assert_eq!(echo_significant(4.63654203317802, 3), "4.64");
+        assert_eq!(echo_significant(1.2345e300, 2), "1.2e300");
     }
 
     #[test]

@@ -420,7 +420,7 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                         "is shorter than one time step (t_end = {}, courant = {} gives dt = {step:.3e}): give `t_end` of at least {}, or a fixed `dt` below it (the critical step grows as h √(ρ / E): E = {} here)",
                         echo_number(t_end),
                         echo_number(c),
-                        echo_number(format!("{step:.2e}").parse().unwrap_or(step)),
+                        crate::scene::limits::echo_significant(step, 3),
                         echo_number(scene.material.young)
                     ),
                 )
