@@ -326,10 +326,17 @@ pub const PS_REGULAR_SAMPLING: f64 = 9.0;
 /// ends with 48 %, 9.4 %, 1.3 %, 0 % of its particles irregular, PL with 2 × 2 and
 /// 4 × 4 with 79 % and 0 %; none of the scenes of `docs/examples` reaches 4 % with
 /// either basis.
+///
+/// With `contact_walls` (the scene has a contact wall) the fix adds that a finer
+/// lattice wants a smaller `courant`: the wall's contact distance is half a
+/// particle spacing, while the time step of a given `courant` grows with the
+/// particles (better covered functions, fewer lumped rows), so a body sampled
+/// finer at the same `courant` can pass through the wall (a user's soft disk did).
 pub fn irregularity_warning(
     irregularity: &Irregularity,
     ps: bool,
     sampling: f64,
+    contact_walls: bool,
 ) -> Option<String> {
     let Irregularity {
         measured,
@@ -343,6 +350,11 @@ pub fn irregularity_warning(
             )
         } else {
             "give more particles per element (`per_block`, `per_triangle`, `count` or `spacing`; `--particles`), and if the body was struck hard a smaller `courant`".to_string()
+        };
+        let fix = if contact_walls {
+            format!("{fix}; with a contact wall lower `courant` with the particle spacing as well (the contact distance is half a spacing, and the step of a given `courant` grows with the particles: from 4 to 9 per triangle, `courant` × 2/3), or the body can pass through the wall")
+        } else {
+            fix
         };
         format!(
             "{irregular} of the {measured} particles ({:.0} %) ended out of their neighbours' arrangement by more than {IRREGULAR_RESIDUAL} of their spacing (the largest {largest:.2}): beyond what a smooth motion does, the particles paired up, opened voids or crossed rows, which the energy verdict does not show: look at the particles (`--out`); {fix}",
@@ -464,10 +476,10 @@ mod tests {
         });
         let r = irregularity(&zigzag, &[]);
         assert!(r.irregular >= 64, "{r:?}");
-        assert!(irregularity_warning(&r, true, 4.0)
+        assert!(irregularity_warning(&r, true, 4.0, false)
             .unwrap()
             .contains("with PS, 4.0 particles per occupied triangle"));
-        assert!(!irregularity_warning(&r, false, 4.0)
+        assert!(!irregularity_warning(&r, false, 4.0, false)
             .unwrap()
             .contains("with PS"));
         let few = |irregular| Irregularity {
@@ -475,8 +487,14 @@ mod tests {
             irregular,
             largest: 0.5,
         };
-        assert!(irregularity_warning(&few(4), true, 4.0).is_none());
-        assert!(irregularity_warning(&few(5), true, 4.0).is_some());
+        assert!(irregularity_warning(&few(4), true, 4.0, false).is_none());
+        assert!(irregularity_warning(&few(5), true, 4.0, false).is_some());
+        assert!(!irregularity_warning(&few(5), true, 4.0, false)
+            .unwrap()
+            .contains("contact wall"));
+        assert!(irregularity_warning(&few(5), true, 4.0, true)
+            .unwrap()
+            .contains("with a contact wall lower `courant`"));
         // The top three rows (30 particles) slide by a spacing along the rest.
         let slid =
             moved(&|x: Vector2<f64>| x + Vector2::new(if x.y > 0.65 { 0.1 } else { 0.0 }, 0.0));

@@ -1150,6 +1150,10 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     &irregularity,
                     scene.basis == crate::bases::BasisKind::Ps,
                     tally.sampling,
+                    scene
+                        .effects
+                        .iter()
+                        .any(|e| matches!(e, crate::scene::EffectSpec::ContactWall { .. })),
                 ))
                 .chain(stray_warning(
                     tally.stray_at_start,
