@@ -1105,7 +1105,10 @@ fn mesh_cases() -> Vec<Case> {
         bad(
             "gmsh-inverted-triangle",
             "inverted.msh",
-            ": invalid mesh: triangle 0 is clockwise (inverted); triangles must be counter-clockwise",
+            &format!(
+                "{}: invalid mesh: the triangle of nodes 37 79 68 runs clockwise while other triangles run counter-clockwise (surfaces meshed with opposite normals): reverse that surface's mesh in Gmsh (`ReverseMesh`) or list the element's nodes the other way round",
+                at("bad/inverted.msh", "33 2 2 5 1 37 79 68")
+            ),
         ),
         bad(
             "gmsh-misspelt-end",

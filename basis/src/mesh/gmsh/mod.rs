@@ -109,12 +109,17 @@ pub enum GmshError {
         /// What is missing or wrong.
         message: String,
     },
-    /// The triangles do not form a valid mesh.
-    #[error("{file}: invalid mesh: {source}")]
+    /// The triangles do not form a valid mesh. The message names the file's node
+    /// tags and, for a failure of one triangle, the line of its element.
+    #[error("{file}{}: invalid mesh: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Mesh {
         /// The file name.
         file: String,
-        /// The validation failure.
+        /// The 1-based line of the element at fault, when one triangle is.
+        line: Option<usize>,
+        /// The failure in the file's terms (node tags, not the mesh's indices).
+        message: String,
+        /// The validation failure, in the mesh's 0-based indices.
         source: MeshError,
     },
 }
@@ -587,9 +592,18 @@ fn build_mesh(c: Contents, source: &str) -> Result<(TriMesh, PhysicalSurfaces), 
             t.swap(1, 2);
         }
     }
-    let mut mesh = TriMesh::new(vertices, tris).map_err(|e| GmshError::Mesh {
-        file: source.to_string(),
-        source: e,
+    let mut mesh = TriMesh::new(vertices, tris).map_err(|e| {
+        let mut node_of = vec![0i64; used.len()];
+        for (&id, &v) in &used {
+            node_of[v] = id;
+        }
+        let (line, message) = in_file_terms(&e, &node_of, &triangles);
+        GmshError::Mesh {
+            file: source.to_string(),
+            line,
+            message,
+            source: e,
+        }
     })?;
     for ([a, b], physical, _) in lines {
         let (Some(&a), Some(&b)) = (used.get(&a), used.get(&b)) else {
@@ -611,6 +625,72 @@ fn build_mesh(c: Contents, source: &str) -> Result<(TriMesh, PhysicalSurfaces), 
             .collect(),
     };
     Ok((mesh, surfaces))
+}
+
+/// A validation failure of the mesh in the file's terms: the node tags of the
+/// file (`node_of[v]` for the mesh's vertex `v`) and, for a failure of one
+/// triangle, the line of its element (`triangles[t].1`).
+fn in_file_terms(
+    e: &MeshError,
+    node_of: &[i64],
+    triangles: &[([i64; 3], usize, Option<i64>)],
+) -> (Option<usize>, String) {
+    let node = |v: usize| node_of.get(v).copied().unwrap_or(v as i64);
+    let element = |t: usize| {
+        triangles.get(t).map(|(nodes, line, _)| {
+            (
+                Some(*line),
+                format!(
+                    "the triangle of nodes {} {} {}",
+                    nodes[0], nodes[1], nodes[2]
+                ),
+            )
+        })
+    };
+    let at_triangle = |t: usize, what: &str| match element(t) {
+        Some((line, named)) => (line, format!("{named} {what}")),
+        None => (None, format!("triangle {t} {what}")),
+    };
+    match *e {
+        MeshError::RepeatedVertex { triangle, .. } => {
+            at_triangle(triangle, "repeats a node")
+        }
+        MeshError::DegenerateTriangle { triangle, area } => at_triangle(
+            triangle,
+            &format!("is degenerate (signed area {area:e} relative to the mesh size): its nodes lie on one line"),
+        ),
+        MeshError::InvertedTriangle { triangle } => at_triangle(
+            triangle,
+            "runs clockwise while other triangles run counter-clockwise (surfaces meshed with opposite normals): reverse that surface's mesh in Gmsh (`ReverseMesh`) or list the element's nodes the other way round",
+        ),
+        MeshError::NonFiniteVertex { vertex } => {
+            (None, format!("node {} has a non-finite coordinate", node(vertex)))
+        }
+        MeshError::NonManifoldEdge { a, b } => (
+            None,
+            format!(
+                "the edge from node {} to node {} is shared by more than two triangles, or by two that overlap (non-manifold): remove the duplicate or overlapping elements",
+                node(a),
+                node(b)
+            ),
+        ),
+        MeshError::NonManifoldVertex { vertex } => (
+            None,
+            format!(
+                "node {} is where two separate fans of triangles touch (non-manifold): regions of the mesh meet at that node only; join them along an edge or mesh them apart",
+                node(vertex)
+            ),
+        ),
+        MeshError::DuplicateVertex { a, b, x, y } => (
+            None,
+            format!(
+                "nodes {} and {} coincide at ({x}, {y}): the surfaces meeting there do not share their nodes (`Coherence Mesh;` in Gmsh merges them)",
+                node(a),
+                node(b)
+            ),
+        ),
+        ref other => (None, other.to_string()),
+    }
 }
 
 #[cfg(test)]
@@ -880,13 +960,51 @@ $EndElements
         assert!((area(&m) - 1.0).abs() < 1e-15);
         m.require_tagged_boundary().unwrap();
         let mixed = GOOD_22.replace("5 2 2 1 1 1 2 3", "5 2 2 1 1 1 3 2");
+        let error = parse_msh(&mixed, "mixed.msh").unwrap_err();
         assert!(matches!(
-            parse_msh(&mixed, "mixed.msh"),
-            Err(GmshError::Mesh {
+            error,
+            GmshError::Mesh {
                 source: MeshError::InvertedTriangle { triangle: 0 },
                 ..
-            })
+            }
         ));
+        // Named by the element's line and the file's node tags.
+        assert!(
+            error.to_string().starts_with(
+                "mixed.msh:21: invalid mesh: the triangle of nodes 1 3 2 runs clockwise"
+            ),
+            "{error}"
+        );
+    }
+
+    /// The mesh's validation failures name the file's node tags (not the mesh's
+    /// 0-based vertices) and, for one triangle, the line of its element.
+    #[test]
+    fn invalid_meshes_are_named_in_the_files_terms() {
+        // Node 5 at the place of node 3, used by the second triangle.
+        let doubled = GOOD_22
+            .replace("$Nodes\n4\n", "$Nodes\n5\n")
+            .replace("4 0 1 0\n$EndNodes", "4 0 1 0\n5 1 1 0\n$EndNodes")
+            .replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 5 4");
+        let error = parse_msh(&doubled, "doubled.msh").unwrap_err().to_string();
+        assert!(
+            error.starts_with("doubled.msh: invalid mesh: nodes 3 and 5 coincide at (1, 1)"),
+            "{error}"
+        );
+        assert!(error.contains("Coherence Mesh"), "{error}");
+        // The second triangle's third node on the line through its first two.
+        let flat = GOOD_22
+            .replace("$Nodes\n4\n", "$Nodes\n5\n")
+            .replace("4 0 1 0\n$EndNodes", "4 0 1 0\n5 2 2 0\n$EndNodes")
+            .replace("6 2 2 1 1 1 3 4", "6 2 2 1 1 1 3 4\n7 2 2 1 1 1 3 5");
+        let flat = flat.replace("$Elements\n6\n", "$Elements\n7\n");
+        let error = parse_msh(&flat, "flat.msh").unwrap_err().to_string();
+        assert!(
+            error.starts_with(
+                "flat.msh:24: invalid mesh: the triangle of nodes 1 3 5 is degenerate"
+            ),
+            "{error}"
+        );
     }
 
     #[test]
