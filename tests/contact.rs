@@ -395,7 +395,8 @@ t_end = 0.6
     let through = failure(&scene("right", 0.02));
     assert!(
         through.contains("left the mesh")
-            && through.contains("and went through a contact wall, whose springs were too soft"),
+            && through
+                .contains("and went through a contact wall: lower `time.courant` from 0.3 to 0.15"),
         "{through}"
     );
     let free = failure(&scene("left", 0.5));

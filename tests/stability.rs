@@ -969,3 +969,45 @@ t_end = 0.9
         out.summary.warnings
     );
 }
+
+/// A free block pushed by a uniform body force moves exactly (`x = a t²/2`), so its
+/// time-centred total must hold to round-off from the first step. It did not: the
+/// work was booked with the mean of the start and end velocities while the centred
+/// kinetic energy `½ m vⁿ·vⁿ⁺¹` pairs with the work along the displacements, and the
+/// total rose by `½ m |a|² Δt²` per step, a `1/n` share of the kinetic energy that
+/// judged a 10-step run UNSTABLE (growth 9e-2; a user's scene).
+#[test]
+fn a_short_run_under_a_body_force_is_judged_on_the_work_along_the_motion() {
+    let text = r#"
+name = "pushed"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 2.0]
+blocks = [8, 4]
+[material]
+young = 1e4
+poisson = 0.3
+density = 2.0
+[[body]]
+min = [0.5, 0.5]
+max = [1.5, 1.5]
+per_block = [4, 4]
+[[effect]]
+kind = "body-force"
+value = [3.0, 1.0]
+[time]
+courant = 0.5
+t_end = 0.01
+"#;
+    let summary = run(&Scene::from_toml(text, "pushed.toml").unwrap(), &mut |_| {}).unwrap();
+    assert!(summary.failure.is_none(), "{summary:?}");
+    assert!(summary.stable, "{summary:?}");
+    assert!(
+        summary.energy_growth_centred < 1e-9,
+        "centred growth {:e}",
+        summary.energy_growth_centred
+    );
+}

@@ -78,18 +78,23 @@ fn check_out(out: &std::path::Path, overwrite: bool) -> Result<(), CliError> {
 
 fn mesh(args: &PlotArgs) -> Result<TriMesh, CliError> {
     if let Some(path) = &args.mesh {
-        return psmpm::basis::mesh::gmsh::read_msh(path)
-            .map_err(|e| CliError::Input(e.to_string()));
+        // The scene's bounded read: a regular file of at most 256 MiB (a FIFO
+        // would block, `/dev/zero` would fill memory).
+        return psmpm::scene::limits::read_mesh(&path.display().to_string())
+            .map_err(CliError::Input);
     }
     if let Some(name) = &args.scene {
         let scene = read_scene(name)?;
+        let located = |e: psmpm::simulation::RunError| match e {
+            psmpm::simulation::RunError::Scene(e) => CliError::Input(crate::run::locate(name, &e)),
+            other => CliError::Input(other.to_string()),
+        };
         if scene.dim != 2 {
             return Err(CliError::Input(format!(
                 "--scene: `{name}` is 1D; basis plots are 2D"
             )));
         }
-        return psmpm::simulation::triangulation(&scene)
-            .map_err(|e| CliError::Input(e.to_string()));
+        return psmpm::simulation::triangulation(&scene).map_err(located);
     }
     let (nx, ny) = pair(args.blocks.as_deref().unwrap_or("2x2"), "--blocks")?;
     if nx == 0 || ny == 0 || nx > 64 || ny > 64 {

@@ -365,9 +365,16 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
         .map(|scene| {
             (0..args.levels)
                 .map(|level| {
-                    scene
-                        .refined(level)
-                        .map_err(|e| CliError::Input(format!("level {level}: {e}")))
+                    scene.refined(level).map_err(|e| {
+                        CliError::Input(if args.scene.ends_with(".toml") {
+                            format!(
+                                "{} (level {level} of the study)",
+                                crate::run::locate(&args.scene, &e)
+                            )
+                        } else {
+                            format!("level {level}: {e}")
+                        })
+                    })
                 })
                 .collect::<Result<Vec<_>, _>>()
         })

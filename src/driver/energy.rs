@@ -77,6 +77,9 @@ where
     /// start and end velocities, the rule under which the kinetic energy of the
     /// symplectic Euler update changes: `W += Δt F · (v̂ⁿ + v̂ⁿ⁺¹) / 2`.
     /// The dissipative effects' part the same way, into `dissipated`.
+    ///
+    /// The time-centred total pairs with a work shifted by half a step
+    /// ([`Driver::step`]).
     pub(super) fn book_work(&mut self, power_start: [f64; 2]) {
         self.velocity_known = true;
         if !self.work_force.is_empty() {

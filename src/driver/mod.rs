@@ -216,6 +216,9 @@ where
     /// or the initial state's before the first step.
     previous_energy: Option<(f64, f64)>,
     work: f64,
+    /// `½ Δt F⁰ · v̂⁰` of the first step: the share of the start power the
+    /// time-centred total's work does not count ([`Driver::step`]).
+    first_half_power: Option<f64>,
     /// The part of `work` done by the dissipative effects ([`Effect::dissipative`]).
     dissipated: f64,
     inputs: StrategyInputs,
@@ -398,6 +401,7 @@ where
                 Vec::new()
             },
             work: 0.0,
+            first_half_power: None,
             dissipated: 0.0,
             constraints: Constraints::new(general, n),
             walled,
@@ -534,8 +538,14 @@ where
         let e = self.step_energies();
         let mut report = self.report_with(e);
         // ½ Σ m_p vⁿ·vⁿ⁺¹ = Kⁿ + ½ Σ m_p vⁿ·Δv_p, with the rest of the energy at xⁿ.
+        // The work it pairs with: symplectic Euler changes it by exactly
+        // `½ Δt v̂ᵏ⁺¹ · (Fᵏ + Fᵏ⁺¹)` per step on a linear system, the work booked up
+        // to the last step (`Δt F · (v̂ᵏ + v̂ᵏ⁺¹) / 2`) plus half of this step's start
+        // power `Fⁿ · v̂ⁿ`, less half of the first step's.
         let dot: f64 = self.centred_terms.iter().sum();
-        report.total_centred = previous.0 + 0.5 * dot + previous.1;
+        let half_power = 0.5 * self.dt.to_f64() * power_start[0];
+        let first = *self.first_half_power.get_or_insert(half_power);
+        report.total_centred = previous.0 + 0.5 * dot + previous.1 - (half_power - first);
         self.previous_energy = Some((report.kinetic, report.total_energy() - report.kinetic));
         Ok(report)
     }
@@ -563,8 +573,31 @@ where
             // particle's element is still the last one found).
             let from = self.particles.element[p];
             let hint = if self.effects.iter().any(|e| e.walls_element(from)) {
+                // The contact distance of a contact wall: half the particle's spacing.
+                let distance = 0.5
+                    * self.particles.volume0[p]
+                        .to_f64()
+                        .powf(1.0 / D as f64);
+                let how = if moved < 0.25 * distance {
+                    format!(
+                        "a small part of its contact distance ({}): it was pressed through over several steps, the springs too soft for the load",
+                        crate::scene::limits::echo_significant(distance, 3)
+                    )
+                } else {
+                    format!(
+                        "more than a quarter of its contact distance ({}): too fast for the springs",
+                        crate::scene::limits::echo_significant(distance, 3)
+                    )
+                };
+                let courant = self.dt_critical.map_or(String::new(), |critical| {
+                    format!(
+                        " from {} to {}",
+                        crate::scene::limits::echo_significant(self.dt.to_f64() / critical, 2),
+                        crate::scene::limits::echo_significant(0.5 * self.dt.to_f64() / critical, 2)
+                    )
+                });
                 format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went through a contact wall, whose springs were too soft for the load or the speed: lower `time.courant` (impacts on contact walls want 0.25 or less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
             } else if self
                 .basis

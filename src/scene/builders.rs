@@ -137,7 +137,7 @@ impl Scene {
             MeshSpec::Gmsh { .. } => {
                 return Err(conflict(
                     "mesh.kind",
-                    "a Gmsh mesh cannot be refined by a study",
+                    "a Gmsh mesh cannot be refined by a study: `converge` refines `blocks`, `polygon` and `interval` meshes (write the domain as a `polygon` mesh with its outline and `edge_length`), or make the finer meshes with Gmsh and `run` each one",
                 ))
             }
         }

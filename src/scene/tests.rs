@@ -207,3 +207,22 @@ fn refinement_multiplies_count_and_divides_spacing_along_the_refined_axes() {
         Some(vec![0.25, 0.25])
     );
 }
+
+/// In 1D a traction loads a point: `length` other than 1 scaled the load in silence
+/// (a user's bar settled at half the stress asked for).
+#[test]
+fn a_1d_traction_takes_length_one() {
+    let text = |length: f64| {
+        format!(
+            "name = \"bar\"\ndim = 1\nbasis = \"pl1d\"\n[mesh]\nkind = \"interval\"\nx = [0.0, 1.0]\nelements = 8\n[material]\nyoung = 100.0\ndensity = 1.0\n[[body]]\nmin = [0.0]\nmax = [1.0]\nper_block = [2]\n[[boundary]]\ntag = \"left\"\nfix = [\"x\"]\n[[effect]]\nkind = \"traction\"\nmin = [0.9]\nmax = [1.0]\ntraction = [20.0]\nlength = {length:?}\n[time]\ncourant = 0.5\nt_end = 0.1\n"
+        )
+    };
+    assert!(Scene::from_toml(&text(1.0), "bar.toml").is_ok());
+    let error = Scene::from_toml(&text(0.5), "bar.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("effect[0].length: in 1D the loaded boundary is a point: give `length = 1`"),
+        "{error}"
+    );
+}

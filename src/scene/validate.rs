@@ -273,6 +273,15 @@ impl Scene {
                     vector(&field("max"), max)?;
                     vector(&field("traction"), traction)?;
                     positive(&field("length"), *length)?;
+                    if self.dim == 1 && *length != 1.0 {
+                        return Err(conflict(
+                            field("length"),
+                            format!(
+                                "in 1D the loaded boundary is a point: give `length = 1` (the force is `traction × length`, and `traction` is the force per unit cross-section); got {}",
+                                echo_number(*length)
+                            ),
+                        ));
+                    }
                     if !(*ramp >= 0.0 && ramp.is_finite()) {
                         return Err(bad(
                             field("ramp"),

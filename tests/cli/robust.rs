@@ -450,6 +450,18 @@ fn command_line_cases() -> Vec<Case> {
         args_case("compare-threads-over-the-limit", None, &["compare", "vibrating-bar", "--threads", "100000000"], "--threads 100000000 is above the limit of 1024"),
         args_case("stability-threads-over-the-limit", None, &["stability", "--threads", "2000"], "--threads 2000 is above the limit of 1024"),
         args_case("converge-level-refused-before-any-run", None, &["converge", "vibrating-bar", "--levels", "7", "--blocks", "1024x1"], "level 3: mesh.blocks: each count must be in 1..=4096, got [8192, 1]"),
+        args_case(
+            "converge-gmsh-mesh",
+            Some(GMSH.replace("FILE", concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/square.msh"))),
+            &["converge", "@", "--levels", "3"],
+            "converge-gmsh-mesh.toml:6:8: mesh.kind: a Gmsh mesh cannot be refined by a study: `converge` refines `blocks`, `polygon` and `interval` meshes",
+        ),
+        args_case(
+            "basis-plot-scene-names-its-file",
+            Some(GMSH.replace("FILE", "none.msh")),
+            &["basis", "plot", "--scene", "@", "--out", "OUT/plot.svg"],
+            "basis-plot-scene-names-its-file.toml:7:8: mesh.file:",
+        ),
     ]
 }
 
@@ -563,6 +575,27 @@ fn mesh_and_scene_files_must_be_bounded_regular_files() {
         .filter_map(|c| run_case(&dir, c).err())
         .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // The same files as `basis plot --mesh` (it read them unbounded, and a FIFO
+    // blocked it).
+    let mut meshes = vec![
+        (std::path::PathBuf::from("/dev/zero"), "not a regular file"),
+        (big.clone(), "above the limit of 268435456 bytes"),
+    ];
+    if made_fifo {
+        meshes.push((fifo.clone(), "not a regular file"));
+    }
+    for (file, fragment) in meshes {
+        let out = cli()
+            .args(["basis", "plot", "--mesh"])
+            .arg(&file)
+            .arg("--out")
+            .arg(dir.join("plot.svg"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{}: {stderr}", file.display());
+        assert!(stderr.contains(fragment), "{}: {stderr}", file.display());
+    }
     // The scene file itself.
     let big_scene = dir.join("big.toml");
     std::fs::File::create(&big_scene)
