@@ -504,12 +504,30 @@ fn end_time_warning(scene: &Scene, dt: f64, steps: usize) -> Option<String> {
     })
 }
 
+/// The keys that set the particles per element of `scene`'s bodies, for the fixes
+/// the warnings give: a Gmsh body takes `subdivide`, the others `per_block`,
+/// `count` or `spacing` (and `--particles`).
+pub fn particle_keys(scene: &Scene) -> &'static str {
+    let gmsh = scene
+        .bodies
+        .iter()
+        .filter(|b| b.shape == crate::scene::BodyShape::Gmsh)
+        .count();
+    if gmsh == 0 {
+        "`per_block`, `count` or `spacing`; `--particles`"
+    } else if gmsh == scene.bodies.len() {
+        "`per_triangle` and `subdivide` of the Gmsh bodies"
+    } else {
+        "`per_block`, `count` or `spacing`, and `per_triangle` and `subdivide` of the Gmsh bodies; `--particles`"
+    }
+}
+
 /// The warning for bodies sampled by `sampling` particles per occupied element at
-/// the start, if that is below [`SPARSE_SAMPLING`].
-pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
+/// the start, if that is below [`SPARSE_SAMPLING`]; `keys` from [`particle_keys`].
+pub fn sparse_sampling_warning(sampling: f64, keys: &str) -> Option<String> {
     (sampling < SPARSE_SAMPLING).then(|| {
         format!(
-            "the bodies are sampled by {sampling:.2} particles per occupied element at the start: with about one particle per element or fewer, the elements between particles hold none, the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element (`per_block`, `count` or `spacing`; `--particles`)"
+            "the bodies are sampled by {sampling:.2} particles per occupied element at the start: with about one particle per element or fewer, the elements between particles hold none, the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element ({keys})"
         )
     })
 }
@@ -521,11 +539,11 @@ pub fn sparse_sampling_warning(sampling: f64) -> Option<String> {
 pub const DENSE_SAMPLING: f64 = 2500.0;
 
 /// The warning for bodies sampled by `sampling` particles per occupied element at
-/// the start, if that is above [`DENSE_SAMPLING`].
-pub fn dense_sampling_warning(sampling: f64) -> Option<String> {
+/// the start, if that is above [`DENSE_SAMPLING`]; `keys` from [`particle_keys`].
+pub fn dense_sampling_warning(sampling: f64, keys: &str) -> Option<String> {
     (sampling > DENSE_SAMPLING).then(|| {
         format!(
-            "the bodies are sampled by {sampling:.0} particles per occupied element at the start: the step's cost grows with the particles, but beyond a few hundred per element the error is set by the mesh (B4 on h = 0.25: 1.96e-4 at 260, 1.96e-4 at 1040); for accuracy refine the mesh (`blocks` or `edge_length`) and give a few dozen particles per element (`per_block`, `per_triangle`, `count` or `spacing`; `--particles`)"
+            "the bodies are sampled by {sampling:.0} particles per occupied element at the start: the step's cost grows with the particles, but beyond a few hundred per element the error is set by the mesh (B4 on h = 0.25: 1.96e-4 at 260, 1.96e-4 at 1040); for accuracy refine the mesh (`blocks` or `edge_length`) and give a few dozen particles per element ({keys})"
         )
     })
 }
@@ -599,7 +617,7 @@ pub fn spin_loss_warning(scene: &Scene, start: Spin, end: Spin) -> Option<String
         ) {
             "lumped rows damp a rotation (PS `lumped` lost 97 % of a plate's in half a turn, PL `lumped` 14 % of a disk's); the default mass strategy keeps it (remove `mass`, or `--mass default`)"
         } else {
-            "fewer than about 3 particles per triangle let whole elements damp it; give more particles per element (`per_block`, `count` or `spacing`; `--particles`)"
+            &format!("fewer than about 3 particles per triangle let whole elements damp it; give more particles per element ({})", particle_keys(scene))
         };
         format!(
             "the bodies' angular momentum about their centre of mass went from {l0:.4e} to {:.4e} ({:.0} % {}), although nothing in the scene exerts a torque about it: the rotation turned into strain or was damped, which the energy verdict does not see; {fix}",
@@ -620,10 +638,12 @@ pub const PS_SAMPLING: f64 = 3.0;
 /// particles per block (2.25 per triangle) on 1 × 10, 2 × 20, 4 × 40 blocks:
 /// UNSTABLE, then det F failures at steps 2441 and 3057; 6 × 6 per block: stable,
 /// E_u 2.7e-4, 1.2e-4, 1.1e-4.
-pub fn ps_sampling_warning(sampling: f64) -> Option<String> {
+///
+/// `keys` from [`particle_keys`].
+pub fn ps_sampling_warning(sampling: f64, keys: &str) -> Option<String> {
     (SPARSE_SAMPLING..PS_SAMPLING).contains(&sampling).then(|| {
         format!(
-            "the bodies are sampled by {sampling:.2} particles per occupied triangle at the start, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle (`per_block` 4 × 4 on block meshes, `count` or `spacing`; `--particles`); a body whose edges cut triangles fills those in part, which lowers this average below what its lattice gives inside: place its edges on block lines, or give more per block"
+            "the bodies are sampled by {sampling:.2} particles per occupied triangle at the start, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle ({keys}; `per_block` 4 × 4 on block meshes); a body whose edges cut triangles fills those in part, which lowers this average below what its lattice gives inside: place its edges on block lines, or give more per block"
         )
     })
 }
@@ -1125,8 +1145,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .into_iter()
                 .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(self_weight.clone())
-                .chain(sparse_sampling_warning(tally.sampling))
-                .chain(dense_sampling_warning(tally.sampling))
+                .chain(sparse_sampling_warning(
+                    tally.sampling,
+                    particle_keys(scene),
+                ))
+                .chain(dense_sampling_warning(tally.sampling, particle_keys(scene)))
                 .chain(
                     failure
                         .is_none()
@@ -1141,7 +1164,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .chain(
                     (scene.basis == crate::bases::BasisKind::Ps)
-                        .then(|| ps_sampling_warning(tally.sampling))
+                        .then(|| ps_sampling_warning(tally.sampling, particle_keys(scene)))
                         .flatten(),
                 )
                 .chain(body_contact_warning(scene))
@@ -1207,13 +1230,43 @@ mod tests {
         assert!(unseen_velocity_warning((1.0, 0.1, 1.0), 0.0).is_none());
     }
 
+    /// A warning's fix names the keys the scene's bodies take: `subdivide` for a
+    /// Gmsh body (a user was told `per_block`, which a Gmsh body refuses).
+    #[test]
+    fn the_sampling_fix_names_the_keys_of_the_bodies() {
+        let scene = |body: &str| {
+            Scene::from_toml(
+                &format!("name = \"g\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"gmsh\"\nfile = \"m.msh\"\n[material]\nyoung = 1.0\ndensity = 1.0\n{body}[time]\ndt = 0.1\nt_end = 1.0\n"),
+                "g.toml",
+            )
+            .unwrap()
+        };
+        let gmsh = "[[body]]\nshape = \"gmsh\"\nfile = \"m.msh\"\nsurface = 1\n";
+        let block = "[[body]]\nmin = [0.1, 0.1]\nmax = [0.2, 0.2]\ncount = [2, 2]\n";
+        assert_eq!(
+            particle_keys(&scene(gmsh)),
+            "`per_triangle` and `subdivide` of the Gmsh bodies"
+        );
+        assert!(particle_keys(&scene(block)).starts_with("`per_block`"));
+        let both = particle_keys(&scene(&format!("{gmsh}{block}")));
+        assert!(
+            both.contains("`per_block`") && both.contains("`subdivide`"),
+            "{both}"
+        );
+        let w = sparse_sampling_warning(1.0, particle_keys(&scene(gmsh))).unwrap();
+        assert!(
+            w.contains("(`per_triangle` and `subdivide` of the Gmsh bodies)"),
+            "{w}"
+        );
+    }
+
     #[test]
     fn sampling_far_above_the_studies_is_warned_about() {
         assert!(
-            dense_sampling_warning(1130.0).is_none(),
+            dense_sampling_warning(1130.0, "keys").is_none(),
             "the B4 ladder's sampling"
         );
-        let w = dense_sampling_warning(250_000.0).unwrap();
+        let w = dense_sampling_warning(250_000.0, "keys").unwrap();
         assert!(w.contains("250000 particles per occupied element"), "{w}");
         assert!(w.contains("refine the mesh"), "{w}");
     }

@@ -458,13 +458,39 @@ impl BodyShape {
 }
 
 /// A physical surface of a Gmsh file: its name, or its number.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 #[serde(untagged)]
 pub enum SurfaceRef {
     /// The name from `$PhysicalNames`.
     Name(String),
     /// The physical tag.
     Tag(i64),
+}
+
+/// Read by hand, so that a value of another type is named in the user's terms (a
+/// derived untagged enum said "data did not match any variant of untagged enum").
+impl<'de> Deserialize<'de> for SurfaceRef {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = SurfaceRef;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("the name of a physical surface (a string, e.g. \"soil\") or its number (an integer, e.g. 7)")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<SurfaceRef, E> {
+                Ok(SurfaceRef::Name(v.to_string()))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<SurfaceRef, E> {
+                Ok(SurfaceRef::Tag(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<SurfaceRef, E> {
+                i64::try_from(v)
+                    .map(SurfaceRef::Tag)
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Unsigned(v), &self))
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
 }
 
 impl SurfaceRef {

@@ -226,3 +226,20 @@ fn a_1d_traction_takes_length_one() {
         "{error}"
     );
 }
+
+/// A Gmsh body's `surface` of the wrong type is named in the user's terms.
+#[test]
+fn a_surface_of_the_wrong_type_says_what_it_takes() {
+    for value in ["5.0", "true", "[1]"] {
+        let text = format!(
+            "name = \"g\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"gmsh\"\nfile = \"m.msh\"\n[material]\nyoung = 1.0\ndensity = 1.0\n[[body]]\nshape = \"gmsh\"\nfile = \"m.msh\"\nsurface = {value}\n[time]\ndt = 0.1\nt_end = 1.0\n"
+        );
+        let error = Scene::from_toml(&text, "g.toml").unwrap_err().to_string();
+        assert!(
+            error.contains("body[0].surface")
+                && error.contains("expected the name of a physical surface (a string")
+                && !error.contains("untagged"),
+            "{value}: {error}"
+        );
+    }
+}

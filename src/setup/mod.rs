@@ -431,9 +431,10 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                     "time.t_end",
                     ErrorKind::Value,
                     format!(
-                        "t_end = {} with courant = {} (dt = {step:e}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}",
+                        "t_end = {} with courant = {} (dt = {}) takes {ratio:.3e} steps, above the limit of {MAX_STEPS}",
                         echo_number(t_end),
-                        echo_number(c)
+                        echo_number(c),
+                        crate::scene::limits::echo_significant(step, 4)
                     ),
                 )
                 .into());

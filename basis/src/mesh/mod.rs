@@ -80,7 +80,21 @@ pub enum MeshError {
     /// the domain, or asking for more points than the mesher may add.
     #[error("{0}")]
     EdgeLength(String),
+    /// Coordinates too large or an extent too small for the geometry's products
+    /// (areas, squared lengths) in `f64`; see [`MAX_COORDINATE`], [`MIN_EXTENT`].
+    #[error("the mesh's coordinates reach {largest:.3e} and its extent is {extent:.3e}: the geometry needs coordinates within ±{MAX_COORDINATE:e} and an extent of at least {MIN_EXTENT:e} (beyond continuum mechanics in metres, and beyond what the geometry's round-off holds); give the mesh in other units")]
+    Scale { largest: f64, extent: f64 },
 }
+
+/// Largest coordinate magnitude of a mesh (1e30: beyond any continuum in metres;
+/// squared lengths and products of areas stay far inside `f64`, where a mesh
+/// scaled by 1e300 reported coinciding vertices).
+pub const MAX_COORDINATE: f64 = 1e30;
+/// Smallest extent (bounding-box diagonal) of a mesh (1e-10: an ångström, below
+/// continuum mechanics in metres; the Powell–Sabin control triangles, whose
+/// round-off tolerances are partly absolute, are found down to 1e-12 and fail
+/// from 1e-14).
+pub const MIN_EXTENT: f64 = 1e-10;
 
 /// One edge of the mesh: its two vertices (in the orientation of its first
 /// triangle), the triangles on either side, and its tag if it is a tagged
@@ -138,7 +152,12 @@ impl TriMesh {
             }
         }
         let (lo, hi) = bounding_box(&vertices);
-        let scale = (hi - lo).norm().max(f64::MIN_POSITIVE);
+        let largest = lo.abs().max().max(hi.abs().max());
+        let extent = (hi - lo).norm();
+        if !(largest <= MAX_COORDINATE && extent >= MIN_EXTENT) {
+            return Err(MeshError::Scale { largest, extent });
+        }
+        let scale = extent;
         for (t, tri) in triangles.iter().enumerate() {
             for &v in tri {
                 if v >= nv {
@@ -712,6 +731,24 @@ mod tests {
             err(dup, vec![[0, 1, 2], [0, 4, 3]]),
             MeshError::DuplicateVertex { a: 2, b: 4, .. }
         ));
+        // Scaled by 1e300 (squared lengths overflow) or 1e-150 (areas underflow).
+        for factor in [1e300, 1e31, 1e-11, 1e-150] {
+            let scaled: Vec<Vec2> = v.iter().map(|p| p * factor).collect();
+            assert!(
+                matches!(
+                    err(scaled, vec![[0, 1, 2], [0, 2, 3]]),
+                    MeshError::Scale { .. }
+                ),
+                "{factor}"
+            );
+        }
+        for factor in [1e29, 1e-9] {
+            let scaled: Vec<Vec2> = v.iter().map(|p| p * factor).collect();
+            assert!(
+                TriMesh::new(scaled, vec![[0, 1, 2], [0, 2, 3]]).is_ok(),
+                "{factor}"
+            );
+        }
         let mut iso = v.clone();
         iso.push(Vec2::new(3.0, 3.0));
         assert!(matches!(
