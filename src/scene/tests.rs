@@ -243,3 +243,44 @@ fn a_surface_of_the_wrong_type_says_what_it_takes() {
         );
     }
 }
+
+/// A traction box with min above max, a traction whose force overflows, and a
+/// lateral coefficient outside [0, 10] are named at their field (a user got "selects
+/// no particle" and advice about particles per element).
+#[test]
+fn traction_boxes_loads_and_k0_are_checked() {
+    let scene = |effects: &str| {
+        let text = format!(
+            "name = \"t\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"blocks\"\nx = [0.0, 4.0]\ny = [0.0, 2.0]\nblocks = [4, 2]\n[material]\nyoung = 1e4\ndensity = 1.0\n[[body]]\nmin = [1.0, 0.0]\nmax = [2.0, 1.0]\nper_block = [2, 2]\n{effects}[time]\ncourant = 0.5\nt_end = 0.1\n"
+        );
+        Scene::from_toml(&text, "t.toml").map_err(|e| e.to_string())
+    };
+    let traction = |min: &str, max: &str, t: &str, length: &str| {
+        format!("[[effect]]\nkind = \"traction\"\nmin = {min}\nmax = {max}\ntraction = {t}\nlength = {length}\n")
+    };
+    assert!(scene(&traction("[1.0, 0.9]", "[2.0, 1.0]", "[0.0, -1.0]", "1.0")).is_ok());
+    let inverted = scene(&traction("[2.0, 0.9]", "[1.0, 1.0]", "[0.0, -1.0]", "1.0")).unwrap_err();
+    assert!(
+        inverted.contains("effect[0].max: the traction box needs min ≤ max"),
+        "{inverted}"
+    );
+    let huge = scene(&traction(
+        "[1.0, 0.9]",
+        "[2.0, 1.0]",
+        "[0.0, -1e300]",
+        "1e300",
+    ))
+    .unwrap_err();
+    assert!(
+        huge.contains("effect[0].length: the force `traction × length` overflows"),
+        "{huge}"
+    );
+    let geostatic = |k0: &str| {
+        scene(&format!("[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n[[effect]]\nkind = \"geostatic-stress\"\nsurface = 1.0\nk0 = {k0}\n"))
+    };
+    assert!(geostatic("0.5").is_ok());
+    for k0 in ["-0.1", "1e300", "11.0"] {
+        let e = geostatic(k0).unwrap_err();
+        assert!(e.contains("effect[1].k0: must be in [0, 10]"), "{k0}: {e}");
+    }
+}

@@ -10,6 +10,9 @@ use super::{
     MeshSpec, Reference, Scene, SceneError,
 };
 
+/// Largest lateral coefficient `k0` of a geostatic stress.
+pub const MAX_K0: f64 = 10.0;
+
 impl Scene {
     /// Checks that the scene is consistent; the error names the field.
     pub fn validate(&self) -> Result<(), SceneError> {
@@ -271,8 +274,27 @@ impl Scene {
                 } => {
                     vector(&field("min"), min)?;
                     vector(&field("max"), max)?;
+                    if min.iter().zip(max.iter()).any(|(a, b)| a > b) {
+                        return Err(bad(
+                            field("max"),
+                            format!(
+                                "the traction box needs min ≤ max on every axis, got min = {:?}, max = {:?}",
+                                min, max
+                            ),
+                        ));
+                    }
                     vector(&field("traction"), traction)?;
                     positive(&field("length"), *length)?;
+                    if !traction.iter().all(|t| (t * length).is_finite()) {
+                        return Err(bad(
+                            field("length"),
+                            format!(
+                                "the force `traction × length` overflows (traction {:?}, length {})",
+                                traction,
+                                echo_number(*length)
+                            ),
+                        ));
+                    }
                     if self.dim == 1 && *length != 1.0 {
                         return Err(conflict(
                             field("length"),
@@ -368,6 +390,15 @@ impl Scene {
                 EffectSpec::GeostaticStress { surface, k0 } => {
                     finite(&field("surface"), *surface)?;
                     finite(&field("k0"), *k0)?;
+                    if !(0.0..=MAX_K0).contains(k0) {
+                        return Err(bad(
+                            field("k0"),
+                            format!(
+                                "must be in [0, {MAX_K0}] (σ_xx / σ_yy at rest: about 0.3–1 in most soils, up to about 3 when overconsolidated), got {}",
+                                echo_number(*k0)
+                            ),
+                        ));
+                    }
                     if gravity.is_none() {
                         return Err(conflict(
                             field("kind"),

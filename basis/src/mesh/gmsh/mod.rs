@@ -10,7 +10,10 @@
 //! - Line elements (type 1) that belong to a physical group tag the boundary edge
 //!   they cover, by the group's name from `$PhysicalNames` (or its number as a
 //!   string when unnamed). When a curve is in several physical groups, the first
-//!   one listed is used. Lines on interior curves tag nothing.
+//!   one listed is used. Lines on interior curves tag nothing; a line element that
+//!   is not an edge of the triangles (a curve meshed apart from the surface it
+//!   should bound) is an error at its line. A physical name that is empty, or a
+//!   group named twice with different names, is an error at its line.
 //! - Triangles in a physical surface are reported by
 //!   [`parse_msh_with_surfaces`] ([`PhysicalSurfaces`]: the group of every triangle,
 //!   by the name from `$PhysicalNames` or the number), for placing material points.
@@ -465,14 +468,26 @@ pub fn parse_msh_with_surfaces(
                     let mut parts = line.splitn(3, char::is_whitespace);
                     let dim = r.int(parts.next().unwrap_or(""), "a physical dimension")?;
                     let tag = r.int(parts.next().unwrap_or(""), "a physical tag")?;
-                    let name = parts
-                        .next()
-                        .unwrap_or("")
-                        .trim()
-                        .trim_matches('"')
-                        .to_string();
+                    let raw = parts.next().unwrap_or("").trim();
+                    let name = raw.trim_matches('"').to_string();
+                    if raw.is_empty() {
+                        return Err(r.error(
+                            "expected a quoted physical name after the dimension and the tag",
+                        ));
+                    }
                     if name.is_empty() {
-                        return Err(r.error("expected a quoted physical name"));
+                        return Err(r.error(format!(
+                            "the physical group of dimension {dim} and tag {tag} has an empty name: name it in Gmsh, or remove the line to leave it unnamed (it is then known by its number)"
+                        )));
+                    }
+                    if let Some(earlier) = c.names.get(&(dim, tag)) {
+                        if *earlier != name {
+                            return Err(r.error(format!(
+                                "the physical group of dimension {dim} and tag {tag} is named twice, `{}` and `{}`: keep one name per group",
+                                shown(earlier),
+                                shown(&name)
+                            )));
+                        }
                     }
                     c.names.insert((dim, tag), name);
                 }
@@ -605,16 +620,34 @@ fn build_mesh(c: Contents, source: &str) -> Result<(TriMesh, PhysicalSurfaces), 
             source: e,
         }
     })?;
-    for ([a, b], physical, _) in lines {
-        let (Some(&a), Some(&b)) = (used.get(&a), used.get(&b)) else {
-            continue;
-        };
+    // The first physical group listed for an edge tags it (a curve in several
+    // groups has one line element per group).
+    let mut tagged = std::collections::HashSet::new();
+    for ([id_a, id_b], physical, line) in lines {
         let name = names
             .get(&(1, physical))
             .cloned()
             .unwrap_or_else(|| physical.to_string());
+        let (a, b) = match (used.get(&id_a), used.get(&id_b)) {
+            (Some(&a), Some(&b)) => (a, b),
+            // A line on nodes of no triangle: a curve apart from the surfaces.
+            (None, None) => continue,
+            _ => (usize::MAX, usize::MAX),
+        };
+        if a == b || mesh.find_edge(a, b).is_none() {
+            return Err(GmshError::Syntax {
+                file: source.to_string(),
+                line,
+                message: format!(
+                    "the line element of nodes {id_a} {id_b} in physical group `{}` is not an edge of the triangles: a boundary curve must be meshed with the surfaces it bounds (its nodes shared with theirs)",
+                    shown(&name)
+                ),
+            });
+        }
         // Lines on interior curves tag nothing: only boundary edges carry tags.
-        mesh.set_edge_tag(a, b, &name);
+        if tagged.insert((a.min(b), a.max(b))) {
+            mesh.set_edge_tag(a, b, &name);
+        }
     }
     let surfaces = PhysicalSurfaces {
         of_triangle: triangles.iter().map(|(_, _, p)| *p).collect(),
@@ -975,6 +1008,47 @@ $EndElements
             ),
             "{error}"
         );
+    }
+
+    /// Physical lines that are not edges of the triangles, and physical names that
+    /// are empty or given twice, are errors at their line (they were dropped, or
+    /// the last name won, in silence).
+    #[test]
+    fn physical_lines_and_names_must_fit_the_mesh() {
+        let error = |text: &str| parse_msh(text, "m.msh").unwrap_err().to_string();
+        // Nodes 2 and 4 share no triangle; line elements are lines 17–20.
+        let across = GOOD_22.replace("3 1 2 7 1 3 4", "3 1 2 7 1 2 4");
+        assert!(
+            error(&across).starts_with(
+                "m.msh:19: the line element of nodes 2 4 in physical group `wall` is not an edge"
+            ),
+            "{}",
+            error(&across)
+        );
+        let point = GOOD_22.replace("3 1 2 7 1 3 4", "3 1 2 7 1 3 3");
+        assert!(
+            error(&point).starts_with("m.msh:19: the line element of nodes 3 3"),
+            "{}",
+            error(&point)
+        );
+        let empty = GOOD_22.replace("1 7 \"wall\"", "1 7 \"\"");
+        assert!(
+            error(&empty)
+                .contains("m.msh:6: the physical group of dimension 1 and tag 7 has an empty name"),
+            "{}",
+            error(&empty)
+        );
+        let twice = GOOD_22.replace(
+            "$PhysicalNames\n1\n1 7 \"wall\"",
+            "$PhysicalNames\n2\n1 7 \"wall\"\n1 7 \"side\"",
+        );
+        assert!(error(&twice).contains("m.msh:7: the physical group of dimension 1 and tag 7 is named twice, `wall` and `side`"), "{}", error(&twice));
+        // The same name again is no conflict.
+        let again = GOOD_22.replace(
+            "$PhysicalNames\n1\n1 7 \"wall\"",
+            "$PhysicalNames\n2\n1 7 \"wall\"\n1 7 \"wall\"",
+        );
+        assert!(parse_msh(&again, "m.msh").is_ok());
     }
 
     /// The mesh's validation failures name the file's node tags (not the mesh's
