@@ -462,6 +462,37 @@ pub fn self_weight_warning<const D: usize>(
     })
 }
 
+/// The warning for a geostatic stress over bodies of several densities of which
+/// some are Gmsh bodies: a Gmsh body has no region the other bodies' weight can be
+/// integrated over, so it starts with its own density times the depth, and a layer
+/// under a lighter or heavier one starts out of equilibrium (a user's two Gmsh
+/// layers: +20 % at the bottom, a heave of 5 mm, where the same layers as boxes
+/// start exact).
+pub fn layered_gmsh_geostatic_warning(scene: &Scene) -> Option<String> {
+    use crate::scene::{BodyShape, EffectSpec};
+    let geostatic = scene
+        .effects
+        .iter()
+        .any(|e| matches!(e, EffectSpec::GeostaticStress { .. }));
+    let densities: Vec<f64> = (0..scene.bodies.len())
+        .map(|b| scene.body_material(b).density)
+        .collect();
+    let layered = densities.iter().any(|&r| r != densities[0]);
+    let gmsh: Vec<String> = scene
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.shape == BodyShape::Gmsh)
+        .map(|(i, _)| format!("body[{i}]"))
+        .collect();
+    (geostatic && layered && !gmsh.is_empty()).then(|| {
+        format!(
+            "the geostatic stress of a Gmsh body ({}) is its own density times the depth below `surface`, without the weight of the other bodies above it: with bodies of several densities a layer starts out of equilibrium and moves (a user's two Gmsh layers started 20 % off at the bottom and heaved 5 mm); give the layers as `box` or `polygon` bodies, whose stress counts the layers above",
+            gmsh.join(", ")
+        )
+    })
+}
+
 /// The warning for contact between bodies on a piecewise-linear basis with a mass
 /// other than `lumped`: the contact forces are sized on lumped rows, and nearly
 /// consistent rows spread them further, so they can do positive work.
@@ -1168,6 +1199,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                         .flatten(),
                 )
                 .chain(body_contact_warning(scene))
+                .chain(layered_gmsh_geostatic_warning(scene))
                 .chain(unseen_velocity_warning(tally.unseen, tally.verdict.scale()))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .chain(crate::arrangement::irregularity_warning(
@@ -1258,6 +1290,47 @@ mod tests {
             w.contains("(`per_triangle` and `subdivide` of the Gmsh bodies)"),
             "{w}"
         );
+    }
+
+    /// Gmsh layers of two densities under a geostatic stress are warned about; box
+    /// layers, or Gmsh bodies of one density, are not.
+    #[test]
+    fn gmsh_layers_under_a_geostatic_stress_are_warned_about() {
+        let scene = |bodies: &str| {
+            Scene::from_toml(
+                &format!("name = \"g\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"blocks\"\nx = [0.0, 1.0]\ny = [0.0, 2.0]\nblocks = [2, 4]\n[material]\nyoung = 1e6\ndensity = 1000.0\n{bodies}[[effect]]\nkind = \"gravity\"\ng = [0.0, -10.0]\n[[effect]]\nkind = \"geostatic-stress\"\nsurface = 2.0\n[time]\ndt = 1e-4\nt_end = 1e-3\n"),
+                "g.toml",
+            )
+            .unwrap()
+        };
+        let gmsh = |density: f64| {
+            format!("[[body]]\nshape = \"gmsh\"\nfile = \"m.msh\"\nsurface = 1\nmaterial = {{ young = 1e6, density = {density:?} }}\n")
+        };
+        let boxed = |y0: f64, density: f64| {
+            format!("[[body]]\nmin = [0.0, {y0:?}]\nmax = [1.0, {:?}]\ncount = [2, 2]\nmaterial = {{ young = 1e6, density = {density:?} }}\n", y0 + 1.0)
+        };
+        let w = layered_gmsh_geostatic_warning(&scene(&format!(
+            "{}{}",
+            gmsh(2000.0),
+            boxed(1.0, 1000.0)
+        )));
+        assert!(
+            w.as_deref()
+                .is_some_and(|w| w.starts_with("the geostatic stress of a Gmsh body (body[0])")),
+            "{w:?}"
+        );
+        assert!(layered_gmsh_geostatic_warning(&scene(&format!(
+            "{}{}",
+            boxed(0.0, 2000.0),
+            boxed(1.0, 1000.0)
+        )))
+        .is_none());
+        assert!(layered_gmsh_geostatic_warning(&scene(&format!(
+            "{}{}",
+            gmsh(1000.0),
+            gmsh(1000.0)
+        )))
+        .is_none());
     }
 
     #[test]
