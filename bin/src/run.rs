@@ -637,12 +637,18 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
                     return;
                 }
             }
-            // The time step against the critical one, before the first step.
-            let line = time_step_line(r);
+            // The time step against the critical one, before the first step, and
+            // what a run of very many steps owes them to.
+            let mut line = time_step_line(r);
+            if let Some(note) = long_run_note(&s, out::steps_from_dt(t_end, r.dt), r.dt) {
+                line = format!("{line}\nnote: {note}");
+            }
             match format {
                 Format::Table => stdout.line(&line),
                 Format::Json => {
-                    let _ = writeln!(std::io::stderr(), "# {line}");
+                    for part in line.lines() {
+                        let _ = writeln!(std::io::stderr(), "# {part}");
+                    }
                 }
                 // stderr of csv holds `# key=value` lines only (the summary's dt and
                 // dt_critical come at the end). The ratio of the step taken to the
@@ -747,6 +753,36 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
         ))),
         None => Ok(()),
     }
+}
+
+/// Steps from which a run says at the start how many it takes and why.
+pub const LONG_RUN_STEPS: usize = 1_000_000;
+
+/// For a run of [`LONG_RUN_STEPS`] steps or more, how many and why: the critical
+/// step is the element size over the P-wave speed, `√((λ + 2μ)/ρ)`, which a
+/// Poisson's ratio near 1/2 makes large (a user's ν = 0.4999999999 gave 5·10⁶
+/// steps, eight minutes, with nothing said at the start).
+pub fn long_run_note(scene: &psmpm::scene::Scene, steps: usize, dt: f64) -> Option<String> {
+    (steps >= LONG_RUN_STEPS).then(|| {
+        // √((1 − ν) / ((1 + ν)(1 − 2ν))): the P-wave speed over √(E / ρ).
+        let p_wave = |nu: f64| ((1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))).sqrt();
+        let nu = (0..scene.bodies.len().max(1))
+            .map(|b| scene.body_material(b).poisson)
+            .fold(scene.material.poisson, f64::max);
+        let cause = if nu > 0.45 {
+            format!(
+                ": the step is the element size over the P-wave speed, which ν = {} makes {}× that of ν = 0.3 (nearly incompressible)",
+                psmpm::scene::limits::echo_significant(nu, 12),
+                psmpm::scene::limits::echo_significant(p_wave(nu) / p_wave(0.3), 3)
+            )
+        } else {
+            ": the step is the element size over the P-wave speed √((λ + 2μ) / ρ)".to_string()
+        };
+        format!(
+            "this run takes {steps} steps of {}{cause}; for a first look lower `t_end` (`--t-end`) or coarsen the mesh",
+            sci(dt)
+        )
+    })
 }
 
 /// `time step … · critical step … · Courant number …`, printed at the start of a run.
@@ -927,4 +963,31 @@ pub fn summary_text(summary: &Summary) -> String {
         100.0 * p.update / total
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run of a million steps or more says so at the start, and names a Poisson's
+    /// ratio near 1/2 as the cause (a user waited eight minutes for ν = 0.4999999999).
+    #[test]
+    fn a_long_run_is_announced_with_its_cause() {
+        let scene = |poisson: f64| {
+            psmpm::scene::Scene::from_toml(
+                &format!("name = \"b\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"blocks\"\nx = [0.0, 1.0]\ny = [0.0, 1.0]\nblocks = [2, 2]\n[material]\nyoung = 1e4\npoisson = {poisson:?}\ndensity = 1.0\n[[body]]\nmin = [0.0, 0.0]\nmax = [1.0, 1.0]\nper_block = [2, 2]\n[time]\ncourant = 0.5\nt_end = 1.0\n"),
+                "b.toml",
+            )
+            .unwrap()
+        };
+        assert!(long_run_note(&scene(0.3), LONG_RUN_STEPS - 1, 1e-6).is_none());
+        let plain = long_run_note(&scene(0.3), 2_000_000, 1e-6).unwrap();
+        assert!(plain.starts_with("this run takes 2000000 steps"), "{plain}");
+        assert!(!plain.contains("incompressible"), "{plain}");
+        let nearly = long_run_note(&scene(0.4999999999), 5_000_000, 1e-8).unwrap();
+        assert!(
+            nearly.contains("ν = 0.4999999999 makes 35200× that of ν = 0.3"),
+            "{nearly}"
+        );
+    }
 }
