@@ -53,6 +53,26 @@ where
     }
 }
 
+/// Parses a real number of a flag, refusing text that `f64` rounds to 0 or to
+/// infinity while it names neither (`1e-400` was read as 0 and echoed `0.0`).
+pub(crate) fn real(text: &str) -> Result<f64, String> {
+    let x: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| "must be a number".to_string())?;
+    let digits = text.trim().split(['e', 'E']).next().unwrap_or("");
+    if x == 0.0 && digits.chars().any(|c| ('1'..='9').contains(&c)) {
+        return Err(
+            "is below the smallest representable number (about 1e-308) and would be read as 0"
+                .into(),
+        );
+    }
+    if x.is_infinite() && !text.to_ascii_lowercase().contains("inf") {
+        return Err("is beyond the largest representable number (about 1.8e308)".into());
+    }
+    Ok(x)
+}
+
 /// The range of `--threads`, as [`whole`] names it ([`MAX_THREADS`] the limit).
 pub(crate) const THREADS_RANGE: &str = "from 1 to 1024";
 const _: () = assert!(psmpm::scene::limits::MAX_THREADS == 1024);
@@ -210,5 +230,22 @@ where
         Command::Compare(args) => compare::prepare(&args).map(Checked::Scenes),
         Command::Converge(args) => converge::prepare(&args).map(Checked::Scenes),
         _ => Ok(Checked::Parsed),
+    }
+}
+
+#[cfg(test)]
+mod real_tests {
+    /// Text that `f64` rounds to 0 or to infinity is refused unless it says so.
+    #[test]
+    fn reals_that_round_to_zero_or_infinity_are_refused() {
+        assert_eq!(super::real("2.5e-3"), Ok(2.5e-3));
+        assert_eq!(super::real("0"), Ok(0.0));
+        assert_eq!(super::real("0.0e-500"), Ok(0.0));
+        assert!(super::real("inf").is_ok_and(f64::is_infinite));
+        assert!(super::real("1e-400").unwrap_err().contains("read as 0"));
+        assert!(super::real("-3e999")
+            .unwrap_err()
+            .contains("beyond the largest"));
+        assert_eq!(super::real("x"), Err("must be a number".into()));
     }
 }

@@ -42,14 +42,14 @@ pub struct Overrides {
     #[arg(long)]
     pub layout: Option<String>,
     /// Time step (replaces the scene's dt or Courant number).
-    #[arg(long, allow_hyphen_values = true, conflicts_with = "courant")]
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "courant", value_parser = crate::real)]
     pub dt: Option<f64>,
     /// Time step as a fraction C of the critical step estimated at the start,
     /// Δt = C Δt_crit (replaces the scene's dt or Courant number; below 1).
-    #[arg(long, value_name = "C", allow_hyphen_values = true)]
+    #[arg(long, value_name = "C", allow_hyphen_values = true, value_parser = crate::real)]
     pub courant: Option<f64>,
     /// End time.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::real)]
     pub t_end: Option<f64>,
     /// Run with a time step above the critical step estimated at the start (an error
     /// otherwise): to see what an unstable step does.
@@ -332,10 +332,16 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
         use psmpm::scene::limits::{echo, read_bounded, MAX_SCENE_FILE_BYTES};
         let bytes = read_bounded(std::path::Path::new(name), MAX_SCENE_FILE_BYTES)
             .map_err(|e| CliError::Input(format!("{}: {e}", echo(name))))?;
-        let text = String::from_utf8(bytes).map_err(|_| {
+        let text = String::from_utf8(bytes).map_err(|e| {
+            // Where the first byte that is not UTF-8 stands, as a line and column.
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = 1 + valid.iter().filter(|&&b| b == b'\n').count();
+            let start = valid.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+            let column = 1 + String::from_utf8_lossy(&valid[start..]).chars().count();
             CliError::Input(format!(
-                "{}: cannot read: stream did not contain valid UTF-8",
-                echo(name)
+                "{}:{line}:{column}: cannot read: byte 0x{:02x} is not UTF-8; save the scene as UTF-8 text",
+                echo(name),
+                e.as_bytes()[valid.len()]
             ))
         })?;
         let mut s = Scene::from_toml(&text, name).map_err(|e| CliError::Input(e.to_string()))?;

@@ -1348,7 +1348,7 @@ fn unreadable_scene_files_are_named() {
     let binary = binary.to_str().unwrap();
     assert_eq!(
         input_error(&["run", binary]).unwrap(),
-        format!("error: {binary}: cannot read: stream did not contain valid UTF-8\n")
+        format!("error: {binary}:1:9: cannot read: byte 0xff is not UTF-8; save the scene as UTF-8 text\n")
     );
     let folder = dir.join("folder.toml");
     std::fs::create_dir_all(&folder).unwrap();
@@ -1480,7 +1480,7 @@ fn unknown_flags_follow_clap_conventions() {
         ),
         (
             &["run", "vibrating-bar", "--dt", "small"][..],
-            "error: invalid value 'small' for '--dt <DT>': invalid float literal",
+            "error: invalid value 'small' for '--dt <DT>': must be a number",
         ),
         (
             &["run", "vibrating-bar", "--format", "xml"][..],
