@@ -57,6 +57,8 @@ pub enum MeshError {
     NonManifoldEdge { a: usize, b: usize },
     #[error("vertex {vertex} is where two separate fans of triangles touch (non-manifold vertex)")]
     NonManifoldVertex { vertex: usize },
+    #[error("triangles {a} and {b} overlap (the centroid of {a} lies inside {b})")]
+    Overlap { a: usize, b: usize },
     #[error("vertices {a} and {b} coincide at ({x}, {y})")]
     DuplicateVertex { a: usize, b: usize, x: f64, y: f64 },
     #[error("vertex {vertex} belongs to no triangle")]
@@ -290,6 +292,17 @@ impl TriMesh {
             locator: Locator::default(),
         };
         mesh.locator = Locator::new(&mesh);
+        // Overlapping triangles (a second copy of the mesh, a triangle laid over
+        // others) pass every check above when they share no edge: the centroid of
+        // a triangle lies strictly inside it, so location finds another triangle
+        // there only where two overlap.
+        for t in 0..mesh.triangles.len() {
+            let [a, b, c] = mesh.triangles[t].map(|v| mesh.vertices[v]);
+            let centroid = (a + b + c) / 3.0;
+            if let Some(other) = mesh.locate(centroid, None).filter(|&o| o != t) {
+                return Err(MeshError::Overlap { a: t, b: other });
+            }
+        }
         Ok(mesh)
     }
 
@@ -749,6 +762,17 @@ mod tests {
                 "{factor}"
             );
         }
+        // A triangle laid inside the square, sharing none of its vertices.
+        let mut over = v.clone();
+        over.extend([
+            Vec2::new(0.6, 0.2),
+            Vec2::new(0.8, 0.2),
+            Vec2::new(0.8, 0.4),
+        ]);
+        assert!(matches!(
+            err(over, vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]]),
+            MeshError::Overlap { .. }
+        ));
         let mut iso = v.clone();
         iso.push(Vec2::new(3.0, 3.0));
         assert!(matches!(

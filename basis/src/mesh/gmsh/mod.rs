@@ -696,6 +696,16 @@ fn in_file_terms(
             triangle,
             "runs clockwise while other triangles run counter-clockwise (surfaces meshed with opposite normals): reverse that surface's mesh in Gmsh (`ReverseMesh`) or list the element's nodes the other way round",
         ),
+        MeshError::Overlap { a, b } => match (element(a), element(b)) {
+            (Some((line, first)), Some((other_line, second))) => (
+                line,
+                format!(
+                    "{first} overlaps {second} (line {}): the file holds triangles laid over others (a surface meshed twice, or two surfaces over one region); mesh each region once",
+                    other_line.unwrap_or(0)
+                ),
+            ),
+            _ => (None, e.to_string()),
+        },
         MeshError::NonFiniteVertex { vertex } => {
             (None, format!("node {} has a non-finite coordinate", node(vertex)))
         }
