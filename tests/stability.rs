@@ -1011,3 +1011,47 @@ t_end = 0.01
         summary.energy_growth_centred
     );
 }
+
+/// A block falling freely with no wall (PS, default mass) inverts at `courant = 0.7`
+/// (a user's scene; open in docs/stability.md): the message must not blame an
+/// impact, but say that the step is that share of the start's critical step, which
+/// changes as the body moves over the mesh, and ask for 0.5 or less.
+#[test]
+fn an_inversion_above_half_the_critical_step_asks_for_courant_one_half() {
+    let text = r#"
+name = "falling"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [0.0, 2.0]
+blocks = [8, 8]
+[material]
+young = 1e5
+poisson = 0.3
+density = 100.0
+[[body]]
+min = [0.5, 0.5]
+max = [1.5, 1.0]
+per_block = [6, 6]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.7
+t_end = 0.3
+"#;
+    let summary = run(
+        &Scene::from_toml(text, "falling.toml").unwrap(),
+        &mut |_| {},
+    )
+    .unwrap();
+    let failure = summary.failure.unwrap_or_default();
+    assert!(
+        failure.contains("Δt is 0.70 of that step, which changes as the bodies move over the mesh")
+            && failure.contains("`time.courant` 0.5 or less")
+            && !failure.contains("(compression, an impact)"),
+        "{failure}"
+    );
+}
