@@ -331,6 +331,9 @@ struct Contents {
 impl Contents {
     /// Records node `id`; a node defined twice is an error at the current line.
     fn add_node(&mut self, r: &Reader, id: i64, xyz: [f64; 3]) -> Result<(), GmshError> {
+        if id < 1 {
+            return Err(r.error(format!("node tag {id}: Gmsh numbers nodes from 1")));
+        }
         if self.nodes.insert(id, xyz).is_some() {
             return Err(r.error(format!("node {id} is defined twice")));
         }
@@ -498,6 +501,9 @@ pub fn parse_msh_with_surfaces(
                 r.expect_end("Entities")?;
             }
             "$Nodes" => {
+                if c.seen_nodes {
+                    return Err(r.error("a second $Nodes section: a .msh file holds one"));
+                }
                 c.seen_nodes = true;
                 if version == Some(22) {
                     v22::read_nodes(&mut r, &mut c)?;
@@ -507,6 +513,9 @@ pub fn parse_msh_with_surfaces(
                 r.expect_end("Nodes")?;
             }
             "$Elements" => {
+                if c.seen_elements {
+                    return Err(r.error("a second $Elements section: a .msh file holds one"));
+                }
                 c.seen_elements = true;
                 if version == Some(22) {
                     v22::read_elements(&mut r, &mut c)?;
@@ -1059,6 +1068,33 @@ $EndElements
             "$PhysicalNames\n2\n1 7 \"wall\"\n1 7 \"wall\"",
         );
         assert!(parse_msh(&again, "m.msh").is_ok());
+    }
+
+    /// Node tag 0 (Gmsh numbers from 1) and a second `$Nodes` or `$Elements`
+    /// section are errors at their line (they were accepted).
+    #[test]
+    fn node_tags_start_at_one_and_sections_come_once() {
+        let error = |text: &str| parse_msh(text, "m.msh").unwrap_err().to_string();
+        let zero = GOOD_22
+            .replace("1 0 0 0\n2 1 0 0", "0 0 0 0\n2 1 0 0")
+            .replace(" 1 2\n", " 0 2\n");
+        assert!(
+            error(&zero).starts_with("m.msh:10: node tag 0: Gmsh numbers nodes from 1"),
+            "{}",
+            error(&zero)
+        );
+        let twice = GOOD_22.replace("$EndNodes\n", "$EndNodes\n$Nodes\n0\n$EndNodes\n");
+        assert!(
+            error(&twice).starts_with("m.msh:15: a second $Nodes section"),
+            "{}",
+            error(&twice)
+        );
+        let elements = format!("{GOOD_22}$Elements\n0\n$EndElements\n");
+        assert!(
+            error(&elements).contains("a second $Elements section"),
+            "{}",
+            error(&elements)
+        );
     }
 
     /// The mesh's validation failures name the file's node tags (not the mesh's
