@@ -322,6 +322,13 @@ struct State {
     started: bool,
 }
 
+/// The contact distance of a particle of initial volume `volume0` in `D`
+/// dimensions: half its spacing, `½ (V_p⁰)^(1/D)`, so that the body's surface, not
+/// its outermost particles, touches a contact wall.
+pub fn contact_distance<const D: usize>(volume0: f64) -> f64 {
+    0.5 * volume0.powf(1.0 / D as f64)
+}
+
 impl ContactWall {
     /// The wall `geometry` for `particles`, with spring frequency `stiffness / Δt`.
     /// `Err` with the largest contact distance when it exceeds the geometry's
@@ -334,7 +341,7 @@ impl ContactWall {
         let distance: Vec<f64> = particles
             .volume0
             .iter()
-            .map(|v| 0.5 * v.to_f64().powf(1.0 / D as f64))
+            .map(|v| contact_distance::<D>(v.to_f64()))
             .collect();
         let largest = distance.iter().copied().fold(0.0, f64::max);
         if largest > geometry.reach {

@@ -474,10 +474,6 @@ pub fn layered_gmsh_geostatic_warning(scene: &Scene) -> Option<String> {
         .effects
         .iter()
         .any(|e| matches!(e, EffectSpec::GeostaticStress { .. }));
-    let densities: Vec<f64> = (0..scene.bodies.len())
-        .map(|b| scene.body_material(b).density)
-        .collect();
-    let layered = densities.iter().any(|&r| r != densities[0]);
     let gmsh: Vec<String> = scene
         .bodies
         .iter()
@@ -485,7 +481,7 @@ pub fn layered_gmsh_geostatic_warning(scene: &Scene) -> Option<String> {
         .filter(|(_, b)| b.shape == BodyShape::Gmsh)
         .map(|(i, _)| format!("body[{i}]"))
         .collect();
-    (geostatic && layered && !gmsh.is_empty()).then(|| {
+    (geostatic && scene.layered() && !gmsh.is_empty()).then(|| {
         format!(
             "the geostatic stress of a Gmsh body ({}) is its own density times the depth below `surface`, without the weight of the other bodies above it: with bodies of several densities a layer starts out of equilibrium and moves (a user's two Gmsh layers started 20 % off at the bottom and heaved 5 mm); give the layers as `box` or `polygon` bodies, whose stress counts the layers above",
             gmsh.join(", ")
@@ -1118,6 +1114,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     );
     let at_end = fragments(&driver.particles, &run.body_sizes);
     let irregularity = crate::arrangement::irregularity(&driver.particles, &run.body_sizes);
+    let keys = particle_keys(scene);
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
@@ -1176,11 +1173,8 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .into_iter()
                 .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(self_weight.clone())
-                .chain(sparse_sampling_warning(
-                    tally.sampling,
-                    particle_keys(scene),
-                ))
-                .chain(dense_sampling_warning(tally.sampling, particle_keys(scene)))
+                .chain(sparse_sampling_warning(tally.sampling, keys))
+                .chain(dense_sampling_warning(tally.sampling, keys))
                 .chain(
                     failure
                         .is_none()
@@ -1195,7 +1189,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .chain(
                     (scene.basis == crate::bases::BasisKind::Ps)
-                        .then(|| ps_sampling_warning(tally.sampling, particle_keys(scene)))
+                        .then(|| ps_sampling_warning(tally.sampling, keys))
                         .flatten(),
                 )
                 .chain(body_contact_warning(scene))
@@ -1206,10 +1200,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     &irregularity,
                     scene.basis == crate::bases::BasisKind::Ps,
                     tally.sampling,
-                    scene
-                        .effects
-                        .iter()
-                        .any(|e| matches!(e, crate::scene::EffectSpec::ContactWall { .. })),
+                    scene.contact_walls(),
                 ))
                 .chain(stray_warning(
                     tally.stray_at_start,

@@ -770,12 +770,20 @@ pub const LONG_RUN_STEPS: usize = 1_000_000;
 /// steps, eight minutes, with nothing said at the start).
 pub fn long_run_note(scene: &psmpm::scene::Scene, steps: usize, dt: f64) -> Option<String> {
     (steps >= LONG_RUN_STEPS).then(|| {
-        // √((1 − ν) / ((1 + ν)(1 − 2ν))): the P-wave speed over √(E / ρ).
-        let p_wave = |nu: f64| ((1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))).sqrt();
+        // The P-wave speed over √(E / ρ), `√((λ + 2μ) / E)`, as the wave speed of
+        // the scene takes it.
+        let p_wave = |nu: f64| {
+            let elastic = psmpm::material::Elastic {
+                young: 1.0,
+                poisson: nu,
+                density: 1.0,
+            };
+            elastic.p_modulus(scene.dim).sqrt()
+        };
         let nu = (0..scene.bodies.len().max(1))
             .map(|b| scene.body_material(b).poisson)
-            .fold(scene.material.poisson, f64::max);
-        let cause = if nu > 0.45 {
+            .fold(f64::NEG_INFINITY, f64::max);
+        let cause = if p_wave(nu) > 2.0 * p_wave(0.3) {
             format!(
                 ": the step is the element size over the P-wave speed, which ν = {} makes {}× that of ν = 0.3 (nearly incompressible)",
                 psmpm::scene::limits::echo_significant(nu, 12),

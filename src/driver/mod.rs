@@ -573,11 +573,8 @@ where
             // particle's element is still the last one found).
             let from = self.particles.element[p];
             let hint = if self.effects.iter().any(|e| e.walls_element(from)) {
-                // The contact distance of a contact wall: half the particle's spacing.
-                let distance = 0.5
-                    * self.particles.volume0[p]
-                        .to_f64()
-                        .powf(1.0 / D as f64);
+                let distance =
+                    crate::contact::contact_distance::<D>(self.particles.volume0[p].to_f64());
                 let how = if moved < 0.25 * distance {
                     format!(
                         "a small part of its contact distance ({}): it was pressed through over several steps, the springs too soft for the load",

@@ -104,6 +104,20 @@ impl Scene {
             .any(|e| matches!(e, EffectSpec::BodyContact {}))
     }
 
+    /// The scene has a contact wall (`[[effect]]` with `kind = "contact-wall"`).
+    pub fn contact_walls(&self) -> bool {
+        self.effects
+            .iter()
+            .any(|e| matches!(e, EffectSpec::ContactWall { .. }))
+    }
+
+    /// The bodies' densities differ (layers: a geostatic stress then integrates
+    /// the weight of what lies above each particle).
+    pub fn layered(&self) -> bool {
+        let density = |b: usize| self.body_material(b).density;
+        (1..self.bodies.len()).any(|b| density(b) != density(0))
+    }
+
     /// The time step `dt`, or with `courant` a mesh-based guess `C h / c` (P-wave
     /// speed `c`, `h` halved for PS) used to set a run up and to estimate its cost;
     /// the run itself takes `C Δt_crit` (see [`TimeSpec::courant`](super::TimeSpec::courant)).

@@ -378,7 +378,7 @@ fn initial_stress<const D: usize>(
     let densities: Vec<f64> = (0..scene.bodies.len())
         .map(|b| scene.body_material(b).density)
         .collect();
-    let layered = densities.iter().any(|&r| r != densities[0]);
+    let layered = scene.layered();
     let regions: Vec<Option<Region>> = scene
         .bodies
         .iter()
