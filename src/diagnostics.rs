@@ -27,9 +27,15 @@ pub struct StepReport {
     pub time: f64,
     /// The time step `Δt`.
     pub dt: f64,
+    /// The sub-steps the step was taken in (1 but where the watch over the
+    /// critical step split it, [`crate::driver::Driver::watch_critical_step`]).
+    pub substeps: usize,
     /// The critical time step estimated at the start of the run (power iteration on
     /// `M⁻¹K`), when it was estimated; `Δt / Δt_crit` is the Courant number.
     pub dt_critical: Option<f64>,
+    /// The latest estimate of the critical step while the bodies move, when the
+    /// watch is on ([`crate::driver::Driver::watch_critical_step`]).
+    pub dt_critical_latest: Option<f64>,
     /// Kinetic energy `Σ ½ m_p |v_p|²`.
     pub kinetic: f64,
     /// Kinetic energy of the motion, `Σ ½ m_p |v̂_p|²` with `v̂_p` the velocity

@@ -97,6 +97,15 @@ pub struct Summary {
     /// shortened to end at `t_end`; `dt / dt_critical` is the ratio the run used),
     /// `None` when the scene gives `dt`.
     pub courant: Option<f64>,
+    /// The lowest critical step estimated while the bodies moved (the watch over
+    /// the critical step, [`crate::driver::Driver::watch_critical_step`]), when
+    /// watched; `dt_critical` is the start's.
+    pub dt_critical_lowest: Option<f64>,
+    /// Steps the watch took in sub-steps, the critical step having fallen below
+    /// what the step needs ([`crate::setup::watch_thresholds`]).
+    pub split_steps: usize,
+    /// The most sub-steps of one step (1 when none was split).
+    pub most_substeps: usize,
     /// Largest condition-number estimate (when requested).
     pub max_condition: Option<f64>,
     /// Total energy at the start.
@@ -1037,6 +1046,30 @@ pub fn unearned_work_hint(scene: &Scene, unearned: f64, scale: f64) -> Option<St
     })
 }
 
+/// With a fixed `dt`, the steps the watch over the critical step split: the
+/// scene's step was above 0.9 of the critical step somewhere
+/// ([`crate::setup::watch_thresholds`]), and the run took those steps in sub-steps.
+fn split_steps_warning(
+    scene: &Scene,
+    dt: f64,
+    start: Option<f64>,
+    watched: Option<crate::driver::WatchReport>,
+) -> Option<String> {
+    let w = watched.filter(|w| w.split_steps > 0 && scene.time.courant.is_none())?;
+    let (lowest, step, time) = w.lowest?;
+    let start = start?;
+    Some(format!(
+        "the critical step fell from {} at the start to {} (step {step}, t = {}) as the bodies moved over the mesh: `time.dt` = {} was above 0.9 of it, so {} taken in up to {} sub-steps at 0.7 of the critical step; give `courant` instead of `dt` to follow the critical step throughout, or a `dt` below {}",
+        crate::scene::limits::echo_significant(start, 3),
+        crate::scene::limits::echo_significant(lowest, 3),
+        crate::scene::limits::echo_significant(time, 4),
+        crate::scene::limits::echo_number(dt),
+        crate::scene::limits::plural(w.split_steps, "step was", "steps were"),
+        w.most_substeps,
+        crate::scene::limits::echo_significant(0.7 * lowest, 2),
+    ))
+}
+
 /// What a condition estimate above [`STABLE_CONDITION`] says about the system the
 /// mass strategy `mass` (a [`Summary::mass`] name) solves, and what to do about it.
 /// On `docs/examples/drop-plate.toml` to t = 0.3: `lumped` 3.7e19, `partial`
@@ -1102,6 +1135,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
         }
     });
     let driver = run.driver;
+    let watched = driver.watch_report();
     let now = crate::material::max_rotation(&driver.particles.f);
     let max_rotation = tally.max_rotation.max(now);
     // The warning concerns the particles of the paper's non-objective law only.
@@ -1148,6 +1182,9 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             max_deactivated: tally.deactivated,
             max_extended: tally.extended,
             dt_critical: run.dt_critical,
+            dt_critical_lowest: watched.and_then(|w| w.lowest).map(|(c, _, _)| c),
+            split_steps: watched.map_or(0, |w| w.split_steps),
+            most_substeps: watched.map_or(1, |w| w.most_substeps),
             courant: scene.time.courant,
             max_condition,
             energy_initial: tally.verdict.initial_energy(),
@@ -1172,6 +1209,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             warnings: warnings
                 .into_iter()
                 .chain(end_time_warning(scene, run.dt, run.steps))
+                .chain(split_steps_warning(scene, run.dt, run.dt_critical, watched))
                 .chain(self_weight.clone())
                 .chain(sparse_sampling_warning(tally.sampling, keys))
                 .chain(dense_sampling_warning(tally.sampling, keys))

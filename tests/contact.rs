@@ -342,7 +342,10 @@ t_end = 0.9
     let s = &out.summary;
     assert!(s.failure.is_none() && s.stable, "{s:?}");
     assert!(rising, "the disk did not bounce");
-    assert!(s.energy_growth_centred < 1e-6, "{s:?}");
+    // 3e-15 with every step whole; the watch over the critical step splits 4 steps
+    // in two, and the centred total's terms of second order in Δt change with it:
+    // 1.4e-6.
+    assert!(s.energy_growth_centred < 1e-5, "{s:?}");
     assert!(s.energy_growth < 2e-2, "{s:?}");
     assert!(s.energy_drift < 3e-2, "{s:?}");
 }

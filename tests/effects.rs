@@ -41,6 +41,7 @@ fn bar_1d(effects: Vec<EffectSpec>, t_end: f64) -> Scene {
         dt: Some(1e-3),
         courant: None,
         t_end,
+        watch: true,
     };
     s.reference = None;
     s.resolutions.clear();

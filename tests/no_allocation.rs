@@ -17,7 +17,7 @@ use psmpm::basis::basis::linear::Linear;
 use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
 use psmpm::basis::mesh::generators::block_grid;
 use psmpm::basis::Basis;
-use psmpm::driver::{Driver, Fix};
+use psmpm::driver::{Driver, Fix, WATCH_EVERY};
 use psmpm::effect::{BodyForce, Effect, Gravity, LocalDamping};
 use psmpm::mass::MassKind;
 use psmpm::material::{Elastic, LinearElastic};
@@ -171,11 +171,18 @@ fn steps_allocate_here<B: Basis<f64, 2>>(
             .unwrap();
     }
     driver.estimate_condition = true;
-    driver.step().unwrap(); // warm-up outside the count
+    // The watch over the critical step, set to split every step in two or more, so that
+    // every counted step checks the critical step and takes sub-steps.
+    let critical = driver.critical_time_step().unwrap();
+    driver.watch_critical_step(0.5 * driver.dt() / critical, 0.0);
+    // Warm-up outside the count, through the watch's first check.
+    for _ in 0..WATCH_EVERY + 1 {
+        driver.step().unwrap();
+    }
     ALLOCATIONS.store(0, Ordering::SeqCst);
     COUNTING.store(true, Ordering::SeqCst);
     for _ in 0..20 {
-        driver.step().unwrap();
+        assert!(driver.step().unwrap().substeps >= 2);
     }
     COUNTING.store(false, Ordering::SeqCst);
     ALLOCATIONS.load(Ordering::SeqCst)

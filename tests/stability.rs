@@ -134,9 +134,12 @@ fn where_nothing_is_under_supported_the_default_is_the_consistent_mass() {
 /// A soft block sliding on the slip floor of a `polygon` mesh (written from the
 /// docs, `docs/examples/slide-strike.toml`): at x ≈ 2.3 its bottom rows cross two
 /// small boundary elements whose vertex functions the body covers fully but only
-/// about three particles sample. Solved consistently, their rows stop every
-/// strategy that keeps them (at any time step, t ≈ 0.32); the default lumps the
-/// rows of functions sampled by fewer than three particles and goes on.
+/// about three particles sample. Solved consistently, their rows lower the critical
+/// step to about a tenth of the start's: with every step whole, they stop every
+/// strategy that keeps them (at any time step, t ≈ 0.32); the watch over the
+/// critical step takes those steps in up to 9 sub-steps and goes on. The default
+/// lumps the rows of functions sampled by fewer than three particles and goes on
+/// with few split steps.
 #[test]
 fn a_block_sliding_over_small_boundary_elements_stays_stable_with_the_default_mass() {
     let path = concat!(
@@ -151,6 +154,16 @@ fn a_block_sliding_over_small_boundary_elements_stays_stable_with_the_default_ma
     assert!(summary.stable, "{summary:?}");
     let mut extended = scene.clone();
     extended.mass = MassKind::parse("extended").unwrap();
+    let watched = run(&extended, &mut |_| {}).unwrap();
+    let start = watched.dt_critical.unwrap();
+    assert!(
+        watched.failure.is_none()
+            && watched.dt_critical_lowest.unwrap() < 0.2 * start
+            && watched.most_substeps >= 4
+            && watched.split_steps > 10 * summary.split_steps.max(1),
+        "default {summary:?}\nextended {watched:?}"
+    );
+    extended.time.watch = false;
     let failed = run(&extended, &mut |_| {}).unwrap();
     assert!(failed.failure.is_some(), "{failed:?}");
 }
@@ -1012,12 +1025,15 @@ t_end = 0.01
     );
 }
 
-/// A block falling freely with no wall (PS, default mass) inverts at `courant = 0.7`
-/// (a user's scene; open in docs/stability.md): the message must not blame an
-/// impact, but say that the step is that share of the start's critical step, which
-/// changes as the body moves over the mesh, and ask for 0.5 or less.
+/// A block falling freely with no wall (PS, default mass; a user's scene): as it
+/// moves over the mesh the functions its particles cover change, and the critical
+/// step falls to about half the start's. With every step whole it inverted at
+/// `courant = 0.7` (the message then says that the step is that share of the start's
+/// critical step, which changes as the bodies move, and names the watch); with the
+/// watch over the critical step the steps that need it are split and it falls to
+/// the end at 0.7 and 0.95.
 #[test]
-fn an_inversion_above_half_the_critical_step_asks_for_courant_one_half() {
+fn a_falling_block_keeps_its_courant_number_as_the_critical_step_falls() {
     let text = r#"
 name = "falling"
 dim = 2
@@ -1042,14 +1058,33 @@ g = [0.0, -9.81]
 courant = 0.7
 t_end = 0.3
 "#;
-    let summary = run(
-        &Scene::from_toml(text, "falling.toml").unwrap(),
-        &mut |_| {},
-    )
-    .unwrap();
+    let scene = Scene::from_toml(text, "falling.toml").unwrap();
+    for courant in [0.7, 0.95] {
+        let mut s = scene.clone();
+        s.time.courant = Some(courant);
+        let mut speed = 0.0;
+        let summary = run(&s, &mut |r| speed = r.momentum()[1] / r.mass).unwrap();
+        let start = summary.dt_critical.unwrap();
+        let lowest = summary.dt_critical_lowest.unwrap();
+        assert!(
+            summary.failure.is_none()
+                && summary.stable
+                && lowest < 0.6 * start
+                && summary.split_steps > 0
+                && summary.most_substeps >= 2,
+            "{summary:?}"
+        );
+        // The free fall itself: the mean velocity is −g t at the end.
+        let exact = -9.81 * 0.3;
+        assert!((speed / exact - 1.0).abs() < 1e-3, "{speed} vs {exact}");
+    }
+    let mut whole = scene.clone();
+    whole.time.watch = false;
+    let summary = run(&whole, &mut |_| {}).unwrap();
     let failure = summary.failure.unwrap_or_default();
     assert!(
         failure.contains("Δt is 0.70 of that step, which changes as the bodies move over the mesh")
+            && failure.contains("remove `watch = false`")
             && failure.contains("`time.courant` 0.5 or less")
             && !failure.contains("(compression, an impact)"),
         "{failure}"

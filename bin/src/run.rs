@@ -55,6 +55,10 @@ pub struct Overrides {
     /// otherwise): to see what an unstable step does.
     #[arg(long)]
     pub allow_above_critical: bool,
+    /// Keep every step whole: no new estimate of the critical step as the bodies
+    /// move, no sub-steps where it falls (the scene's `time.watch = false`).
+    #[arg(long)]
+    pub no_watch: bool,
     /// Estimate the condition number of the solved mass system every step (about 60
     /// extra solves; 30 products for `extended`). The verdict then also requires it
     /// below 1e8, as in the stability matrix (docs/stability.md); without it the
@@ -139,6 +143,9 @@ impl Overrides {
         }
         if self.allow_above_critical {
             s.time.allow_above_critical = true;
+        }
+        if self.no_watch {
+            s.time.watch = false;
         }
         if let Some(t) = self.t_end {
             s.time.t_end = t;
@@ -955,6 +962,25 @@ pub fn summary_text(summary: &Summary) -> String {
         summary.max_condition.map_or("-".into(), sci),
         summary.max_lumped_rows,
     );
+    if summary.split_steps > 0 {
+        if let (Some(lowest), Some(start), Some(c)) = (
+            summary.dt_critical_lowest,
+            summary.dt_critical,
+            summary.courant,
+        ) {
+            out += &format!(
+                "critical step watched as the bodies moved: it fell to {} ({:.2} of the start's {}), so {} of the {} steps {} taken in up to {} sub-steps to keep courant {}\n",
+                sci(lowest),
+                lowest / start,
+                sci(start),
+                summary.split_steps,
+                summary.steps,
+                if summary.split_steps == 1 { "was" } else { "were" },
+                summary.most_substeps,
+                short(c)
+            );
+        }
+    }
     if let Some(reason) = &summary.failure {
         out += &format!("stopped: {reason}\n");
     }

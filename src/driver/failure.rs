@@ -136,14 +136,30 @@ where
         })
     }
 
+    /// The critical step the step was taken against, and when it was estimated:
+    /// the watch's latest estimate ([`Driver::watch_critical_step`]) or the
+    /// start's.
+    fn critical_now(&self) -> Option<(f64, String)> {
+        match self
+            .watch
+            .as_ref()
+            .and_then(|w| w.latest.map(|c| (c, w.latest_step)))
+        {
+            Some((c, step)) if step > 0 => Some((c, format!("estimated at step {step}"))),
+            _ => self
+                .dt_critical
+                .map(|c| (c, "estimated at the start".to_string())),
+        }
+    }
+
     /// What the driver can see around a failing particle, and the fix that fits.
     pub(super) fn diagnose_particle(&self, particle: usize) -> String {
-        if let Some(critical) = self.dt_critical {
+        if let Some((critical, when)) = self.critical_now() {
             let dt = self.dt.to_f64();
             if dt > critical {
                 let speed = self.particles.v[particle].norm().to_f64();
                 return format!(
-                    "the element around it inverted (speed {speed:.3e}): Δt = {dt:.3e} is above the critical step {critical:.3e} of this basis, mass strategy and material (estimated at the start): lower `time.dt` below it (or `time.courant` below 1)"
+                    "the element around it inverted (speed {speed:.3e}): Δt = {dt:.3e} is above the critical step {critical:.3e} of this basis, mass strategy and material ({when}): lower `time.dt` below it (or `time.courant` below 1)"
                 );
             }
         }
@@ -166,25 +182,34 @@ where
             return cause;
         }
         let speed = self.particles.v[particle].norm().to_f64();
-        if let Some(critical) = self.dt_critical {
+        if let Some((critical, when)) = self.critical_now() {
             let dt = self.dt.to_f64();
             // In 1D nothing rotates: objectivity is not a cause there.
             let ratio = dt / critical;
             let cause = if !(self.material.is_objective(particle) || D == 1) {
                 "its law, `linear-elastic`, is not objective and builds spurious stress where the body rotates: use `neo-hookean` or `corotational`, or a smaller `time.dt`".to_string()
+            } else if ratio > 0.5 && self.watch.is_some() {
+                // The watch estimates again every 4 to 32 steps; between two
+                // estimates a body moving into new functions can lower it.
+                format!(
+                    "Δt is {ratio:.2} of that step, which can fall between two of its estimates (every {} to {} steps) as a body moves into functions its particles barely cover: take `time.courant` 0.5 or less, and less again where the body is compressed or struck",
+                    super::critical::WATCH_EVERY,
+                    super::critical::WATCH_EVERY_MOST
+                )
             } else if ratio > 0.5 {
                 // The estimate is of the start's particles; as the bodies move over
                 // the mesh the functions they cover, and the rows the mass strategy
                 // lumps or extends, change (a user's block falling freely, PS, 6 × 6
-                // per block, inverted at courant 0.7 and held at 0.6).
+                // per block, inverted at courant 0.7 and held at 0.6 without the
+                // watch; with it, at 0.95).
                 format!(
-                    "Δt is {ratio:.2} of that step, which changes as the bodies move over the mesh (the basis functions their particles cover change; a block falling freely inverted at 0.7): take `time.courant` 0.5 or less, and less again where the body is compressed or struck"
+                    "Δt is {ratio:.2} of that step, which changes as the bodies move over the mesh (the basis functions their particles cover change; a block falling freely inverted at 0.7): remove `watch = false` from `[time]` (or `--no-watch`), so that the run estimates it again and splits the steps that need it, or take `time.courant` 0.5 or less"
                 )
             } else {
                 "the deformation there is large, with a stiffer response than at the start (compression, an impact): lower `time.courant` or `time.dt`".to_string()
             };
             return format!(
-                "the element around it inverted (speed {speed:.3e}) although Δt = {dt:.3e} is below the critical step {critical:.3e} estimated at the start: {cause}"
+                "the element around it inverted (speed {speed:.3e}) although Δt = {dt:.3e} is below the critical step {critical:.3e} {when}: {cause}"
             );
         }
         let rotation = if D == 1 {
@@ -203,7 +228,7 @@ where
     /// to speak of); 0 when there are none, and in 1D. The median, not the largest:
     /// a body that spins turns as a whole, while the few particles around a failing
     /// one turn by any angle as it fails.
-    fn non_objective_rotation(&self, particle: usize) -> f64 {
+    pub(super) fn non_objective_rotation(&self, particle: usize) -> f64 {
         let mut angles: Vec<f64> = self
             .particles
             .f
@@ -278,7 +303,7 @@ where
             };
             // At an impact with a long step, more particles alone does not help
             // (a user's block at `courant = 0.5` failed sooner with more).
-            let step = match self.dt_critical {
+            let step = match self.critical_now().map(|(c, _)| c) {
                 Some(c) if c > 0.0 && self.dt.to_f64() > 0.3 * c => format!(
                     "; if it inverted at an impact, lower `time.courant` too (the step is {:.2} of the critical one; impacts want 0.25 or less)",
                     self.dt.to_f64() / c
@@ -379,6 +404,27 @@ where
     }
 }
 
+/// The message of [`StepError::CriticalStepFell`].
+fn critical_fell_message(
+    time: f64,
+    critical: f64,
+    start: Option<f64>,
+    dt: f64,
+    cause: Option<&str>,
+) -> String {
+    let from = start.map_or(String::new(), |s| {
+        format!(" from {s:.3e} at the start ({:.1e} of it)", critical / s)
+    });
+    let cause = cause.map_or_else(
+        || "the mass system the strategy solves became nearly singular as the bodies moved (a function the particles barely sample), or a body is collapsing: look at the particles (`--out`) near the worst-covered function (`worst_coverage` in diagnostics.csv); use more particles per element (`per_block`, `per_triangle`, `count` or `spacing`; `--particles`), or `--mass lumped`".to_string(),
+        str::to_string,
+    );
+    format!(
+        "at t = {time:.4e} the critical step fell to {critical:.3e}{from}: Δt = {dt:.3e} would take more than {} sub-steps; {cause}",
+        super::critical::MAX_SUBSTEPS
+    )
+}
+
 /// Why a step failed. Each names the step, the cause the driver can see, and a
 /// fix that fits that cause.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -412,6 +458,24 @@ pub enum StepError {
         position: Vec<f64>,
         /// What the driver sees near the particle and what to change.
         hint: String,
+    },
+    /// The critical step, estimated again as the bodies moved
+    /// ([`super::Driver::watch_critical_step`]), fell so far that the step would
+    /// take more than [`super::critical::MAX_SUBSTEPS`] sub-steps.
+    #[error("step {step}: {}", critical_fell_message(*time, *critical, *start, *dt, cause.as_deref()))]
+    CriticalStepFell {
+        step: usize,
+        /// The time at the start of the step.
+        time: f64,
+        /// The critical step estimated at the start of the step.
+        critical: f64,
+        /// The critical step estimated at the start of the run.
+        start: Option<f64>,
+        /// The time step.
+        dt: f64,
+        /// What makes the mass system nearly singular, with its fix, when the driver
+        /// sees it.
+        cause: Option<String>,
     },
     /// A body compressed to a few percent of its volume: judged by the caller, who
     /// knows the material (see `crate::material::COLLAPSED_JACOBIAN`).

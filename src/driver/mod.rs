@@ -30,7 +30,9 @@ mod energy;
 mod failure;
 pub mod phases;
 
-pub use critical::CRITICAL_ITERATIONS;
+pub use critical::{
+    WatchReport, CRITICAL_ITERATIONS, MAX_SUBSTEPS, WATCH_EVERY, WATCH_ITERATIONS, WATCH_SEED_SHARE,
+};
 pub(crate) use failure::point;
 pub use failure::{SetupError, StepError, NEARLY_SINGULAR};
 
@@ -160,9 +162,17 @@ where
     constraints: Constraints<T, D>,
     effects: Vec<Box<dyn Effect<T, D>>>,
     pattern: SymmetricPattern,
+    /// The step being taken: `dt_outer`, or a sub-step of it
+    /// ([`Driver::watch_critical_step`]).
     dt: T,
+    /// The time step of [`Driver::step`].
+    dt_outer: f64,
     step: usize,
     time: f64,
+    /// The watch over the critical step while the bodies move, when enabled.
+    watch: Option<critical::Watch<T>>,
+    /// The last vector of the power iteration of [`Driver::critical_time_step`].
+    critical_vector: Vec<Vec<T>>,
     // Buffers, sized once.
     evals: Evaluations<T, D>,
     /// One basis scratch per particle chunk ([`phases::CHUNK`]).
@@ -417,8 +427,11 @@ where
             effects,
             pattern,
             dt: T::of(dt),
+            dt_outer: dt,
             step: 0,
             time: 0.0,
+            watch: None,
+            critical_vector: Vec::new(),
             last_report: MassReport::default(),
         })
     }
@@ -477,16 +490,35 @@ where
     pub fn steps(&self) -> usize {
         self.step
     }
-    /// The time step.
+    /// The time step of [`Driver::step`] (which the watch over the critical step
+    /// may take in sub-steps, [`Driver::watch_critical_step`]).
     pub fn dt(&self) -> f64 {
-        self.dt.to_f64()
+        self.dt_outer
     }
     /// Changes the time step (e.g. to a fraction of [`Driver::critical_time_step`]).
     pub fn set_dt(&mut self, dt: f64) {
+        self.dt_outer = dt;
         self.dt = T::of(dt);
         for effect in &mut self.effects {
             effect.set_time_step(dt);
         }
+    }
+    /// The step actually taken: `dt_outer` or a sub-step of it. The effects keep
+    /// `dt_outer` ([`Effect::set_time_step`]): a contact wall's springs sized on it
+    /// are softer than a sub-step needs, so they stay stable, and springs that
+    /// stiffened and softened as steps are split would store and release energy.
+    fn set_substep_dt(&mut self, dt: f64) {
+        self.dt = T::of(dt);
+    }
+    /// What the watch over the critical step saw so far
+    /// ([`Driver::watch_critical_step`]); `None` without the watch.
+    pub fn watch_report(&self) -> Option<critical::WatchReport> {
+        self.watch.as_ref().map(|w| critical::WatchReport {
+            latest: w.latest,
+            lowest: w.lowest,
+            split_steps: w.split_steps,
+            most_substeps: w.most_substeps,
+        })
     }
     /// The material.
     pub fn material(&self) -> &Mat {
@@ -501,8 +533,57 @@ where
         &self.velocity
     }
 
-    /// Advances one time step: the phases in order, each timed.
+    /// Advances one time step: the phases in order, each timed. With the watch
+    /// over the critical step ([`Driver::watch_critical_step`]) the step may be
+    /// taken in equal sub-steps, each the whole sequence of phases; the report is
+    /// that of the end of the step, its phase times the sub-steps' sum.
     pub fn step(&mut self) -> Result<StepReport, StepError> {
+        let mut times = PhaseTimes::default();
+        self.prepare_system(&mut times)?;
+        let clock = Instant::now();
+        let substeps = self.substeps()?;
+        times.solve += clock.elapsed().as_secs_f64();
+        self.set_substep_dt(self.dt_outer / substeps as f64);
+        if substeps > 1 {
+            if let Some(w) = self.watch.as_mut() {
+                w.split_steps += 1;
+            }
+        }
+        let mut report = self.advance(0, substeps, &mut times)?;
+        for j in 1..substeps {
+            self.prepare_system(&mut times)?;
+            report = self.advance(j, substeps, &mut times)?;
+        }
+        self.phases = times;
+        report.phases = times;
+        report.substeps = substeps;
+        Ok(report)
+    }
+
+    /// Phases 1, 2a and the factorisation: the particles located, the basis
+    /// evaluated, `M` and `F^int` assembled and `M` factorised.
+    fn prepare_system(&mut self, times: &mut PhaseTimes) -> Result<(), StepError> {
+        let clock = Instant::now();
+        self.locate_and_evaluate()?;
+        let t_evaluate = clock.elapsed().as_secs_f64();
+        self.assemble_mass();
+        let t_assemble = clock.elapsed().as_secs_f64();
+        self.factorize()?;
+        times.evaluate += t_evaluate;
+        times.assemble += t_assemble - t_evaluate;
+        times.solve += clock.elapsed().as_secs_f64() - t_assemble;
+        Ok(())
+    }
+
+    /// Sub-step `j` of `substeps` from a factorised system
+    /// ([`Driver::prepare_system`]): the effects' forces, both solves, the
+    /// particles' update, and the report.
+    fn advance(
+        &mut self,
+        j: usize,
+        substeps: usize,
+        times: &mut PhaseTimes,
+    ) -> Result<StepReport, StepError> {
         let clock = Instant::now();
         let previous = match self.previous_energy {
             Some(previous) => previous,
@@ -512,11 +593,8 @@ where
                 (e.kinetic, e.strain + e.potential - self.work)
             }
         };
-        self.locate_and_evaluate()?;
-        let t_evaluate = clock.elapsed().as_secs_f64();
-        self.assemble();
+        self.assemble_effects();
         let t_assemble = clock.elapsed().as_secs_f64();
-        self.factorize()?;
         let power_start = self.power_at_start()?;
         self.solve_acceleration()?;
         let t_solve = clock.elapsed().as_secs_f64() - t_assemble;
@@ -526,22 +604,25 @@ where
         let t_projection = clock.elapsed().as_secs_f64() - before_projection;
         self.book_work(power_start);
         self.update_particles()?;
-        self.phases = PhaseTimes {
-            evaluate: t_evaluate,
-            assemble: t_assemble - t_evaluate,
-            solve: t_solve + t_projection,
-            update: clock.elapsed().as_secs_f64() - t_assemble - t_solve - t_projection,
-        };
-        self.step += 1;
+        times.assemble += t_assemble;
+        times.solve += t_solve + t_projection;
+        times.update += clock.elapsed().as_secs_f64() - t_assemble - t_solve - t_projection;
         // Time from the step count, so that it does not accumulate round-off.
-        self.time = self.step as f64 * self.dt.to_f64();
+        if j + 1 == substeps {
+            self.step += 1;
+            self.time = self.step as f64 * self.dt_outer;
+        } else {
+            self.time = (self.step as f64 + (j + 1) as f64 / substeps as f64) * self.dt_outer;
+        }
         let e = self.step_energies();
         let mut report = self.report_with(e);
         // ½ Σ m_p vⁿ·vⁿ⁺¹ = Kⁿ + ½ Σ m_p vⁿ·Δv_p, with the rest of the energy at xⁿ.
         // The work it pairs with: symplectic Euler changes it by exactly
         // `½ Δt v̂ᵏ⁺¹ · (Fᵏ + Fᵏ⁺¹)` per step on a linear system, the work booked up
         // to the last step (`Δt F · (v̂ᵏ + v̂ᵏ⁺¹) / 2`) plus half of this step's start
-        // power `Fⁿ · v̂ⁿ`, less half of the first step's.
+        // power `Fⁿ · v̂ⁿ`, less half of the first step's. With sub-steps `Δt` is the
+        // sub-step's: `½ Δt Fⁿ · v̂ⁿ` is the part of `½ m vⁿ · vⁿ⁺¹` the step's
+        // length puts in, which a change of the length changes with it.
         let dot: f64 = self.centred_terms.iter().sum();
         let half_power = 0.5 * self.dt.to_f64() * power_start[0];
         let first = *self.first_half_power.get_or_insert(half_power);
@@ -609,6 +690,12 @@ where
                 format!(
                     "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`, or a contact wall) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
+            };
+            // A spinning body of the paper's non-objective law is crushed or torn by
+            // its spurious stress: that first, whichever way it failed.
+            let hint = match crate::material::non_objective_cause(self.non_objective_rotation(p)) {
+                Some(law) => format!("{hint}; before anything else: {law}"),
+                None => hint,
             };
             StepError::ParticleLeftMesh {
                 step: self.step + 1,
@@ -686,10 +773,9 @@ where
         }
     }
 
-    /// Phase 2: [`assemble_mass`](Self::assemble_mass), then the effects' forces
+    /// Phase 2b, after [`assemble_mass`](Self::assemble_mass): the effects' forces
     /// into `rhs`.
-    fn assemble(&mut self) {
-        self.assemble_mass();
+    fn assemble_effects(&mut self) {
         if self.effects.is_empty() {
             return;
         }

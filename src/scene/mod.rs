@@ -679,6 +679,17 @@ pub struct TimeSpec {
     /// error otherwise, naming both): for studies of what an unstable step does.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub allow_above_critical: bool,
+    /// Estimate the critical step again as the bodies move and take a step in
+    /// sub-steps where it fell below what the step needs
+    /// (`Driver::watch_critical_step`; on by default, and off with
+    /// `allow_above_critical`): `false` keeps every step whole, as a run of the
+    /// seeds would.
+    #[serde(default = "yes", skip_serializing_if = "Clone::clone")]
+    pub watch: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// The exact or reference solution of a scene, and so its error measure.

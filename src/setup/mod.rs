@@ -214,6 +214,14 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
             return Err(above_critical(scene, dt, critical, cause).into());
         }
     }
+    if let (Some(critical), false, true) = (
+        dt_critical,
+        scene.time.allow_above_critical,
+        scene.time.watch,
+    ) {
+        let (courant, trigger) = watch_thresholds(scene.time.courant, dt / critical);
+        driver.watch_critical_step(courant, trigger);
+    }
     Ok(Prepared {
         driver,
         dt,
@@ -392,6 +400,25 @@ fn driver<const D: usize, B: Basis<f64, D>>(
         })?;
     }
     Ok(driver)
+}
+
+/// The Courant number of the sub-steps and the ratio `Δt / Δt_crit` above which a
+/// step is split, for the watch over the critical step while the bodies move
+/// ([`crate::driver::Driver::watch_critical_step`]), from the scene's `courant` or,
+/// with a fixed `dt`, its ratio `start` to the critical step at the start.
+///
+/// With `courant = C` a step is split when it is above `min(1.25 C, (1 + C) / 2)` of
+/// the current critical step (within a quarter of `C`, and halfway to 1), into
+/// sub-steps at `C`: `courant` keeps its meaning as the bodies move over the mesh,
+/// while the small changes of the estimate as a body at rest settles do not split
+/// steps. With a fixed `dt` only a step near the limit is split (above 0.9 of the
+/// critical step, or above `start` when the scene starts closer to it), into
+/// sub-steps at 0.7: the scene's step is kept wherever it is stable.
+pub(crate) fn watch_thresholds(courant: Option<f64>, start: f64) -> (f64, f64) {
+    match courant {
+        Some(c) => (c, (1.25 * c).min(0.5 * (1.0 + c))),
+        None => (0.7, start.clamp(0.9, 1.0)),
+    }
 }
 
 /// The time step, the number of steps and the critical step at the start: a fixed
