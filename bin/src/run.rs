@@ -806,6 +806,30 @@ pub fn long_run_note(scene: &psmpm::scene::Scene, steps: usize, dt: f64) -> Opti
     })
 }
 
+/// `critical step watched as the bodies moved: …`, when the watch over the critical
+/// step split steps of a run with `courant` (with a fixed `dt` a warning says it).
+pub fn watched_line(summary: &Summary) -> Option<String> {
+    if summary.split_steps == 0 {
+        return None;
+    }
+    let (lowest, start, c) = (
+        summary.dt_critical_lowest?,
+        summary.dt_critical?,
+        summary.courant?,
+    );
+    Some(format!(
+        "critical step watched as the bodies moved: it fell to {} ({:.2} of the start's {}), so {} of the {} steps {} taken in up to {} sub-steps to keep courant {}",
+        sci(lowest),
+        lowest / start,
+        sci(start),
+        summary.split_steps,
+        summary.steps,
+        if summary.split_steps == 1 { "was" } else { "were" },
+        summary.most_substeps,
+        short(c)
+    ))
+}
+
 /// `time step … · critical step … · Courant number …`, printed at the start of a run.
 pub fn time_step_line(r: &StepReport) -> String {
     match r.dt_critical {
@@ -962,24 +986,8 @@ pub fn summary_text(summary: &Summary) -> String {
         summary.max_condition.map_or("-".into(), sci),
         summary.max_lumped_rows,
     );
-    if summary.split_steps > 0 {
-        if let (Some(lowest), Some(start), Some(c)) = (
-            summary.dt_critical_lowest,
-            summary.dt_critical,
-            summary.courant,
-        ) {
-            out += &format!(
-                "critical step watched as the bodies moved: it fell to {} ({:.2} of the start's {}), so {} of the {} steps {} taken in up to {} sub-steps to keep courant {}\n",
-                sci(lowest),
-                lowest / start,
-                sci(start),
-                summary.split_steps,
-                summary.steps,
-                if summary.split_steps == 1 { "was" } else { "were" },
-                summary.most_substeps,
-                short(c)
-            );
-        }
+    if let Some(line) = watched_line(summary) {
+        out += &format!("{line}\n");
     }
     if let Some(reason) = &summary.failure {
         out += &format!("stopped: {reason}\n");

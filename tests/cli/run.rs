@@ -999,3 +999,86 @@ t_end = 1.0
         "{stderr}"
     );
 }
+
+/// A block falling freely across the mesh (PS, default mass; a user's scene): its
+/// critical step falls to about half the start's as its particles cover new
+/// functions. `run` says how far it fell and how many steps were split, `--format
+/// json` gives the figures, `compare` says it per variant, and with `--no-watch`
+/// the run inverts at `courant = 0.7` and is told about the watch.
+#[test]
+fn the_critical_step_watched_while_a_block_falls_is_reported() {
+    let file = SceneFile::new(
+        "watch-fall",
+        r#"name = "falling"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [0.0, 2.0]
+blocks = [8, 8]
+[material]
+young = 1e5
+poisson = 0.3
+density = 100.0
+[[body]]
+min = [0.5, 0.5]
+max = [1.5, 1.0]
+per_block = [6, 6]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.7
+t_end = 0.3
+"#,
+    );
+    let out = cli()
+        .args(["run", file.arg(), "--diag-every", "0"])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("critical step watched as the bodies moved: it fell to 1.3")
+            && stdout.contains("(0.5")
+            && stdout.contains("sub-steps to keep courant 0.7"),
+        "{stdout}"
+    );
+    let out = cli()
+        .args(["run", file.arg(), "--format", "json"])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let summary: Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    let (start, lowest) = (
+        summary["dt_critical"].as_f64().unwrap(),
+        summary["dt_critical_lowest"].as_f64().unwrap(),
+    );
+    assert!(lowest < 0.6 * start, "{summary}");
+    assert!(summary["split_steps"].as_u64().unwrap() > 0, "{summary}");
+    assert!(summary["most_substeps"].as_u64().unwrap() >= 2, "{summary}");
+    let out = cli()
+        .args(["compare", file.arg(), "--basis", "ps,pl"])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("ps extended-hybrid: critical step watched as the bodies moved")
+            && stdout.contains("pl extended-hybrid: critical step watched as the bodies moved"),
+        "{stdout}"
+    );
+    let out = cli()
+        .args(["run", file.arg(), "--diag-every", "0", "--no-watch"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("which changes as the bodies move over the mesh")
+            && stderr.contains("remove `watch = false` from `[time]` (or `--no-watch`)"),
+        "{stderr}"
+    );
+}
