@@ -258,10 +258,30 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     }
                     None => "no reference solution, no error".to_string(),
                 };
+                // Where a variant stopped early, its own time, to 3 digits.
+                let stopped: Vec<String> = summaries
+                    .iter()
+                    .filter(|v| v.t_end < t_end)
+                    .map(|v| {
+                        format!(
+                            "{} {} stopped at t = {}",
+                            v.basis,
+                            v.mass,
+                            crate::table::short(
+                                crate::table::sci(v.t_end).parse().unwrap_or(v.t_end)
+                            )
+                        )
+                    })
+                    .collect();
+                let stopped = if stopped.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", stopped.join("; "))
+                };
                 println!(
-                    "{}: {error}, t = {}; wall times measured side by side",
+                    "{}: {error}, t = {}{stopped}; wall times measured side by side",
                     s.scene,
-                    (t_end * 1e9).round() / 1e9
+                    crate::table::short(t_end)
                 );
                 let steps: Vec<f64> = summaries.iter().map(|s| s.dt).collect();
                 if steps.iter().any(|&dt| dt != steps[0]) {

@@ -1070,6 +1070,17 @@ t_end = 0.3
             && stdout.contains("pl extended-hybrid: critical step watched as the bodies moved"),
         "{stdout}"
     );
+    // Every step whole: PS stops, and `compare`'s footer gives its own stop time
+    // (to 3 digits) beside the end time the other variant reached.
+    let out = cli()
+        .args(["compare", file.arg(), "--basis", "ps,pl", "--no-watch"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("t = 0.3 (ps extended-hybrid stopped at t = 0.181)"),
+        "{stdout}"
+    );
     let out = cli()
         .args(["run", file.arg(), "--diag-every", "0", "--no-watch"])
         .output()
