@@ -1058,15 +1058,17 @@ fn split_steps_warning(
     let w = watched.filter(|w| w.split_steps > 0 && scene.time.courant.is_none())?;
     let (lowest, step, time) = w.lowest?;
     let start = start?;
+    let (_, trigger) = crate::setup::watch_thresholds(None, dt / start);
     Some(format!(
-        "the critical step fell from {} at the start to {} (step {step}, t = {}) as the bodies moved over the mesh: `time.dt` = {} was above 0.9 of it, so {} taken in up to {} sub-steps at 0.7 of the critical step; give `courant` instead of `dt` to follow the critical step throughout, or a `dt` below {}",
+        "the critical step fell from {} at the start to {} at its lowest (step {step}, t = {}) as the bodies moved over the mesh: `time.dt` = {} was above {} of it in places, so {} taken in up to {} sub-steps at 0.7 of the critical step; give `courant` instead of `dt` to follow the critical step throughout, or a `dt` below {}",
         crate::scene::limits::echo_significant(start, 3),
         crate::scene::limits::echo_significant(lowest, 3),
         crate::scene::limits::echo_significant(time, 4),
         crate::scene::limits::echo_number(dt),
+        crate::scene::limits::echo_significant(trigger, 3),
         crate::scene::limits::plural(w.split_steps, "step was", "steps were"),
         w.most_substeps,
-        crate::scene::limits::echo_significant(0.7 * lowest, 2),
+        crate::scene::limits::echo_significant(0.9 * lowest, 2),
     ))
 }
 
@@ -1182,7 +1184,12 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             max_deactivated: tally.deactivated,
             max_extended: tally.extended,
             dt_critical: run.dt_critical,
-            dt_critical_lowest: watched.and_then(|w| w.lowest).map(|(c, _, _)| c),
+            // The lowest of the start's estimate and the watch's.
+            dt_critical_lowest: watched.and_then(|w| {
+                w.lowest.map_or(run.dt_critical, |(c, _, _)| {
+                    Some(run.dt_critical.map_or(c, |start| start.min(c)))
+                })
+            }),
             split_steps: watched.map_or(0, |w| w.split_steps),
             most_substeps: watched.map_or(1, |w| w.most_substeps),
             courant: scene.time.courant,

@@ -809,14 +809,24 @@ pub fn long_run_note(scene: &psmpm::scene::Scene, steps: usize, dt: f64) -> Opti
 /// `critical step watched as the bodies moved: …`, when the watch over the critical
 /// step split steps of a run with `courant` (with a fixed `dt` a warning says it).
 pub fn watched_line(summary: &Summary) -> Option<String> {
-    if summary.split_steps == 0 {
-        return None;
-    }
     let (lowest, start, c) = (
         summary.dt_critical_lowest?,
         summary.dt_critical?,
         summary.courant?,
     );
+    if summary.split_steps == 0 {
+        // Fell, but not far enough to split a step: said, so that the figure in
+        // summary.json is not the only trace.
+        return (lowest < 0.9 * start).then(|| {
+            format!(
+                "critical step watched as the bodies moved: it fell to {} ({:.2} of the start's {}), not far enough to split a step at courant {}",
+                sci(lowest),
+                lowest / start,
+                sci(start),
+                short(c)
+            )
+        });
+    }
     Some(format!(
         "critical step watched as the bodies moved: it fell to {} ({:.2} of the start's {}), so {} of the {} steps {} taken in up to {} sub-steps to keep courant {}",
         sci(lowest),

@@ -134,16 +134,27 @@ where
         })
     }
 
-    /// The critical step `2 / √(a λ_max(M⁻¹K))` by `iterations` Lanczos steps on
-    /// `A = M⁻¹K` from `start` (its first `D` vectors of `buffers`), `M⁻¹` the
-    /// strategy's solve with the walls. `A` is self-adjoint in the stiffness's inner
-    /// product `⟨x, y⟩_K = xᵀ K y` (`K A = K M⁻¹ K`), so the Lanczos recurrence in that
-    /// product gives a tridiagonal `T` whose largest eigenvalue approaches
-    /// `λ_max(A)` from below, much faster than the power iteration where the top of
-    /// the spectrum is crowded (a body half over new functions). One stiffness
-    /// product and one solve per step, as a power iteration; no allocation.
-    /// The rigid modes (`K x = 0`) drop out of the product, which is what the
-    /// largest eigenvalue needs.
+    /// The critical step `2 / √(a λ_max(A))` of the update as it is taken, by
+    /// `iterations` Lanczos steps from `buffers.start`, with `A = M⁻¹ M_c M⁻¹ K`:
+    /// `M⁻¹` the strategy's solve with the walls, `M_c` the particles' consistent
+    /// mass. The grid velocities of a step are projected from the particles'
+    /// (`M v̂ = Φᵀ m v_p`, eq. (20)) after the particles took the grid's
+    /// acceleration, so a grid field `v̂` becomes `M⁻¹ M_c v̂` plus the step's
+    /// change: where `M = M_c` (the consistent mass) `A = M⁻¹K`, and where rows are
+    /// lumped (`M ⪰ M_c`) the projection damps what a lumped row's small mass would
+    /// make stiff (a function that a particle near the edge of its support sees
+    /// with `phi ≈ ε` has a lumped mass `∝ ε` and a consistent one `∝ ε²`).
+    /// Measured: PL's default on a block falling onto a no-slip floor ran stable
+    /// with every step whole at 3.5 times the critical step of `M⁻¹K`.
+    ///
+    /// `A` is self-adjoint in the stiffness's inner product `⟨x, y⟩_K = xᵀKy`
+    /// (`KA = K M⁻¹ M_c M⁻¹ K`), so the Lanczos recurrence in that product gives a
+    /// tridiagonal `T` whose largest eigenvalue approaches `λ_max(A)` from below,
+    /// much faster than a power iteration where the top of the spectrum is crowded
+    /// (a body half over new functions). Per step: a stiffness product, a
+    /// consistent-mass product and two solves; no allocation. The rigid modes
+    /// (`Kx = 0`) drop out of the product, which is what the largest eigenvalue
+    /// needs.
     pub(super) fn lanczos_critical(
         &mut self,
         buffers: &mut Lanczos<T>,
@@ -157,6 +168,7 @@ where
             current,
             k_current,
             next,
+            scratch,
         } = buffers;
         let material = &self.material;
         let lame = |p: usize| material.elastic(p).lame(D);
@@ -189,6 +201,17 @@ where
             // w = M⁻¹ K q_j, with the walls.
             for (w, kq) in next.iter_mut().zip(k_current.iter()) {
                 w.copy_from_slice(kq);
+            }
+            for (k, w) in next.iter_mut().enumerate() {
+                if let Err(source) = self.mass.solve(k, w) {
+                    return Err(self.mass_failure(source));
+                }
+            }
+            self.constraints.project(next);
+            // The velocity projection's filter: w ← M⁻¹ M_c w.
+            consistent_mass_product(&self.evals, &self.particles.mass, next, scratch);
+            for (w, m) in next.iter_mut().zip(scratch.iter()) {
+                w.copy_from_slice(m);
             }
             for (k, w) in next.iter_mut().enumerate() {
                 if let Err(source) = self.mass.solve(k, w) {
@@ -514,6 +537,7 @@ pub(super) struct Lanczos<T> {
     current: Vec<Vec<T>>,
     k_current: Vec<Vec<T>>,
     next: Vec<Vec<T>>,
+    scratch: Vec<Vec<T>>,
 }
 
 impl<T: Scalar> Lanczos<T> {
@@ -526,6 +550,7 @@ impl<T: Scalar> Lanczos<T> {
             current: Vec::new(),
             k_current: Vec::new(),
             next: Vec::new(),
+            scratch: Vec::new(),
         }
     }
 
@@ -546,6 +571,30 @@ impl<T: Scalar> Lanczos<T> {
             current: field(),
             k_current: field(),
             next: field(),
+            scratch: field(),
+        }
+    }
+}
+
+/// `out = M_c v`, `M_c = Σ_p m_p phi(x_p) phi(x_p)ᵀ` the consistent mass of the
+/// particles (paper eq. (13)), per component, without the matrix.
+fn consistent_mass_product<T: Scalar, const D: usize>(
+    evals: &phases::Evaluations<T, D>,
+    mass: &[T],
+    v: &[Vec<T>],
+    out: &mut [Vec<T>],
+) {
+    phases::zero(out);
+    for (p, &m) in mass.iter().enumerate() {
+        for k in 0..D {
+            let mut at = T::zero();
+            for (s, i) in evals.entries(p) {
+                at += evals.phi[s] * v[k][i];
+            }
+            let at = at * m;
+            for (s, i) in evals.entries(p) {
+                out[k][i] += evals.phi[s] * at;
+            }
         }
     }
 }
