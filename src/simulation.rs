@@ -102,7 +102,7 @@ pub struct Summary {
     /// watched; `dt_critical` is the start's.
     pub dt_critical_lowest: Option<f64>,
     /// Steps the watch took in sub-steps, the critical step having fallen below
-    /// what the step needs ([`crate::setup::watch_thresholds`]).
+    /// what the step needs (`setup::watch_thresholds`).
     pub split_steps: usize,
     /// The most sub-steps of one step (1 when none was split).
     pub most_substeps: usize,

@@ -272,7 +272,7 @@ where
     /// Enables the watch over the critical step while the bodies move: every
     /// [`WATCH_EVERY`] steps (every step while steps are split) the step estimates
     /// the critical step again at its own mass system, with [`WATCH_ITERATIONS`]
-    /// power iterations from the last estimate's vector (plus a share of [`seed`],
+    /// power iterations from the last estimate's vector (plus a share of the fixed start field,
     /// for a new stiff mode elsewhere), and when `Δt` is above `trigger` times that
     /// estimate it is taken in `k = ⌈Δt / (courant Δt_crit)⌉` equal sub-steps. The
     /// step's end time and everything reported per step stay those of `Δt`.
@@ -452,7 +452,7 @@ pub struct WatchReport {
 }
 
 /// Steps between two checks of the critical step while the bodies move, after a
-/// change (of the estimate by [`WATCH_STEADY`] or more, or of the functions the
+/// change (of the estimate by `WATCH_STEADY` or more, or of the functions the
 /// strategy's system holds or treats).
 pub const WATCH_EVERY: usize = 4;
 /// Steps from the last check after which a change of the functions the
@@ -464,7 +464,7 @@ pub const WATCH_EVERY_MOST: usize = 32;
 pub const WATCH_STEADY: f64 = 0.02;
 /// Lanczos steps of a check, from the last check's Ritz vector.
 pub const WATCH_ITERATIONS: usize = 4;
-/// The share (in norm) of [`seed`] added to the last Ritz vector at each check.
+/// The share (in norm) of the fixed start field added to the last Ritz vector at each check.
 pub const WATCH_SEED_SHARE: f64 = 0.3;
 /// Most sub-steps one step may be split into before the run stops: a critical
 /// step that fell that far means a nearly singular mass system or a collapse.
