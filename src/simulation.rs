@@ -531,7 +531,7 @@ fn end_time_warning(scene: &Scene, dt: f64, steps: usize) -> Option<String> {
             crate::scene::limits::echo_number(t_end),
             crate::scene::limits::plural(steps, "step", "steps"),
             crate::scene::limits::echo_number(dt),
-            crate::scene::limits::echo_number(ends),
+            crate::scene::limits::echo_significant(ends, 12),
             (ends - t_end).abs() / t_end,
             if ends > t_end { "after it" } else { "before it" },
             steps,
@@ -1177,7 +1177,17 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             particles: driver.particles.len(),
             steps: driver.steps(),
             dt: run.dt,
-            t_end: driver.time(),
+            // A `courant` run that took all its steps of `t_end / steps` ends at
+            // `t_end` itself (the product of the two rounds: 0.7999999999999999).
+            t_end: if scene.time.courant.is_some()
+                && failure.is_none()
+                && !tally.interrupted
+                && driver.steps() == run.steps
+            {
+                scene.time.t_end
+            } else {
+                driver.time()
+            },
             error,
             error_measure: scene.reference.map(|r| r.error_measure(scene.dim)),
             max_lumped_rows: tally.lumped,
