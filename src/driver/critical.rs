@@ -284,6 +284,10 @@ where
             courant,
             trigger,
             lanczos: Lanczos::new(D, n, WATCH_ITERATIONS),
+            seed_norm: (0..D)
+                .flat_map(|k| (0..n).map(move |i| seed(i, k).powi(2)))
+                .sum::<f64>()
+                .sqrt(),
             latest: self.dt_critical,
             latest_step: 0,
             lowest: None,
@@ -325,17 +329,15 @@ where
         watch.since_check = 0;
         // Warm start: the last Ritz vector, with a share of the fixed non-smooth
         // field (for a new stiff mode elsewhere).
-        let mut lanczos = std::mem::replace(&mut watch.lanczos, Lanczos::empty());
-        let (nv, ns) = (norm(&lanczos.start), self.seed_norm());
-        let share = WATCH_SEED_SHARE;
-        for (k, c) in lanczos.start.iter_mut().enumerate() {
+        let (nv, ns) = (norm(&watch.lanczos.start), watch.seed_norm);
+        for (k, c) in watch.lanczos.start.iter_mut().enumerate() {
             for (i, a) in c.iter_mut().enumerate() {
                 let warm = if nv > 0.0 { a.to_f64() / nv } else { 0.0 };
-                *a = T::of(warm + share * seed(i, k) / ns);
+                *a = T::of(warm + WATCH_SEED_SHARE * seed(i, k) / ns);
             }
         }
-        let estimate = self.lanczos_critical(&mut lanczos, WATCH_ITERATIONS);
-        watch.lanczos = lanczos;
+        // The watch is out of `self` while it runs, so its buffers lend directly.
+        let estimate = self.lanczos_critical(&mut watch.lanczos, WATCH_ITERATIONS);
         let estimate = match estimate {
             Ok(e) => e,
             Err(e) => {
@@ -392,15 +394,6 @@ where
         self.watch = Some(watch);
         Ok(k)
     }
-
-    /// `‖seed‖` over this basis's functions and the components.
-    fn seed_norm(&self) -> f64 {
-        let n = self.basis.num_functions();
-        (0..D)
-            .flat_map(|k| (0..n).map(move |i| seed(i, k).powi(2)))
-            .sum::<f64>()
-            .sqrt()
-    }
 }
 
 /// The watch over the critical step while the bodies move
@@ -413,6 +406,8 @@ pub(super) struct Watch<T> {
     pub trigger: f64,
     /// The Lanczos buffers; the start vector is the last check's Ritz vector.
     pub lanczos: Lanczos<T>,
+    /// `‖seed‖` over the basis's functions and the components.
+    pub seed_norm: f64,
     /// The latest estimate of the critical step.
     pub latest: Option<f64>,
     /// The step (1-based) of the latest estimate; 0 for the start's.
@@ -541,19 +536,6 @@ pub(super) struct Lanczos<T> {
 }
 
 impl<T: Scalar> Lanczos<T> {
-    /// No buffers (a placeholder while the watch's are in use).
-    fn empty() -> Self {
-        Self {
-            start: Vec::new(),
-            kept: Vec::new(),
-            previous: Vec::new(),
-            current: Vec::new(),
-            k_current: Vec::new(),
-            next: Vec::new(),
-            scratch: Vec::new(),
-        }
-    }
-
     /// Buffers for `n` functions in `d` components, the start [`seed`], keeping
     /// `keep` Lanczos vectors for the Ritz vector.
     pub fn new(d: usize, n: usize, keep: usize) -> Self {
