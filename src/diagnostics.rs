@@ -387,6 +387,11 @@ pub struct Verdict {
     /// has stayed at or above [`STABLE_ENERGY_GROWTH`] of the energy scale seen so
     /// far.
     pub growth_crossed: Option<(usize, f64)>,
+    /// The step (and its time) in which the largest growth of the time-centred
+    /// total so far rose most, and by how much (absolute): an impact's growth
+    /// comes in a few steps, which the crossing of the bound, reached by a
+    /// smaller growth on a smaller scale earlier, need not name.
+    pub largest_rise: Option<(usize, f64, f64)>,
     /// Largest condition estimate seen.
     pub max_condition: Option<f64>,
 }
@@ -405,6 +410,7 @@ impl Verdict {
             growth: 0.0,
             growth_centred: 0.0,
             growth_crossed: None,
+            largest_rise: None,
             max_condition: None,
         }
     }
@@ -429,9 +435,12 @@ impl Verdict {
         let change = r.total_energy() + unearned - self.e0;
         self.drift = self.drift.max(change.abs());
         self.growth = self.growth.max(change);
-        self.growth_centred = self
-            .growth_centred
-            .max(r.total_centred + unearned - self.e0);
+        let centred = r.total_centred + unearned - self.e0;
+        let rise = centred - self.growth_centred;
+        if rise > 0.0 && self.largest_rise.is_none_or(|(_, _, most)| rise > most) {
+            self.largest_rise = Some((r.step, r.time, rise));
+        }
+        self.growth_centred = self.growth_centred.max(centred);
         // The scale widens over the run (it starts at the round-off floor for a
         // body thrown in pure translation): a crossing that a wider scale undoes is
         // forgotten, so the step reported is the one since which the growth has
@@ -477,6 +486,13 @@ impl Verdict {
             }
         };
         (relative(self.drift), relative(self.growth))
+    }
+
+    /// The step and time of [`Verdict::largest_rise`] and its share of the
+    /// largest growth of the time-centred total (`None` when it never grew).
+    pub fn largest_rise_share(&self) -> Option<(usize, f64, f64)> {
+        let (step, time, rise) = self.largest_rise?;
+        (self.growth_centred > 0.0).then(|| (step, time, rise / self.growth_centred))
     }
 
     /// The largest growth of the time-centred total
@@ -669,6 +685,27 @@ mod tests {
         assert!(!v.stable(false));
         assert!((v.centred_growth() - 0.06).abs() < 1e-15);
         assert_eq!(v.growth_crossed, Some((1, 1.0)));
+    }
+
+    /// The step in which the centred total rose most is kept with its share of
+    /// the growth: a slow gain of 1 over ten steps, then 3 in one step (an
+    /// impact), then a fall (which is no rise).
+    #[test]
+    fn the_largest_rise_of_the_centred_total_is_named() {
+        let at = |step: usize, gain: f64| StepReport {
+            step,
+            time: 0.1 * step as f64,
+            kinetic: 100.0,
+            total_centred: 100.0 + gain,
+            ..StepReport::default()
+        };
+        let mut history: Vec<StepReport> = (0..=10).map(|k| at(k, 0.1 * k as f64)).collect();
+        history.push(at(11, 4.0));
+        history.push(at(12, 2.0));
+        let v = verdict(&history);
+        let (step, time, share) = v.largest_rise_share().unwrap();
+        assert_eq!((step, time), (11, 1.1));
+        assert!((share - 0.75).abs() < 1e-12, "{share}");
     }
 
     /// A body vibrating with energy 0.1 that gains 30 % of it over the run,

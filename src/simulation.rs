@@ -972,10 +972,15 @@ fn error<const D: usize, B: Basis<f64, D>>(
 /// growing 0.104 at `courant = 0.5` grew 5.4e-2 at the 0.25 that halving gave, and
 /// held at 0.125, a user found; a growth that rises faster than the step, an
 /// instability, is not helped by less than a quarter either).
+/// The share of the growth that one step must hold for the growth hint to name
+/// that step beside the crossing of the bound.
+const RISE_NAMED: f64 = 0.2;
+
 #[allow(clippy::too_many_arguments)]
 pub fn energy_growth_hint(
     growth: f64,
     crossed: Option<(usize, f64)>,
+    rise: Option<(usize, f64, f64)>,
     steps: usize,
     dt: f64,
     dt_critical: Option<f64>,
@@ -983,11 +988,25 @@ pub fn energy_growth_hint(
     particles_per_element: f64,
     functions_per_element: usize,
 ) -> String {
-    let when = match crossed {
-        Some((step, time)) => {
+    // Where most of the growth came in one step (an impact) away from the
+    // crossing, that step is named too: the crossing can come early, a smaller
+    // growth against a smaller energy scale.
+    let rise = rise.filter(|&(step, _, share)| {
+        share >= RISE_NAMED && crossed.is_none_or(|(crossed, _)| crossed != step)
+    });
+    let when = match (crossed, rise) {
+        (Some((step, time)), None) => {
             format!("it reached the bound at t = {time:.4} (step {step} of {steps}); ")
         }
-        None => String::new(),
+        (Some((step, time)), Some((at, at_time, share))) => format!(
+            "it reached the bound at t = {time:.4} (step {step} of {steps}) and grew most at t = {at_time:.4} (step {at}: {:.0} % of the growth in that step); ",
+            100.0 * share
+        ),
+        (None, Some((at, at_time, share))) => format!(
+            "it grew most at t = {at_time:.4} (step {at} of {steps}: {:.0} % of the growth in that step); ",
+            100.0 * share
+        ),
+        (None, None) => String::new(),
     };
     let critical = dt_critical.filter(|c| c.is_finite() && *c > 0.0);
     let factor = if growth.is_finite() && growth > 0.0 {
@@ -1115,6 +1134,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             energy_growth_hint(
                 tally.verdict.centred_growth(),
                 tally.verdict.growth_crossed,
+                tally.verdict.largest_rise_share(),
                 run.driver.steps(),
                 run.dt,
                 run.dt_critical,
@@ -1432,8 +1452,17 @@ mod tests {
     /// `dt`, not `courant`, which it does not give.
     #[test]
     fn the_energy_growth_hint_fits_the_step_and_the_sampling() {
-        let sparse =
-            energy_growth_hint(0.06, Some((120, 0.25)), 400, 1e-3, Some(2e-3), true, 4.5, 9);
+        let sparse = energy_growth_hint(
+            0.06,
+            Some((120, 0.25)),
+            None,
+            400,
+            1e-3,
+            Some(2e-3),
+            true,
+            4.5,
+            9,
+        );
         for part in [
             "it reached the bound at t = 0.2500 (step 120 of 400)",
             "the time step is 0.50 of the critical step",
@@ -1442,7 +1471,7 @@ mod tests {
         ] {
             assert!(sparse.contains(part), "`{part}` not in: {sparse}");
         }
-        let dense = energy_growth_hint(0.06, None, 400, 1e-3, None, false, 12.0, 3);
+        let dense = energy_growth_hint(0.06, None, None, 400, 1e-3, None, false, 12.0, 3);
         assert!(!dense.contains("per occupied element"), "{dense}");
         assert!(
             dense.contains("lower `time.dt` (now 1.000e-3; to 5.000e-4, say: a growth of 6.00e-2")
@@ -1455,6 +1484,7 @@ mod tests {
         let fixed = energy_growth_hint(
             0.104,
             Some((120, 0.25)),
+            Some((120, 0.25, 0.6)),
             400,
             1e-3,
             Some(2e-3),
@@ -1469,8 +1499,38 @@ mod tests {
             assert!(fixed.contains(part), "`{part}` not in: {fixed}");
         }
         assert!(!fixed.contains("courant"), "{fixed}");
+        // The bound crossed early on a small scale; most of the growth came at an
+        // impact later: both named. A rise held by a fifth of the growth or less,
+        // or in the crossing's step, is not.
+        let impact = energy_growth_hint(
+            0.08,
+            Some((12, 0.03)),
+            Some((300, 0.75, 0.45)),
+            400,
+            1e-3,
+            Some(2e-3),
+            true,
+            12.0,
+            3,
+        );
+        assert!(
+            impact.contains("it reached the bound at t = 0.0300 (step 12 of 400) and grew most at t = 0.7500 (step 300: 45 % of the growth in that step)"),
+            "{impact}"
+        );
+        let spread = energy_growth_hint(
+            0.08,
+            Some((12, 0.03)),
+            Some((300, 0.75, 0.1)),
+            400,
+            1e-3,
+            Some(2e-3),
+            true,
+            12.0,
+            3,
+        );
+        assert!(!spread.contains("grew most"), "{spread}");
         // An instability growing far faster than the step: no less than a quarter.
-        let fast = energy_growth_hint(0.9, None, 400, 1e-3, Some(2e-3), true, 12.0, 3);
+        let fast = energy_growth_hint(0.9, None, None, 400, 1e-3, Some(2e-3), true, 12.0, 3);
         assert!(
             fast.contains("lower `time.courant` (to 0.12, say"),
             "{fast}"

@@ -9,10 +9,11 @@
 //! - `diagnostics.csv`: one row per step (not the initial state): `step, time,
 //!   kinetic, strain, potential, work, total, total_centred, mass, momentum_x, momentum_y,
 //!   max_speed, active, lumped_rows, deactivated, extended, worst_coverage,
-//!   worst_function, worst_x, worst_y, condition` (the values of `--format json`;
-//!   floats in Rust's shortest round-trip `{:e}` form, integers as integers, the
-//!   `worst_*` columns empty when the mass strategy does not measure coverage,
-//!   `worst_y` in 1D, `condition` unless `--condition`). All CSV files are written
+//!   worst_function, worst_x, worst_y, condition, kinetic_motion, substeps,
+//!   dt_critical` (the values of `--format json`; floats in Rust's shortest
+//!   round-trip `{:e}` form, integers as integers, the `worst_*` columns empty when
+//!   the mass strategy does not measure coverage, `worst_y` in 1D, `condition`
+//!   unless `--condition`, `dt_critical` when the critical step was not estimated). All CSV files are written
 //!   with the `csv` crate (RFC 4180 quoting where needed).
 //! - `summary.json`: the summary of `--format json`, pretty-printed (with
 //!   `"interrupted": true` when SIGINT/SIGTERM or a closed stdout stopped the run;
@@ -56,7 +57,7 @@ use std::path::{Path, PathBuf};
 
 /// A row of `diagnostics.csv` (and of `run --format csv`): floats in Rust's
 /// shortest round-trip `{:e}` form.
-pub fn diagnostics_record(r: &StepReport) -> [String; 22] {
+pub fn diagnostics_record(r: &StepReport) -> [String; 24] {
     let float = |x: f64| format!("{x:e}");
     let worst = r.mass_report.worst_coverage;
     let at = |k: usize| {
@@ -88,11 +89,19 @@ pub fn diagnostics_record(r: &StepReport) -> [String; 22] {
         at(1),
         r.condition.map_or_else(String::new, float),
         float(r.kinetic_motion),
+        r.substeps.to_string(),
+        critical_step(r).map_or_else(String::new, float),
     ]
 }
 
+/// The critical time step a run knew at a step: the watch's latest estimate
+/// while it watches, else the start's (`None` when neither was estimated).
+pub fn critical_step(r: &StepReport) -> Option<f64> {
+    r.dt_critical_latest.or(r.dt_critical)
+}
+
 /// Columns of `diagnostics.csv`.
-pub const DIAGNOSTICS_COLUMNS: [&str; 22] = [
+pub const DIAGNOSTICS_COLUMNS: [&str; 24] = [
     "step",
     "time",
     "kinetic",
@@ -115,6 +124,8 @@ pub const DIAGNOSTICS_COLUMNS: [&str; 22] = [
     "worst_y",
     "condition",
     "kinetic_motion",
+    "substeps",
+    "dt_critical",
 ];
 
 /// File names.

@@ -447,6 +447,8 @@ fn row_json(r: &StepReport) -> serde_json::Value {
         json!(at(1)),
         json!(r.condition),
         json!(r.kinetic_motion),
+        json!(r.substeps),
+        json!(out::critical_step(r)),
     ];
     serde_json::Value::Object(
         out::DIAGNOSTICS_COLUMNS

@@ -172,7 +172,9 @@ fn a_2d_run_writes_every_file_consistent_with_its_json_output() {
             "worst_x",
             "worst_y",
             "condition",
-            "kinetic_motion"
+            "kinetic_motion",
+            "substeps",
+            "dt_critical"
         ]
     );
     // docs/scenes.md lists exactly these columns, in this order.
