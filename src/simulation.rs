@@ -154,11 +154,31 @@ pub struct Summary {
     /// serialised when false.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
+    /// Connected pieces the particles form at the start and at the end
+    /// ([`pieces`]; every body counted on its own): more at the end than at the
+    /// start means a body came apart, which the energy verdict does not judge.
+    pub pieces: [usize; 2],
+    /// Stray particles (no other within [`STRAY_DISTANCE`] of their spacing) at
+    /// the start and at the end ([`stray_particles`]).
+    pub stray: [usize; 2],
     /// Wall time of the time loop.
     pub seconds: f64,
     /// Wall time per phase, summed over the steps.
     #[serde(skip)]
     pub phases: PhaseTimes,
+}
+
+impl Summary {
+    /// The particles form more pieces at the end than at the start, or at least
+    /// [`crate::arrangement::STRAY_WARNING`] of them (and 3) became stray: a
+    /// body came apart (the warnings say how), which the energy verdict does not
+    /// judge.
+    pub fn came_apart(&self) -> bool {
+        let new_stray = self.stray[1].saturating_sub(self.stray[0]);
+        self.pieces[1] > self.pieces[0]
+            || (new_stray >= 3
+                && new_stray as f64 >= crate::arrangement::STRAY_WARNING * self.particles as f64)
+    }
 }
 
 /// The history of one tracked particle.
@@ -1303,6 +1323,8 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .collect(),
             interrupted: tally.interrupted,
+            pieces: [tally.pieces_at_start, at_end.pieces.len()],
+            stray: [tally.stray_at_start, at_end.stray],
             seconds: tally.seconds,
             phases: tally.phases,
         },

@@ -730,6 +730,9 @@ t_end = 2.0
         "{:?}",
         torn.warnings
     );
+    // The summary counts the pieces (`mpm-cli run` says so on its verdict line:
+    // `a_body_that_came_apart_is_said_so_on_the_verdict_line`).
+    assert!(torn.pieces == [1, 2] && torn.came_apart(), "{torn:?}");
     let whole = run(
         &Scene::from_toml(
             &text.replace("per_block = [3, 3]", "per_block = [6, 6]"),
@@ -745,6 +748,7 @@ t_end = 2.0
         "{:?}",
         whole.warnings
     );
+    assert!(whole.pieces == [1, 1] && !whole.came_apart(), "{whole:?}");
 }
 
 /// A soft neo-Hookean block (E = 3e3, ρ = 100, ρ g H / E = 0.25) dropped 0.125

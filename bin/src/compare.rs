@@ -242,6 +242,9 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     sci(s.energy_drift),
                     match (s.stable, s.failure.is_some()) {
                         (_, true) => "stopped",
+                        // Stable in energy, with a body broken up (the warnings
+                        // on standard error say how).
+                        (true, false) if s.came_apart() => "yes, in pieces",
                         (true, false) => "yes",
                         (false, false) => "NO",
                     }

@@ -980,11 +980,28 @@ pub fn summary_text(summary: &Summary) -> String {
         (Some(e), Some(m)) => format!("error {m} = {}", sci(e)),
         _ => "no reference solution".into(),
     };
+    let stray = if summary.stray[1] > summary.stray[0] {
+        format!(
+            "; {} stray at the end",
+            plural(summary.stray[1], "particle", "particles")
+        )
+    } else {
+        String::new()
+    };
+    let came_apart = format!(
+        "stable in energy, but a body came apart ({} at the start, {} at the end{stray}): see the warnings",
+        plural(summary.pieces[0], "piece", "pieces"),
+        summary.pieces[1]
+    );
     out += &format!(
         "{error} · {} · energy {} → {} (drift {:.2e}) · max condition {} · lumped rows ≤ {}\n",
         if summary.failure.is_some() {
             // Stopped: the line after says why; no energy verdict is made.
             "FAILED"
+        } else if summary.stable && summary.came_apart() {
+            // The energy verdict does not see a body broken up (the warnings say
+            // how): said on the verdict's own line.
+            &came_apart
         } else if summary.stable && summary.max_condition.is_none() {
             "stable (energy; condition not measured, see --condition)"
         } else if summary.stable {

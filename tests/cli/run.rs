@@ -65,10 +65,15 @@ fn json_lines_then_a_summary_with_the_documented_keys() {
         "energy_initial",
         "energy_final",
         "stable",
+        "pieces",
+        "stray",
         "seconds",
     ] {
         assert!(summary.get(key).is_some(), "missing {key}");
     }
+    // One bar, whole and without a stray particle at both ends.
+    assert_eq!(summary["pieces"], serde_json::json!([1, 1]));
+    assert_eq!(summary["stray"], serde_json::json!([0, 0]));
     assert_eq!(summary["functions"], 42);
     assert_eq!(summary["steps"], 500);
     assert_eq!(summary["stable"], true);
@@ -1134,8 +1139,61 @@ t_end = 0.5
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("warning: the critical step fell from 0.00122 at the start to 0.000692 at its lowest")
-            && stderr.contains("`time.dt` = 0.0008 was above 0.9 of it in places, so 36 steps were taken in up to 2 sub-steps at 0.7 of the critical step")
+            && stderr.contains("`time.dt` = 0.0008 was above 0.9 of it in places, so 50 steps were taken in up to 2 sub-steps at 0.7 of the critical step")
             && stderr.contains("or a `dt` below 0.00062"),
         "{stderr}"
+    );
+}
+
+/// A soft block hanging from a no-slip ceiling on 3 × 3 particles per block tears
+/// in two with its energy bounded (`tests/stability.rs`,
+/// `a_hanging_block_that_tears_is_warned_about`): the verdict line says the body
+/// came apart instead of a bare "stable", the summary counts the pieces, and the
+/// exit status stays 0.
+#[test]
+fn a_body_that_came_apart_is_said_so_on_the_verdict_line() {
+    let file = SceneFile::new(
+        "came-apart",
+        r#"
+name = "hang"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [-9.0, 3.0]
+blocks = [8, 48]
+[material]
+model = "neo-hookean"
+young = 5e4
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [0.5, 1.5]
+max = [1.5, 3.0]
+per_block = [3, 3]
+[[boundary]]
+tag = "top"
+fix = ["x", "y"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[[effect]]
+kind = "damping"
+alpha = 0.2
+[time]
+courant = 0.25
+t_end = 2.0
+"#,
+    );
+    let out = cli()
+        .args(["run", file.arg(), "--diag-every", "0"])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("stable in energy, but a body came apart (1 piece at the start, 2 at the end): see the warnings"),
+        "{stdout}"
     );
 }
