@@ -49,11 +49,11 @@ impl BasisKind {
             .find(|k| k.name() == name)
             .ok_or_else(|| {
                 let known: Vec<_> = Self::ALL.iter().map(|k| k.name()).collect();
-                format!(
+                crate::scene::names::did_you_mean(format!(
                     "unknown basis `{}` (known: {})",
                     crate::scene::limits::echo(name),
                     known.join(", ")
-                )
+                ))
             })
     }
 

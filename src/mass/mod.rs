@@ -266,9 +266,9 @@ impl MassKind {
                         crate::scene::limits::echo(a)
                     )
                 }),
-            _ => Err(format!(
+            _ => Err(crate::scene::names::did_you_mean(format!(
                 "unknown mass strategy `{shown}` (known: {MASS_NAMES})"
-            )),
+            ))),
         }
     }
 

@@ -61,11 +61,11 @@ impl Scene {
     pub fn builtin(name: &str) -> Result<Self, String> {
         let (_, _, text) = BUILTIN.iter().find(|(n, _, _)| *n == name).ok_or_else(|| {
             let known: Vec<&str> = BUILTIN.iter().map(|(n, _, _)| *n).collect();
-            format!(
+            super::names::did_you_mean(format!(
                 "unknown scene `{}` (known: {})",
                 super::limits::echo(name),
                 known.join(", ")
-            )
+            ))
         })?;
         Scene::from_toml(text, &format!("scenes/{name}.toml")).map_err(|e| e.to_string())
     }

@@ -245,7 +245,7 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
     } else {
         at
     };
-    let (at, field, message) = located(text, at, message);
+    let (at, field, message) = located(text, at, super::names::did_you_mean(message));
     // The type's lower bound is not the field's: say the field's range.
     let message = match field.as_deref().and_then(whole_number_rule) {
         Some(rule) => message.replace(WHOLE_NUMBER, &rule),

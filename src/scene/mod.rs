@@ -73,7 +73,7 @@ mod builtin;
 mod derived;
 pub mod limits;
 mod locate;
-mod names;
+pub(crate) mod names;
 mod validate;
 
 pub use annotate::annotate;

@@ -95,3 +95,133 @@ pub fn parse_mirror_line(name: &str) -> Result<MirrorAxis, String> {
 pub(super) fn is_vertical(m: &MirrorAxis) -> bool {
     *m == MirrorAxis::Vertical
 }
+
+/// `message` with a suggestion for a name it rejects, when one of the names it
+/// lists is close (a typo, a transposition, another case or a missing `-`):
+/// `unknown field `yuong` (did you mean `young`?), expected one of …`. Reads the
+/// parser's `unknown field|variant `X`, expected one of `a`, `b`, …` and the
+/// scene's own `unknown … `X` (known: a, b, …)`; any other message is returned
+/// as it is, and so is one that already suggests.
+pub(crate) fn did_you_mean(message: String) -> String {
+    if message.contains("(did you mean") {
+        return message;
+    }
+    let Some(start) = message.find("unknown ") else {
+        return message;
+    };
+    let rest = &message[start..];
+    let Some(open) = rest.find('`') else {
+        return message;
+    };
+    let Some(close) = rest[open + 1..].find('`').map(|c| open + 1 + c) else {
+        return message;
+    };
+    let name = &rest[open + 1..close];
+    let after = &rest[close + 1..];
+    let candidates: Vec<&str> = if let Some(list) = after.strip_prefix(" (known: ") {
+        list.split(')')
+            .next()
+            .unwrap_or("")
+            .split(", ")
+            // `partial:TAU`, `extended-hybrid-apic[:C1:C2]`: the name alone.
+            .map(|c| c.split([':', '[']).next().unwrap_or(c))
+            .collect()
+    } else if after.starts_with(", expected") {
+        after.split('`').skip(1).step_by(2).collect()
+    } else {
+        return message;
+    };
+    let Some(best) = closest(name, &candidates) else {
+        return message;
+    };
+    let at = start + close + 1;
+    format!(
+        "{} (did you mean `{best}`?){}",
+        &message[..at],
+        &message[at..]
+    )
+}
+
+/// The candidate nearest to `name` by the optimal string alignment distance
+/// (edits and transpositions), compared in lower case without `-`, `_` and
+/// spaces, when it is near enough to be a typo: none for names of up to 3
+/// letters (`nx` is not `x`), 1 edit up to 5, 2 up to 9, 3 beyond; `None` for
+/// none, or for `name` itself.
+fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let plain = |s: &str| -> String {
+        s.chars()
+            .filter(|c| !matches!(c, '-' | '_' | ' '))
+            .flat_map(char::to_lowercase)
+            .collect()
+    };
+    let wanted = plain(name);
+    let allowed = match wanted.chars().count() {
+        0..=3 => 0,
+        4..=5 => 1,
+        6..=9 => 2,
+        _ => 3,
+    };
+    candidates
+        .iter()
+        .filter(|c| !c.is_empty() && **c != name)
+        .map(|c| (strsim::osa_distance(&wanted, &plain(c)), *c))
+        .filter(|(d, _)| *d <= allowed)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::did_you_mean;
+
+    /// The typos a user made (and a few more) get the name they meant; names
+    /// far from every candidate, and other messages, are left alone.
+    #[test]
+    fn a_misspelt_name_gets_the_nearest_known_one() {
+        let cases = [
+            (
+                "unknown field `yuong`, expected one of `model`, `young`, `poisson`, `density`",
+                "unknown field `yuong` (did you mean `young`?), expected one of `model`, `young`, `poisson`, `density`",
+            ),
+            (
+                "unknown variant `neohookean`, expected one of `linear-elastic`, `paper-linear`, `corotated`, `corotational`, `neo-hookean`",
+                "unknown variant `neohookean` (did you mean `neo-hookean`?), expected one of",
+            ),
+            (
+                "unknown field `radious`, expected one of `shape`, `centre`, `radius`",
+                "(did you mean `radius`?)",
+            ),
+            (
+                "unknown basis `PS` (known: ps, pl, bspline, pl1d)",
+                "unknown basis `PS` (did you mean `ps`?) (known: ps, pl, bspline, pl1d)",
+            ),
+            (
+                "unknown mass strategy `lumpd` (known: default, consistent, lumped, partial, partial:TAU, extended-hybrid-apic[:C1:C2], fmpm:K)",
+                "(did you mean `lumped`?)",
+            ),
+            (
+                "unknown variant `gravit`, expected one of `gravity`, `damping`, `traction`",
+                "(did you mean `gravity`?)",
+            ),
+            (
+                "unknown variant `block`, expected `blocks` or `polygon`",
+                "(did you mean `blocks`?)",
+            ),
+        ];
+        for (message, part) in cases {
+            let out = did_you_mean(message.to_string());
+            assert!(out.contains(part), "`{part}` not in: {out}");
+            // Once only.
+            assert_eq!(did_you_mean(out.clone()), out);
+        }
+        for message in [
+            "unknown field `colour`, expected one of `model`, `young`",
+            "unknown field `nx`, expected one of `x`, `y`, `blocks`, `layout`",
+            "unknown basis `bezier` (known: ps, pl, bspline, pl1d)",
+            "expected a number",
+            "unknown field `x",
+        ] {
+            assert_eq!(did_you_mean(message.to_string()), message);
+        }
+    }
+}

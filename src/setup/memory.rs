@@ -269,7 +269,8 @@ pub(crate) fn check_against(
     let mut footprint = Footprint::of(scene.basis, scene.mass);
     let output = scene.output.output_bytes_per_particle.max(0.0);
     footprint.per_particle += output;
-    let particles: f64 = counts.bodies.iter().map(|b| b.1).sum();
+    // (`+ 0.0`: the sum of no body is −0, which would print as "-0 particles".)
+    let particles: f64 = counts.bodies.iter().map(|b| b.1).sum::<f64>() + 0.0;
     let per_element = footprint.per_element(counts.basis_built);
     let element_bytes = counts.elements * per_element;
     let need =
@@ -448,6 +449,13 @@ t_end = 1e-4
             "{}",
             e.message
         );
+        // No body placed yet (a disk, placed after the mesh): 0 particles, not −0.
+        let no_body = Counts {
+            bodies: Vec::new(),
+            ..big_mesh
+        };
+        let e = check_against(&scene, &no_body, room(1.5e9)).unwrap_err();
+        assert!(e.message.contains("(0 particles at "), "{}", e.message);
     }
 
     /// This machine's room is read and is positive.

@@ -397,7 +397,7 @@ fn unknown_field_cases() -> Vec<Case> {
         case("unknown-field-in-mesh", BAR)
             .edit("[mesh]", "@@[mesh]")
             .edit("blocks = [4, 1]", "blocks = [4, 1]\nblock = [4, 1]")
-            .at(14, 1).expect("mesh.block: unknown field `block`, expected one of `x`, `y`, `blocks`, `layout`"),
+            .at(14, 1).expect("mesh.block: unknown field `block` (did you mean `blocks`?), expected one of `x`, `y`, `blocks`, `layout`"),
         case("unknown-field-in-inline-mesh", BAR)
             .edit("[mesh]\nkind = \"blocks\"\nx = [0.0, 4.0]\ny = [0.0, 1.0]\nblocks = [4, 1]\nlayout = \"four-triangles\"\n\n", "")
             .edit("mass = \"consistent\"\n", "mass = \"consistent\"\nmesh = @@{ kind = \"blocks\", x = [0.0, 4.0], y = [0.0, 1.0], blocks = [4, 1], nx = 4 }\n")
@@ -407,7 +407,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .expect("material.young_modulus: unknown field `young_modulus`, expected one of `model`, `young`, `poisson`, `density`"),
         case("unknown-field-in-body", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, 4]\n@@speed = 1.0")
-            .expect("body[0].speed: unknown field `speed`, expected one of `shape`, `min`, `max`, `outline`, `holes`, `centre`, `radius`, `file`, `surface`, `per_triangle`, `subdivide`, `per_block`, `count`, `spacing`, `jitter`, `seed`, `material`, `initial_velocity`"),
+            .expect("body[0].speed: unknown field `speed` (did you mean `seed`?), expected one of `shape`, `min`, `max`, `outline`, `holes`, `centre`, `radius`, `file`, `surface`, `per_triangle`, `subdivide`, `per_block`, `count`, `spacing`, `jitter`, `seed`, `material`, `initial_velocity`"),
         case("unknown-field-in-boundary", BAR)
             .edit("tag = \"right\"", "tag = \"right\"\n@@fixed = true")
             .expect("boundary[1].fixed: unknown field `fixed`, expected `tag` or `fix`"),
