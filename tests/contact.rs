@@ -402,6 +402,13 @@ t_end = 0.6
                 .contains("and went through a contact wall: lower `time.courant` from 0.3 to 0.15"),
         "{through}"
     );
+    // An impact at a larger step is told 0.25, not half of it (a user's disk went
+    // through at 0.4 after 0.8, and held at 0.25).
+    let fast = failure(&scene("right", 0.02).replace("courant = 0.3", "courant = 0.8"));
+    assert!(
+        fast.contains("and went through a contact wall: lower `time.courant` from 0.8 to 0.25"),
+        "{fast}"
+    );
     let free = failure(&scene("left", 0.5));
     assert!(
         free.contains("left the mesh")
