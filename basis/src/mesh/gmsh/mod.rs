@@ -313,6 +313,9 @@ struct Contents {
     curve_physical: HashMap<i64, i64>,
     /// The physical tag of each surface entity that has one (4.1 `$Entities`).
     surface_physical: HashMap<i64, i64>,
+    /// The curve and surface entities `$Entities` declares (4.1), when it was read:
+    /// an element block must name one of them.
+    declared: Option<[std::collections::HashSet<i64>; 2]>,
     nodes: HashMap<i64, [f64; 3]>,
     /// Node ids in file order.
     node_order: Vec<i64>,

@@ -21,6 +21,7 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
     for _ in 0..counts[0] {
         r.next("a point entity")?;
     }
+    let mut declared: [std::collections::HashSet<i64>; 2] = Default::default();
     for _ in 0..counts[1] {
         let f = r.fields(
             "a curve entity (tag minX minY minZ maxX maxY maxZ numPhysicalTags …)",
@@ -28,6 +29,7 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             true,
         )?;
         let tag = r.int(f[0], "a curve tag")?;
+        declared[0].insert(tag);
         let nphys = r.bounded(f[7], "the number of physical tags", MAX_TAGS)?;
         if f.len() - 8 < nphys {
             return Err(r.error("curve entity lists fewer physical tags than it announces"));
@@ -43,6 +45,7 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             true,
         )?;
         let tag = r.int(f[0], "a surface tag")?;
+        declared[1].insert(tag);
         let nphys = r.bounded(f[7], "the number of physical tags", MAX_TAGS)?;
         if f.len() - 8 < nphys {
             return Err(r.error("surface entity lists fewer physical tags than it announces"));
@@ -55,6 +58,7 @@ pub(super) fn read_entities(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
     for _ in 0..counts[3] {
         r.next("a volume entity")?;
     }
+    c.declared = Some(declared);
     Ok(())
 }
 
@@ -122,6 +126,7 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
             4,
             false,
         )?;
+        let dim = r.int(f[0], "an entity dimension")?;
         let entity = r.int(f[1], "an entity tag")?;
         let kind = r.int(f[2], "an element type")?;
         let n = r.bounded(f[3], "the number of elements in the block", MAX_ELEMENTS)?;
@@ -133,6 +138,25 @@ pub(super) fn read_elements(r: &mut Reader, c: &mut Contents) -> Result<(), Gmsh
         )?;
         // Name an unsupported type at the block header.
         super::supported_element(r, kind)?;
+        // The block's entity: of the element type's dimension, and declared.
+        let element_dim = match kind {
+            1 => 1,
+            2 => 2,
+            _ => 0,
+        };
+        if dim != element_dim {
+            return Err(r.error(format!(
+                "the block's entity dimension is {dim}, but its elements (type {kind}) are of dimension {element_dim}"
+            )));
+        }
+        if let Some(declared) = c.declared.as_ref().filter(|_| element_dim > 0) {
+            if !declared[element_dim as usize - 1].contains(&entity) {
+                let what = if element_dim == 1 { "curve" } else { "surface" };
+                return Err(r.error(format!(
+                    "the block's {what} {entity} is not declared in $Entities: the file is inconsistent (write it again from Gmsh)"
+                )));
+            }
+        }
         let physical = match kind {
             1 => c.curve_physical.get(&entity).copied(),
             2 => c.surface_physical.get(&entity).copied(),
@@ -185,6 +209,25 @@ mod tests {
         assert_eq!(line, line_of(GOOD_41, "2 1 2 2"));
         assert!(
             msg.contains("quadrilateral elements (type 3) are not supported"),
+            "{msg}"
+        );
+        // A block of an entity `$Entities` does not declare, or of another
+        // dimension than its elements.
+        let (line, msg) = syntax_line(&GOOD_41.replace("2 1 2 2\n", "2 9 2 2\n"));
+        assert_eq!(line, line_of(GOOD_41, "2 1 2 2"));
+        assert!(
+            msg.contains("the block's surface 9 is not declared in $Entities"),
+            "{msg}"
+        );
+        let (line, msg) = syntax_line(&GOOD_41.replace("1 5 1 1\n", "1 6 1 1\n"));
+        assert_eq!(line, line_of(GOOD_41, "1 5 1 1"));
+        assert!(msg.contains("the block's curve 6 is not declared"), "{msg}");
+        let (line, msg) = syntax_line(&GOOD_41.replace("2 1 2 2\n", "1 1 2 2\n"));
+        assert_eq!(line, line_of(GOOD_41, "2 1 2 2"));
+        assert!(
+            msg.contains(
+                "the block's entity dimension is 1, but its elements (type 2) are of dimension 2"
+            ),
             "{msg}"
         );
         let (line, msg) = syntax_line(&GOOD_41.replace("6 10 30 40", "6 10 30"));
