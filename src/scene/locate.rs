@@ -39,6 +39,25 @@ fn key_line_after(text: &str, from: usize, key: &str) -> Option<usize> {
 /// table whose header is the first at or after `from`, or of the tables of the same
 /// array `[[T]]` that follow it) that contains `value`.
 fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
+    // A key whose whole value is the one quoted first (`traction = 2.0` where a
+    // sequence was expected, not the `2.0` inside `max = [2.0]` above it), then
+    // any value holding it.
+    let whole = |v: &str| {
+        (v.split('#').next().unwrap_or("").trim() == value).then(|| v.len() - v.trim_start().len())
+    };
+    let holding = |v: &str| v.find(value);
+    keyed_value_after(text, from, whole).or_else(|| keyed_value_after(text, from, holding))
+}
+
+/// The byte offset in the value text (after `=`) of the first key line from
+/// `from` on, within the first table there (or the next elements of the same
+/// array of tables), where `wanted` finds what it looks for (its offset within
+/// the value text).
+fn keyed_value_after(
+    text: &str,
+    from: usize,
+    wanted: impl Fn(&str) -> Option<usize>,
+) -> Option<usize> {
     let mut offset = 0;
     let mut header: Option<&str> = None;
     for line in text.split_inclusive('\n') {
@@ -52,8 +71,8 @@ fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
                     Some(_) => return None,
                 }
             } else if let Some(eq) = line.find('=') {
-                if let Some(i) = line[eq..].find(value) {
-                    return Some(offset + eq + i);
+                if let Some(i) = wanted(&line[eq + 1..]) {
+                    return Some(offset + eq + 1 + i);
                 }
             }
         }
@@ -351,8 +370,30 @@ fn located(text: &str, at: usize, message: String) -> (usize, Option<String>, St
             let rest = message.split_once("string \"")?.1;
             rest.rfind('"').map(|end| format!("\"{}\"", &rest[..end]))
         });
-        if let Some(offset) = quoted.and_then(|value| value_after(text, at, &value)) {
+        if let Some(offset) = quoted
+            .as_ref()
+            .and_then(|value| value_after(text, at, value))
+        {
             at = offset;
+            // A number where a list was expected (a 1D vector): show the list.
+            if message.starts_with("invalid type: floating point")
+                || message.starts_with("invalid type: integer")
+            {
+                if let Some(value) = quoted.filter(|_| message.ends_with("expected a sequence")) {
+                    message = format!("{message}: write it as a list, `[{value}]`");
+                }
+            }
+        } else if message.starts_with("invalid type: sequence") {
+            // An array where a number was expected, with nothing quoted: an
+            // array of arrays (`traction = [[2.0]]` for `[2.0]`) is the likely one.
+            let nested = |v: &str| {
+                let value = v.trim_start();
+                (value.starts_with('[') && value[1..].trim_start().starts_with('['))
+                    .then(|| v.len() - value.len())
+            };
+            if let Some(offset) = keyed_value_after(text, at, nested) {
+                at = offset;
+            }
         }
     }
     // A missing field, or an array of the wrong length, inside a table is reported

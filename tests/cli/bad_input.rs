@@ -502,6 +502,14 @@ fn type_cases() -> Vec<Case> {
         case("string-in-the-third-effect", COLUMN)
             .edit("traction = [0.0, -1.0]", "traction = [0.0, @@\"down\"]")
             .expect("effect[2].traction: invalid type: string \"down\", expected a number"),
+        // A number where a vector was expected, after a vector that holds the same
+        // number (a user's 1D traction after `max = [2.0]`): at its own key.
+        case("number-for-a-vector-after-the-same-number", COLUMN)
+            .edit("traction = [0.0, -1.0]", "traction = @@4.0")
+            .expect("effect[2].traction: invalid type: floating point `4.0`, expected a sequence: write it as a list, `[4.0]`"),
+        case("array-of-arrays-for-a-vector", COLUMN)
+            .edit("traction = [0.0, -1.0]", "traction = @@[[0.0, -1.0]]")
+            .expect("effect[2].traction: invalid type: sequence, expected a number"),
         case("huge-integer", BAR)
             .edit("blocks = [4, 1]", "blocks = [@@99999999999999999999, 1]")
             .expect("mesh.blocks: the integer `99999999999999999999` is out of range (integers in a scene file are 64-bit)"),
