@@ -11,7 +11,7 @@ use psmpm::mass::MassKind;
 use psmpm::output::particle_picture::ParticleField;
 use psmpm::output::vtk::VtuEncoding;
 use psmpm::particles::Particles;
-use psmpm::scene::limits::{echo, plural, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
+use psmpm::scene::limits::{echo, echo_number, plural, MAX_FRAMES, MAX_TABLE_ROWS, MAX_THREADS};
 use psmpm::scene::{parse_mirror_line, parse_split, BlockLayout, BodyShape, Scene, SceneError};
 use psmpm::simulation::{self, AsParticlesRef, ParticlesRef, RunError, Summary};
 use serde_json::json;
@@ -100,6 +100,17 @@ impl Overrides {
                     echo(p)
                 )));
             }
+            // Particles per block need blocks: say so in the flag's words (the
+            // scene's field would be `per_block`, which the file did not give).
+            if !matches!(
+                s.mesh,
+                psmpm::scene::MeshSpec::Blocks { .. } | psmpm::scene::MeshSpec::Interval { .. }
+            ) {
+                return Err(CliError::Input(format!(
+                    "--particles {}: sets the particles per block, which needs a `blocks` or `interval` mesh; on this mesh set the bodies' particles in the scene file (`count` or `spacing`, or `per_triangle` for a Gmsh body)",
+                    echo(p)
+                )));
+            }
             s.set_particles_per_block([px, py]);
         }
         if let Some(split) = &self.split {
@@ -182,10 +193,10 @@ impl Overrides {
         let steps = history || (field == "time.t_end" && e.message.contains("time step"));
         if (field.starts_with("time.") && field != "time.t_end") || steps {
             if let Some(dt) = self.dt {
-                flags.push(format!("--dt {dt:?}"));
+                flags.push(format!("--dt {}", echo_number(dt)));
             }
             if let Some(c) = self.courant {
-                flags.push(format!("--courant {c:?}"));
+                flags.push(format!("--courant {}", echo_number(c)));
             }
         }
         // The number of steps (`t_end / dt`) is `--t-end`'s too.
@@ -194,7 +205,7 @@ impl Overrides {
             || (field.starts_with("time.") && e.message.contains("t_end"))
         {
             if let Some(t) = self.t_end {
-                flags.push(format!("--t-end {t:?}"));
+                flags.push(format!("--t-end {}", echo_number(t)));
             }
         }
         // The critical step depends on the mesh.

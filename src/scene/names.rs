@@ -126,7 +126,7 @@ pub(crate) fn did_you_mean(message: String) -> String {
             // `partial:TAU`, `extended-hybrid-apic[:C1:C2]`: the name alone.
             .map(|c| c.split([':', '[']).next().unwrap_or(c))
             .collect()
-    } else if after.starts_with(", expected") {
+    } else if after.starts_with(", expected") || after.starts_with("; the mesh has tags") {
         after.split('`').skip(1).step_by(2).collect()
     } else {
         return message;
@@ -206,6 +206,10 @@ mod tests {
             (
                 "unknown variant `block`, expected `blocks` or `polygon`",
                 "(did you mean `blocks`?)",
+            ),
+            (
+                "unknown boundary tag `Ramp`; the mesh has tags `ramp`, `walls`, `top`",
+                "unknown boundary tag `Ramp` (did you mean `ramp`?); the mesh has tags",
             ),
         ];
         for (message, part) in cases {

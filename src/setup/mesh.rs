@@ -171,11 +171,11 @@ fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
             return Err(SceneError::new(
                 format!("boundary[{b}].tag"),
                 ErrorKind::Unknown,
-                format!(
+                crate::scene::names::did_you_mean(format!(
                     "unknown boundary tag `{}`; the mesh has tags {}",
                     crate::scene::limits::echo(&bc.tag),
                     crate::scene::limits::echo_tags(tags)
-                ),
+                )),
             )
             .into());
         }
@@ -243,11 +243,11 @@ fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Vec<WallGeometry>, Run
             SceneError::new(
                 field.clone(),
                 ErrorKind::Unknown,
-                format!(
+                crate::scene::names::did_you_mean(format!(
                     "unknown boundary tag `{}`; the mesh has tags {}",
                     crate::scene::limits::echo(tag),
                     crate::scene::limits::echo_tags(mesh.tags())
-                ),
+                )),
             )
         })?;
         walls.push(
