@@ -689,9 +689,10 @@ fn verdict(
              particles cross element edges){crossing}"
         ),
         (false, false) => format!(
-            "neither a smaller time step nor more particles lower the error: it has reached a \
-             floor that refinement does not remove (for example the reference's own \
-             assumptions, such as small strain, or the finest level's error){crossing}"
+            "neither a smaller time step nor more particles lower the error by more than \
+             a fifth: it has reached a floor that refinement does not remove (for example \
+             the reference's own assumptions, such as small strain, or the finest level's \
+             error){crossing}"
         ),
     };
     format!("{not_the_step}{limits}")
