@@ -154,6 +154,12 @@ pub struct Summary {
     /// serialised when false.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
+    /// Each tracked particle's (`output.tracked`) starting position and its
+    /// displacement at the end of the run, in the scene's order (`mpm-cli
+    /// compare` prints the first). Not in the JSON summary (`tracked.csv` holds
+    /// the histories).
+    #[serde(skip)]
+    pub tracked_end: Vec<([f64; 2], [f64; 2])>,
     /// Connected pieces the particles form at the start and at the end
     /// ([`pieces`]; every body counted on its own): more at the end than at the
     /// start means a body came apart, which the energy verdict does not judge.
@@ -1340,6 +1346,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .collect(),
             interrupted: tally.interrupted,
+            tracked_end: tally
+                .tracked
+                .iter()
+                .filter_map(|t| t.displacement.last().map(|u| (t.x0, *u)))
+                .collect(),
             pieces: [tally.pieces_at_start, at_end.pieces.len()],
             stray: [tally.stray_at_start, at_end.stray],
             seconds: tally.seconds,

@@ -199,6 +199,46 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
 }
 
 /// Prints summaries side by side.
+/// The displacement of the scene's first tracked particle (`output.tracked`) at
+/// the end of each variant, so that variants without a reference solution are
+/// compared on a physical result (a cantilever's tip deflection: PL's locking
+/// shows as a smaller one). Nothing without tracked points.
+fn print_tracked(summaries: &[Summary]) {
+    let Some((x0, _)) = summaries.iter().find_map(|s| s.tracked_end.first()) else {
+        return;
+    };
+    let one_d = summaries
+        .first()
+        .is_some_and(|s| matches!(s.basis, "bspline" | "pl1d"));
+    let mut header = vec!["basis", "mass", "u_x"];
+    if !one_d {
+        header.push("u_y");
+    }
+    header.push("at t");
+    let mut table = Table::new(&header);
+    for s in summaries {
+        let u = s.tracked_end.first().map(|(_, u)| *u);
+        let mut row = vec![
+            s.basis.to_string(),
+            s.mass.clone(),
+            u.map_or_else(|| "-".into(), |u| sci(u[0])),
+        ];
+        if !one_d {
+            row.push(u.map_or_else(|| "-".into(), |u| sci(u[1])));
+        }
+        row.push(crate::table::short(s.t_end));
+        table.push(row);
+    }
+    let near = |x: f64| psmpm::scene::limits::echo_significant(x, 4);
+    let at = if one_d {
+        format!("x = {}", near(x0[0]))
+    } else {
+        format!("({}, {})", near(x0[0]), near(x0[1]))
+    };
+    println!("displacement of the tracked particle that started at {at}, at the end of each run (output.tracked; the histories: run --out, tracked.csv):");
+    print!("{}", table.render());
+}
+
 pub fn print_summaries(summaries: &[Summary], format: Format) {
     match format {
         Format::Json => {
@@ -286,6 +326,7 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     s.scene,
                     crate::table::short(t_end)
                 );
+                print_tracked(summaries);
                 let steps: Vec<f64> = summaries.iter().map(|s| s.dt).collect();
                 if steps.iter().any(|&dt| dt != steps[0]) {
                     println!(

@@ -180,6 +180,25 @@ fn compare_ps_and_pl_side_by_side_identically_on_one_and_two_threads() {
             "seconds"
         ]
     );
+    // The scene tracks a particle: its displacement at the end, per variant,
+    // in a table of its own below (the same value as tracked.csv's last row).
+    let tracked = table
+        .split("displacement of the tracked particle that started at (12.37, 1.167), at the end of each run")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{table}"));
+    let rows: Vec<Vec<&str>> = tracked
+        .lines()
+        .skip(2)
+        .take(2)
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    assert_eq!(rows[0][0], "ps", "{table}");
+    assert_eq!(rows[1][0], "pl", "{table}");
+    for row in &rows {
+        let u_x: f64 = row[2].parse().unwrap();
+        assert!(u_x.is_finite() && u_x != 0.0, "{table}");
+        assert_eq!(row[4], "1", "{table}");
+    }
     let csv = stdout(&[
         "compare",
         "vibrating-bar",
