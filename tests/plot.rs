@@ -464,6 +464,25 @@ fn basis_function_plot_shades_one_function_with_mesh_edges_on_top() {
     });
     assert_eq!(outlines, pl.num_elements());
 
+    // On a large mesh the picture zooms to the support and a ring of elements
+    // around it: every element of the support drawn, far fewer than the mesh's.
+    let large = block_grid(0.0, 16.0, 0.0, 16.0, 16, 16).unwrap();
+    let ps_large = bases::powell_sabin::<f64>(large).unwrap();
+    let index = 300;
+    let path = dir.join("ps-basis-large.svg");
+    basis_function_plot(&path, &ps_large, index, &BasisPlotOptions::default()).unwrap();
+    keep(&path);
+    let (_, elements) = read_svg(&path);
+    let outlines = count(&elements, "polyline", |e| e.attr("stroke") == mesh_edge);
+    let support = ps_large.function_support(index).len();
+    assert!(
+        outlines >= support && outlines <= ps_large.num_elements() / 8,
+        "{outlines} elements drawn for a support of {support} in {}",
+        ps_large.num_elements()
+    );
+    let cells = count(&elements, "polygon", |_| true);
+    assert!(cells >= support * 6 * (1 + 144), "{cells}");
+
     // The narrowest picture, and bad options.
     let narrow = BasisPlotOptions {
         width: 400,

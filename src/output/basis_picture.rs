@@ -1,7 +1,10 @@
 //! The SVG picture of one function of any 2D [`Basis`] with
 //! [`basis_function_plot`]: sampled on a uniform subdivision of each of its
 //! polynomial pieces and shaded with the viridis colour map, a colour bar at the
-//! right and the mesh edges on top. Equal scales on both axes. Output as in
+//! right and the mesh edges on top. Equal scales on both axes. A support small
+//! against the mesh (its box, grown by three quarters of its size on each side,
+//! under a quarter of the mesh's) is shown with the elements around it only, so
+//! that it is not lost on a large mesh. Output as in
 //! [`chart`](super::chart#output).
 
 use std::path::Path;
@@ -161,6 +164,47 @@ fn grown(p: &[Vec2], delta: f64) -> Vec<(f64, f64)> {
     p.iter().map(|&q| pt(centre + (q - centre) * k)).collect()
 }
 
+/// Which elements the picture of a function with support `support` shows: all of
+/// them, or, where the support's box (grown by [`ZOOM_MARGIN`] of its size on each
+/// side) covers less than [`ZOOM_BELOW`] of the mesh's box, the elements inside
+/// that grown box: the support and a ring of elements around it.
+fn shown_elements(pieces: &[Vec<[Vec2; 3]>], support: &[usize]) -> Vec<bool> {
+    let boxed = |elements: &mut dyn Iterator<Item = &Vec<[Vec2; 3]>>| {
+        padded_bbox(elements.flatten().flatten().copied(), 0.0)
+    };
+    let all = vec![true; pieces.len()];
+    let (Some((lo, hi)), Some((slo, shi))) = (
+        boxed(&mut pieces.iter()),
+        boxed(&mut support.iter().filter_map(|&e| pieces.get(e))),
+    ) else {
+        return all;
+    };
+    let size = shi - slo;
+    let (vlo, vhi) = (
+        (slo - size * ZOOM_MARGIN).sup(&lo),
+        (shi + size * ZOOM_MARGIN).inf(&hi),
+    );
+    let area = |a: Vec2, b: Vec2| (b.x - a.x).max(0.0) * (b.y - a.y).max(0.0);
+    if area(vlo, vhi) >= ZOOM_BELOW * area(lo, hi) {
+        return all;
+    }
+    let tol = 1e-9 * (hi - lo).norm();
+    let inside = |p: &Vec2| {
+        p.x >= vlo.x - tol && p.x <= vhi.x + tol && p.y >= vlo.y - tol && p.y <= vhi.y + tol
+    };
+    pieces
+        .iter()
+        .map(|element| element.iter().flatten().all(inside))
+        .collect()
+}
+
+/// The share of the mesh's box below which a function's picture zooms to its
+/// support ([`shown_elements`]).
+const ZOOM_BELOW: f64 = 0.25;
+/// The margin around the support's box in a zoomed picture, as a share of the
+/// support's size on each side.
+const ZOOM_MARGIN: f64 = 0.75;
+
 /// Renders one basis function to an SVG string.
 fn render_basis_function_plot(
     basis: &impl Basis<f64, 2>,
@@ -185,7 +229,18 @@ fn render_basis_function_plot(
             side_width + 250
         )));
     }
-    let pieces = element_pieces(basis);
+    let all_pieces = element_pieces(basis);
+    if all_pieces.is_empty() {
+        return Err(PlotError::Empty("the basis has no element".into()));
+    }
+    // A support small against the mesh is shown with the elements around it
+    // (on a large mesh it would be a few pixels); the others are left out.
+    let shown = shown_elements(&all_pieces, basis.function_support(index));
+    let pieces: Vec<Vec<[Vec2; 3]>> = all_pieces
+        .into_iter()
+        .zip(&shown)
+        .map(|(p, &keep)| if keep { p } else { Vec::new() })
+        .collect();
     let bbox = padded_bbox(pieces.iter().flatten().flatten().copied(), 0.02)
         .ok_or_else(|| PlotError::Empty("the basis has no element".into()))?;
 

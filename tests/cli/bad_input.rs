@@ -1514,7 +1514,7 @@ fn a_run_that_fails_numerically_exits_with_1_and_names_the_step() {
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
         stderr.starts_with(
-            "error: vibrating-bar with --dt 100.0: time.dt: the time step 100 is above the critical step 4.32"
+            "error: vibrating-bar with --dt 100: time.dt: the time step 100 is above the critical step 4.32"
         ),
         "{stderr}"
     );

@@ -902,7 +902,7 @@ fn an_error_of_a_converge_level_names_the_file_the_level_and_the_basis() {
         )),
         "{stderr}"
     );
-    assert!(stderr.contains("(from --dt 1.0)"), "{stderr}");
+    assert!(stderr.contains("(from --dt 1)"), "{stderr}");
 }
 
 #[test]
