@@ -690,37 +690,7 @@ t_end = 0.5
 /// block it holds, and nothing is said.
 #[test]
 fn a_hanging_block_that_tears_is_warned_about() {
-    let text = r#"
-name = "hang"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 2.0]
-y = [-9.0, 3.0]
-blocks = [8, 48]
-[material]
-model = "neo-hookean"
-young = 5e4
-poisson = 0.3
-density = 1000.0
-[[body]]
-min = [0.5, 1.5]
-max = [1.5, 3.0]
-per_block = [3, 3]
-[[boundary]]
-tag = "top"
-fix = ["x", "y"]
-[[effect]]
-kind = "gravity"
-g = [0.0, -9.81]
-[[effect]]
-kind = "damping"
-alpha = 0.2
-[time]
-courant = 0.25
-t_end = 2.0
-"#;
+    let text = include_str!("data/hanging-block.toml");
     let torn = run(&Scene::from_toml(text, "hang.toml").unwrap(), &mut |_| {}).unwrap();
     assert!(torn.failure.is_none() && torn.stable, "{torn:?}");
     assert!(

@@ -1152,40 +1152,7 @@ t_end = 0.5
 /// exit status stays 0.
 #[test]
 fn a_body_that_came_apart_is_said_so_on_the_verdict_line() {
-    let file = SceneFile::new(
-        "came-apart",
-        r#"
-name = "hang"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 2.0]
-y = [-9.0, 3.0]
-blocks = [8, 48]
-[material]
-model = "neo-hookean"
-young = 5e4
-poisson = 0.3
-density = 1000.0
-[[body]]
-min = [0.5, 1.5]
-max = [1.5, 3.0]
-per_block = [3, 3]
-[[boundary]]
-tag = "top"
-fix = ["x", "y"]
-[[effect]]
-kind = "gravity"
-g = [0.0, -9.81]
-[[effect]]
-kind = "damping"
-alpha = 0.2
-[time]
-courant = 0.25
-t_end = 2.0
-"#,
-    );
+    let file = SceneFile::new("came-apart", include_str!("../data/hanging-block.toml"));
     let out = cli()
         .args(["run", file.arg(), "--diag-every", "0"])
         .output()
