@@ -1288,6 +1288,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             irregularity,
             warnings: warnings
                 .into_iter()
+                .chain(run.warnings.iter().cloned())
                 .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(split_steps_warning(scene, run.dt, run.dt_critical, watched))
                 .chain(self_weight.clone())

@@ -443,3 +443,30 @@ fn a_traction_keeps_loading_the_particles_it_selected_at_the_start() {
     }
     assert!((momentum.last().unwrap().0 - 1.0).abs() < 1e-9);
 }
+
+/// A traction on the bottom row of a block standing on a no-slip floor: 66 % of
+/// its load (PS; 75 % PL) falls on the floor's fixed functions and moves nothing,
+/// which the run says; the same box on the top row is not warned about.
+#[test]
+fn a_traction_the_walls_take_is_warned_about() {
+    let text = include_str!("data/held-traction.toml");
+    let held = run(&Scene::from_toml(text, "held.toml").unwrap(), &mut |_| {}).unwrap();
+    assert!(
+        held.warnings.iter().any(|w| w.starts_with(
+            "effect[0] (traction): 66 % of its load falls on functions the walls (`fix`) hold"
+        )),
+        "{:?}",
+        held.warnings
+    );
+    let top = text.replace(
+        "min = [0.0, 0.0]\nmax = [1.0, 0.07]",
+        "min = [0.0, 0.93]\nmax = [1.0, 1.0]",
+    );
+    assert_ne!(top, text);
+    let top = run(&Scene::from_toml(&top, "top.toml").unwrap(), &mut |_| {}).unwrap();
+    assert!(
+        !top.warnings.iter().any(|w| w.contains("(traction)")),
+        "{:?}",
+        top.warnings
+    );
+}

@@ -159,6 +159,8 @@ where
     /// `walled[i]`: a wall (`fix`) constrains function `i`, for the message of a
     /// particle that leaves the mesh through a wall.
     walled: Vec<bool>,
+    /// `fixed[k][i]`: component `k` of function `i` is held at zero (`fix`).
+    fixed: Vec<Vec<bool>>,
     constraints: Constraints<T, D>,
     effects: Vec<Box<dyn Effect<T, D>>>,
     pattern: SymmetricPattern,
@@ -415,6 +417,7 @@ where
             dissipated: 0.0,
             constraints: Constraints::new(general, n),
             walled,
+            fixed,
             inputs,
             last_condition: None,
             phases: PhaseTimes::default(),
@@ -480,6 +483,23 @@ where
                 end
             }));
         }
+    }
+
+    /// The share of a force on particle `p` along component `k` that the walls
+    /// (`fix`) take: `Σ phi_i(x_p)` over the functions fixed in that component
+    /// (the basis is a partition of unity, so 1 when every function the particle
+    /// sees is fixed: the force goes into the wall and moves nothing).
+    pub fn share_held_by_walls(&self, p: usize, k: usize) -> f64 {
+        let Some(fixed) = self.fixed.get(k) else {
+            return 0.0;
+        };
+        let mut eval = psmpm_basis::BasisEval::for_basis(&self.basis);
+        self.basis
+            .eval(self.particles.element[p], &self.particles.x[p], &mut eval);
+        eval.iter()
+            .filter(|&(i, _, _)| fixed[i])
+            .map(|(_, phi, _)| phi.to_f64())
+            .sum()
     }
 
     /// Current time.

@@ -107,6 +107,9 @@ pub(crate) struct Prepared<const D: usize, B: Basis<f64, D>> {
     /// The number of particles of each body, in the order of the scene's bodies:
     /// the particles of body `b` follow those of the bodies before it.
     pub body_sizes: Vec<usize>,
+    /// What the set-up saw that the run's summary should say
+    /// ([`held_traction_warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// Sets up the run of `scene` on `domain`: material, particles with their initial
@@ -200,6 +203,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         }
     }
     driver.set_body_sizes(&body_sizes);
+    let warnings = held_traction_warnings(scene, &driver);
     let (dt, steps, dt_critical) = time_steps(scene, &mut driver, dt)?;
     if let (Some(critical), None, false) = (
         dt_critical,
@@ -231,8 +235,61 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         solution,
         origin,
         body_sizes,
+        warnings,
     })
 }
+
+/// A warning for each traction whose load the walls take for the most part: the
+/// share of each particle's force that falls on functions the walls (`fix`) hold
+/// along it ([`crate::driver::Driver::share_held_by_walls`]), over the loaded
+/// particles, weighted by the traction's components, at least
+/// [`HELD_TRACTION`]: a box on the particles next to a no-slip wall loads the wall
+/// more than the body, which the run would not show otherwise.
+fn held_traction_warnings<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    driver: &SceneDriver<D, B>,
+) -> Vec<String> {
+    let particles = &driver.particles;
+    scene
+        .effects
+        .iter()
+        .enumerate()
+        .filter_map(|(i, spec)| {
+            let crate::scene::EffectSpec::Traction {
+                min, max, traction, ..
+            } = spec
+            else {
+                return None;
+            };
+            let selected: Vec<usize> = (0..particles.len())
+                .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
+                .collect();
+            let weight: f64 = (0..D).map(|k| traction[k].abs()).sum();
+            if selected.is_empty() || !(weight > 0.0) {
+                return None;
+            }
+            let held: f64 = selected
+                .iter()
+                .map(|&p| {
+                    (0..D)
+                        .map(|k| traction[k].abs() * driver.share_held_by_walls(p, k))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                / (weight * selected.len() as f64);
+            (held >= HELD_TRACTION).then(|| {
+                format!(
+                    "effect[{i}] (traction): {:.0} % of its load falls on functions the walls (`fix`) hold along it, so that part goes into the wall and moves nothing: the box (`min`, `max`) selects particles next to a wall that holds the load's direction; move it away from the wall, or let the wall slide along the load (`fix = [\"normal\"]`) if that is the physics",
+                    100.0 * held
+                )
+            })
+        })
+        .collect()
+}
+
+/// The share of a traction's load taken by the walls above which the run warns
+/// ([`held_traction_warnings`]).
+pub(crate) const HELD_TRACTION: f64 = 0.5;
 
 /// The law of every particle of `lattice` in `D` dimensions: its body's material.
 fn materials<const D: usize>(scene: &Scene, lattice: &Lattice) -> Result<MaterialTable, RunError> {
