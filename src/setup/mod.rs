@@ -265,7 +265,7 @@ fn held_traction_warnings<const D: usize, B: Basis<f64, D>>(
                 .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
                 .collect();
             let weight: f64 = (0..D).map(|k| traction[k].abs()).sum();
-            if selected.is_empty() || !(weight > 0.0) {
+            if selected.is_empty() || weight <= 0.0 {
                 return None;
             }
             let held: f64 = selected
