@@ -7,7 +7,7 @@
 //! Local damping makes the update up to `1 + α` times stiffer: the step is divided
 //! by `√(1 + α)` ([`crate::effect::Effect::force_amplification`]).
 
-use super::{phases, Driver, StepError};
+use super::{phases, solve_with_walls, Driver, StepError};
 use crate::mass::MassStrategy;
 use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
@@ -108,22 +108,17 @@ where
                 f,
             );
             match lumped {
-                None => {
-                    for (k, fk) in f.iter_mut().enumerate() {
-                        if let Err(source) = self.mass.solve(k, fk) {
-                            return Err(self.mass_failure(source));
-                        }
-                    }
-                }
+                None => solve_with_walls(&mut self.mass, &mut self.constraints, f)
+                    .map_err(|source| self.mass_failure(source))?,
                 Some(m) => {
                     for fk in f.iter_mut() {
                         for (fi, &mi) in fk.iter_mut().zip(m) {
                             *fi = if mi > 0.0 { *fi / T::of(mi) } else { T::zero() };
                         }
                     }
+                    self.constraints.project(f);
                 }
             }
-            self.constraints.project(f);
             estimate = norm(f);
             std::mem::swap(v, f);
         }
@@ -202,23 +197,15 @@ where
             for (w, kq) in next.iter_mut().zip(k_current.iter()) {
                 w.copy_from_slice(kq);
             }
-            for (k, w) in next.iter_mut().enumerate() {
-                if let Err(source) = self.mass.solve(k, w) {
-                    return Err(self.mass_failure(source));
-                }
-            }
-            self.constraints.project(next);
+            solve_with_walls(&mut self.mass, &mut self.constraints, next)
+                .map_err(|source| self.mass_failure(source))?;
             // The velocity projection's filter: w ← M⁻¹ M_c w.
             consistent_mass_product(&self.evals, &self.particles.mass, next, scratch);
             for (w, m) in next.iter_mut().zip(scratch.iter()) {
                 w.copy_from_slice(m);
             }
-            for (k, w) in next.iter_mut().enumerate() {
-                if let Err(source) = self.mass.solve(k, w) {
-                    return Err(self.mass_failure(source));
-                }
-            }
-            self.constraints.project(next);
+            solve_with_walls(&mut self.mass, &mut self.constraints, next)
+                .map_err(|source| self.mass_failure(source))?;
             let a = dot(next, k_current);
             alpha[m] = a;
             betas[m] = beta;

@@ -917,15 +917,8 @@ where
             Which::Acceleration => &mut self.rhs,
             Which::Velocity => &mut self.velocity,
         };
-        if let Err(source) = self.mass.solve_all(target) {
-            return Err(self.mass_failure(source));
-        }
-        let target = match which {
-            Which::Acceleration => &mut self.rhs,
-            Which::Velocity => &mut self.velocity,
-        };
-        self.constraints.project(target);
-        Ok(())
+        solve_with_walls(&mut self.mass, &mut self.constraints, target)
+            .map_err(|source| self.mass_failure(source))
     }
 
     /// Phase 3b: `M a = F` (eq. (17)).
@@ -996,6 +989,19 @@ where
             }
         })
     }
+}
+
+/// `f ← M⁻¹ f` for every component with the strategy's solve, then projected onto
+/// the general constraints: the solve of phases 3b and 5, and of the critical-step
+/// estimates ([`critical`]).
+fn solve_with_walls<T: Scalar, const D: usize, M: MassStrategy<T>>(
+    mass: &mut M,
+    constraints: &mut Constraints<T, D>,
+    f: &mut [Vec<T>],
+) -> Result<(), crate::mass::MassError> {
+    mass.solve_all(f)?;
+    constraints.project(f);
+    Ok(())
 }
 
 #[derive(Clone, Copy)]
