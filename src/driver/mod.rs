@@ -485,21 +485,32 @@ where
         }
     }
 
-    /// The share of a force on particle `p` along component `k` that the walls
-    /// (`fix`) take: `Σ phi_i(x_p)` over the functions fixed in that component
-    /// (the basis is a partition of unity, so 1 when every function the particle
-    /// sees is fixed: the force goes into the wall and moves nothing).
-    pub fn share_held_by_walls(&self, p: usize, k: usize) -> f64 {
-        let Some(fixed) = self.fixed.get(k) else {
+    /// The share of a force `force` on each of the particles `loaded` that the
+    /// walls (`fix`) take, weighted by the force's components: per particle and
+    /// component `Σ phi_i(x_p)` over the functions fixed in that component (the
+    /// basis is a partition of unity, so 1 when every function a particle sees is
+    /// fixed: the force goes into the wall and moves nothing). 0 for no particle
+    /// or no force.
+    pub fn share_held_by_walls(&self, loaded: &[usize], force: &[f64]) -> f64 {
+        let weight: f64 = force.iter().take(D).map(|f| f.abs()).sum();
+        if loaded.is_empty() || weight <= 0.0 {
             return 0.0;
-        };
-        let mut eval = psmpm_basis::BasisEval::for_basis(&self.basis);
-        self.basis
-            .eval(self.particles.element[p], &self.particles.x[p], &mut eval);
-        eval.iter()
-            .filter(|&(i, _, _)| fixed[i])
-            .map(|(_, phi, _)| phi.to_f64())
-            .sum()
+        }
+        let mut eval = BasisEval::for_basis(&self.basis);
+        let mut held = 0.0;
+        for &p in loaded {
+            self.basis
+                .eval(self.particles.element[p], &self.particles.x[p], &mut eval);
+            for (fixed, f) in self.fixed.iter().zip(force) {
+                let share: f64 = eval
+                    .iter()
+                    .filter(|&(i, _, _)| fixed[i])
+                    .map(|(_, phi, _)| phi.to_f64())
+                    .sum();
+                held += f.abs() * share;
+            }
+        }
+        held / (weight * loaded.len() as f64)
     }
 
     /// Current time.

@@ -34,9 +34,7 @@ pub fn build_effects<const D: usize>(
                 length,
                 ramp,
             } => {
-                let selected: Vec<usize> = (0..particles.len())
-                    .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
-                    .collect();
+                let selected = traction_particles(particles, min, max);
                 if selected.is_empty() {
                     return Err(SceneError::new(
                         format!("effect[{i}].min"),
@@ -94,4 +92,15 @@ pub fn build_effects<const D: usize>(
         }
     }
     Ok(effects)
+}
+
+/// The particles a traction's box `[min, max]` loads: those inside it at the start.
+pub(crate) fn traction_particles<const D: usize>(
+    particles: &Particles<f64, D>,
+    min: &[f64],
+    max: &[f64],
+) -> Vec<usize> {
+    (0..particles.len())
+        .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
+        .collect()
 }

@@ -240,16 +240,14 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
 }
 
 /// A warning for each traction whose load the walls take for the most part: the
-/// share of each particle's force that falls on functions the walls (`fix`) hold
-/// along it ([`crate::driver::Driver::share_held_by_walls`]), over the loaded
-/// particles, weighted by the traction's components, at least
+/// share of its particles' force that falls on functions the walls (`fix`) hold
+/// along it ([`crate::driver::Driver::share_held_by_walls`]) at least
 /// [`HELD_TRACTION`]: a box on the particles next to a no-slip wall loads the wall
 /// more than the body, which the run would not show otherwise.
 fn held_traction_warnings<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     driver: &SceneDriver<D, B>,
 ) -> Vec<String> {
-    let particles = &driver.particles;
     scene
         .effects
         .iter()
@@ -261,22 +259,8 @@ fn held_traction_warnings<const D: usize, B: Basis<f64, D>>(
             else {
                 return None;
             };
-            let selected: Vec<usize> = (0..particles.len())
-                .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
-                .collect();
-            let weight: f64 = (0..D).map(|k| traction[k].abs()).sum();
-            if selected.is_empty() || weight <= 0.0 {
-                return None;
-            }
-            let held: f64 = selected
-                .iter()
-                .map(|&p| {
-                    (0..D)
-                        .map(|k| traction[k].abs() * driver.share_held_by_walls(p, k))
-                        .sum::<f64>()
-                })
-                .sum::<f64>()
-                / (weight * selected.len() as f64);
+            let loaded = effects::traction_particles(&driver.particles, min, max);
+            let held = driver.share_held_by_walls(&loaded, traction);
             (held >= HELD_TRACTION).then(|| {
                 format!(
                     "effect[{i}] (traction): {:.0} % of its load falls on functions the walls (`fix`) hold along it, so that part goes into the wall and moves nothing: the box (`min`, `max`) selects particles next to a wall that holds the load's direction; move it away from the wall, or let the wall slide along the load (`fix = [\"normal\"]`) if that is the physics",
