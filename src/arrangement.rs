@@ -206,12 +206,19 @@ pub fn pieces_warning(start: usize, end: &[usize], particles: usize) -> Option<S
 /// neo-Hookean disk, E = 2e3, dropped onto a contact floor at 4 particles per
 /// triangle, ended with its particles scattered).
 pub fn stray_warning(start: usize, end: usize, particles: usize) -> Option<String> {
-    let new = end.saturating_sub(start);
-    (new >= 3 && new as f64 >= STRAY_WARNING * particles as f64).then(|| {
+    strayed(start, end, particles).then(|| {
         format!(
             "{end} of the {particles} particles ended stray ({start} at the start): no other particle within {STRAY_DISTANCE} times their own spacing; the bodies came apart (fragments or single particles flung off), which the energy verdict does not show: look at the particles (`--out`), and for a soft body use more particles per element (`per_block`, `count` or `spacing`) and a smaller `courant`"
         )
     })
+}
+
+/// Whether `end` stray particles of `particles`, `start` of them at the start,
+/// mean that the bodies came apart: at least [`STRAY_WARNING`] of the particles,
+/// and 3, became stray ([`stray_warning`]).
+pub fn strayed(start: usize, end: usize, particles: usize) -> bool {
+    let new = end.saturating_sub(start);
+    new >= 3 && new as f64 >= STRAY_WARNING * particles as f64
 }
 
 /// The share of the particles that must become stray for [`stray_warning`].

@@ -175,15 +175,12 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// The particles form more pieces at the end than at the start, or at least
-    /// [`crate::arrangement::STRAY_WARNING`] of them (and 3) became stray: a
-    /// body came apart (the warnings say how), which the energy verdict does not
+    /// The particles form more pieces at the end than at the start, or enough of
+    /// them became stray ([`crate::arrangement::strayed`]): a body came apart (the warnings say how), which the energy verdict does not
     /// judge.
     pub fn came_apart(&self) -> bool {
-        let new_stray = self.stray[1].saturating_sub(self.stray[0]);
         self.pieces[1] > self.pieces[0]
-            || (new_stray >= 3
-                && new_stray as f64 >= crate::arrangement::STRAY_WARNING * self.particles as f64)
+            || crate::arrangement::strayed(self.stray[0], self.stray[1], self.particles)
     }
 }
 
