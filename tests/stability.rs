@@ -1008,30 +1008,7 @@ t_end = 0.01
 /// the end at 0.7 and 0.95.
 #[test]
 fn a_falling_block_keeps_its_courant_number_as_the_critical_step_falls() {
-    let text = r#"
-name = "falling"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 2.0]
-y = [0.0, 2.0]
-blocks = [8, 8]
-[material]
-young = 1e5
-poisson = 0.3
-density = 100.0
-[[body]]
-min = [0.5, 0.5]
-max = [1.5, 1.0]
-per_block = [6, 6]
-[[effect]]
-kind = "gravity"
-g = [0.0, -9.81]
-[time]
-courant = 0.7
-t_end = 0.3
-"#;
+    let text = include_str!("data/falling-block.toml");
     let scene = Scene::from_toml(text, "falling.toml").unwrap();
     for courant in [0.7, 0.95] {
         let mut s = scene.clone();

@@ -1009,50 +1009,15 @@ t_end = 1.0
 /// the run inverts at `courant = 0.7` and is told about the watch.
 #[test]
 fn the_critical_step_watched_while_a_block_falls_is_reported() {
-    let file = SceneFile::new(
-        "watch-fall",
-        r#"name = "falling"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 2.0]
-y = [0.0, 2.0]
-blocks = [8, 8]
-[material]
-young = 1e5
-poisson = 0.3
-density = 100.0
-[[body]]
-min = [0.5, 0.5]
-max = [1.5, 1.0]
-per_block = [6, 6]
-[[effect]]
-kind = "gravity"
-g = [0.0, -9.81]
-[time]
-courant = 0.7
-t_end = 0.3
-"#,
-    );
-    let out = cli()
-        .args(["run", file.arg(), "--diag-every", "0"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let file = SceneFile::new("watch-fall", include_str!("../data/falling-block.toml"));
+    let (stdout, _) = succeeds(&["run", file.arg(), "--diag-every", "0"]);
     assert!(
         stdout.contains("critical step watched as the bodies moved: it fell to 1.3")
             && stdout.contains("(0.5")
             && stdout.contains("sub-steps to keep courant 0.7"),
         "{stdout}"
     );
-    let out = cli()
-        .args(["run", file.arg(), "--format", "json"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let (stdout, _) = succeeds(&["run", file.arg(), "--format", "json"]);
     let summary: Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
     let (start, lowest) = (
         summary["dt_critical"].as_f64().unwrap(),
@@ -1061,12 +1026,7 @@ t_end = 0.3
     assert!(lowest < 0.6 * start, "{summary}");
     assert!(summary["split_steps"].as_u64().unwrap() > 0, "{summary}");
     assert!(summary["most_substeps"].as_u64().unwrap() >= 2, "{summary}");
-    let out = cli()
-        .args(["compare", file.arg(), "--basis", "ps,pl"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let (stdout, _) = succeeds(&["compare", file.arg(), "--basis", "ps,pl"]);
     assert!(
         stdout.contains("ps extended-hybrid: critical step watched as the bodies moved")
             && stdout.contains("pl extended-hybrid: critical step watched as the bodies moved"),
@@ -1131,12 +1091,7 @@ dt = 8e-4
 t_end = 0.5
 "#,
     );
-    let out = cli()
-        .args(["run", file.arg(), "--diag-every", "0"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let (_, stderr) = succeeds(&["run", file.arg(), "--diag-every", "0"]);
     assert!(
         stderr.contains("warning: the critical step fell from 0.00122 at the start to 0.000692 at its lowest")
             && stderr.contains("`time.dt` = 0.0008 was above 0.9 of it in places, so 50 steps were taken in up to 2 sub-steps at 0.7 of the critical step")
@@ -1153,14 +1108,20 @@ t_end = 0.5
 #[test]
 fn a_body_that_came_apart_is_said_so_on_the_verdict_line() {
     let file = SceneFile::new("came-apart", include_str!("../data/hanging-block.toml"));
-    let out = cli()
-        .args(["run", file.arg(), "--diag-every", "0"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let (stdout, _) = succeeds(&["run", file.arg(), "--diag-every", "0"]);
     assert!(
         stdout.contains("stable in energy, but a body came apart (1 piece at the start, 2 at the end): see the warnings"),
         "{stdout}"
     );
+}
+
+/// Runs `mpm-cli` with `args`, checks that it succeeded, and returns its standard
+/// output and error.
+fn succeeds(args: &[&str]) -> (String, String) {
+    let out = cli().args(args).output().unwrap();
+    assert_success(&out);
+    (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
