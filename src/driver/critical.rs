@@ -69,30 +69,10 @@ where
     /// [`Driver::watch_critical_step`] to start from.
     fn power_iteration(&mut self, lumped: Option<&[f64]>) -> Result<f64, StepError> {
         let n = self.basis.num_functions();
-        let mut v: Vec<Vec<T>> = (0..D)
-            .map(|k| (0..n).map(|i| T::of(seed(i, k))).collect())
-            .collect();
-        let mut f = vec![vec![T::zero(); n]; D];
-        let critical = self.power_iterate(lumped, &mut v, &mut f, CRITICAL_ITERATIONS)?;
-        if lumped.is_none() {
-            self.critical_vector = v;
-        }
-        Ok(critical)
-    }
-
-    /// `iterations` power iterations on `M⁻¹K` (or `lumped⁻¹K`) from `v`, with `f`
-    /// as scratch; `v` ends as the last normalised iterate's image, and the result
-    /// is the critical step `2 / √(a ‖M⁻¹K v‖)` of the last unit `v`.
-    fn power_iterate(
-        &mut self,
-        lumped: Option<&[f64]>,
-        v: &mut Vec<Vec<T>>,
-        f: &mut Vec<Vec<T>>,
-        iterations: usize,
-    ) -> Result<f64, StepError> {
+        let (mut v, mut f) = (seed_field::<T>(D, n), vec![vec![T::zero(); n]; D]);
         let mut estimate = 0.0;
-        for _ in 0..iterations {
-            let nv = norm(v);
+        for _ in 0..CRITICAL_ITERATIONS {
+            let nv = norm(&v);
             if nv == 0.0 {
                 break;
             }
@@ -104,11 +84,11 @@ where
                 &self.evals,
                 &self.particles.volume,
                 |p| material.elastic(p).lame(D),
-                v,
-                f,
+                &v,
+                &mut f,
             );
             match lumped {
-                None => solve_with_walls(&mut self.mass, &mut self.constraints, f)
+                None => solve_with_walls(&mut self.mass, &mut self.constraints, &mut f)
                     .map_err(|source| self.mass_failure(source))?,
                 Some(m) => {
                     for fk in f.iter_mut() {
@@ -116,11 +96,14 @@ where
                             *fi = if mi > 0.0 { *fi / T::of(mi) } else { T::zero() };
                         }
                     }
-                    self.constraints.project(f);
+                    self.constraints.project(&mut f);
                 }
             }
-            estimate = norm(f);
-            std::mem::swap(v, f);
+            estimate = norm(&f);
+            std::mem::swap(&mut v, &mut f);
+        }
+        if lumped.is_none() {
+            self.critical_vector = v;
         }
         Ok(if estimate > 0.0 {
             2.0 / (estimate * self.effects_amplification()).sqrt()
@@ -484,6 +467,13 @@ fn seed(i: usize, k: usize) -> f64 {
     1.0 + ((i * 7 + k * 3) % 11) as f64 * 0.1 * if i % 2 == 0 { 1.0 } else { -1.0 }
 }
 
+/// [`seed`] as a field of `d` components of `n` entries.
+fn seed_field<T: Scalar>(d: usize, n: usize) -> Vec<Vec<T>> {
+    (0..d)
+        .map(|k| (0..n).map(|i| T::of(seed(i, k))).collect())
+        .collect()
+}
+
 /// The Euclidean norm of a field of `D` components.
 fn norm<T: Scalar>(v: &[Vec<T>]) -> f64 {
     v.iter()
@@ -553,14 +543,8 @@ impl<T: Scalar> Lanczos<T> {
     /// `keep` Lanczos vectors for the Ritz vector.
     pub fn new(d: usize, n: usize, keep: usize) -> Self {
         let field = || vec![vec![T::zero(); n]; d];
-        let mut start = field();
-        for (k, c) in start.iter_mut().enumerate() {
-            for (i, a) in c.iter_mut().enumerate() {
-                *a = T::of(seed(i, k));
-            }
-        }
         Self {
-            start,
+            start: seed_field(d, n),
             kept: (0..keep).map(|_| field()).collect(),
             previous: field(),
             current: field(),
