@@ -8,7 +8,7 @@
 //! by `√(1 + α)` ([`crate::effect::Effect::force_amplification`]).
 
 use super::{phases, solve_with_walls, Driver, StepError};
-use crate::mass::MassStrategy;
+use crate::mass::{tridiagonal_extremes, MassStrategy};
 use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
@@ -209,7 +209,7 @@ where
             }
         }
         // β_j for j ≥ 1 couples rows j − 1 and j of T.
-        let lambda = largest_tridiagonal_eigenvalue(&alpha[..m], &betas[..m]);
+        let lambda = tridiagonal_extremes(&alpha[..m], &betas[1..m.max(1)]).1;
         // The Ritz vector `Σ s_j q_j` of λ into `start`, for the next call to start
         // from, when every q_j was kept: `s` by the recurrence of `(T − λ) s = 0`.
         if m > 0 && m <= kept.len() {
@@ -587,61 +587,11 @@ fn dot<T: Scalar>(x: &[Vec<T>], y: &[Vec<T>]) -> f64 {
         .sum()
 }
 
-/// The largest eigenvalue of the symmetric tridiagonal matrix with diagonal
-/// `alpha` and off-diagonal `beta[1..]` (`beta[j]` couples rows `j − 1` and `j`;
-/// `beta[0]` is unused), by bisection on the Sturm count between Gershgorin bounds.
-fn largest_tridiagonal_eigenvalue(alpha: &[f64], beta: &[f64]) -> f64 {
-    let m = alpha.len();
-    if m == 0 {
-        return 0.0;
-    }
-    let off = |j: usize| {
-        if (1..m).contains(&j) {
-            beta[j].abs()
-        } else {
-            0.0
-        }
-    };
-    let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
-    for j in 0..m {
-        let r = off(j) + off(j + 1);
-        low = low.min(alpha[j] - r);
-        high = high.max(alpha[j] + r);
-    }
-    // The number of eigenvalues below x.
-    let below = |x: f64| {
-        let mut count = 0;
-        let mut d = 1.0;
-        for j in 0..m {
-            let coupling = if j == 0 { 0.0 } else { beta[j] * beta[j] / d };
-            d = alpha[j] - x - coupling;
-            if d == 0.0 {
-                d = -f64::EPSILON * (alpha[j].abs() + x.abs()).max(f64::MIN_POSITIVE);
-            }
-            if d < 0.0 {
-                count += 1;
-            }
-        }
-        count
-    };
-    for _ in 0..200 {
-        let mid = 0.5 * (low + high);
-        if mid <= low || mid >= high {
-            break;
-        }
-        if below(mid) >= m {
-            high = mid;
-        } else {
-            low = mid;
-        }
-    }
-    high
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{largest_tridiagonal_eigenvalue, stiffness_product, Lanczos};
+    use super::{stiffness_product, Lanczos};
     use crate::driver::Driver;
+    use crate::mass::tridiagonal_extremes;
     use crate::mass::{MassKind, MassStrategy};
     use crate::material::{Elastic, LinearElastic};
     use crate::particles::Particles;
@@ -780,14 +730,14 @@ mod tests {
             let alpha = vec![2.0; m];
             let beta = vec![-1.0; m];
             let exact = 2.0 + 2.0 * (std::f64::consts::PI / (m + 1) as f64).cos();
-            let got = largest_tridiagonal_eigenvalue(&alpha, &beta);
+            let got = tridiagonal_extremes(&alpha, &beta[1..]).1;
             assert!(
                 (got - exact).abs() < 1e-12 * exact,
                 "m = {m}: {got} vs {exact}"
             );
         }
         // Uncoupled rows: the largest diagonal entry.
-        let got = largest_tridiagonal_eigenvalue(&[1.0, 5.0, 3.0], &[0.0, 0.0, 0.0]);
+        let got = tridiagonal_extremes(&[1.0, 5.0, 3.0], &[0.0, 0.0]).1;
         assert!((got - 5.0).abs() < 1e-12, "{got}");
     }
 

@@ -115,9 +115,14 @@ pub(super) fn lanczos_estimate<T: Scalar>(
 
 /// Smallest and largest eigenvalue of the symmetric tridiagonal matrix with
 /// diagonal `a` and off-diagonal `b` (`b[j]` couples `j` and `j + 1`), by
-/// bisection on the Sturm count.
-fn tridiagonal_extremes(a: &[f64], b: &[f64]) -> (f64, f64) {
+/// bisection on the Sturm count; `(0, 0)` for an empty matrix. The Lanczos
+/// estimates of the condition number here and of the critical step
+/// (`driver::critical`) read it.
+pub(crate) fn tridiagonal_extremes(a: &[f64], b: &[f64]) -> (f64, f64) {
     let m = a.len();
+    if m == 0 {
+        return (0.0, 0.0);
+    }
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for j in 0..m {
         let r = if j > 0 { b[j - 1].abs() } else { 0.0 } + if j + 1 < m { b[j].abs() } else { 0.0 };

@@ -24,6 +24,7 @@
 //! What a strategy did is returned as a [`MassReport`], never printed.
 
 mod condition;
+pub(crate) use condition::tridiagonal_extremes;
 mod consistent;
 mod constraints;
 mod deactivate;
