@@ -13,6 +13,7 @@ use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
 use psmpm_basis::Basis;
+use rayon::iter::ParallelIterator;
 
 /// Power iterations of the critical-step estimate.
 pub const CRITICAL_ITERATIONS: usize = 40;
@@ -82,6 +83,9 @@ where
             let material = &self.material;
             stiffness_product(
                 &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
                 &self.particles.volume,
                 |p| material.elastic(p).lame(D),
                 &v,
@@ -154,7 +158,16 @@ where
         for (n, s) in next.iter_mut().zip(start.iter()) {
             n.copy_from_slice(s);
         }
-        stiffness_product(&self.evals, &self.particles.volume, lame, next, k_current);
+        stiffness_product(
+            &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
+            &self.particles.volume,
+            lame,
+            next,
+            k_current,
+        );
         let mut beta = dot(next, k_current).max(0.0).sqrt();
         let (mut alpha, mut betas) = ([0.0; MAX_LANCZOS], [0.0; MAX_LANCZOS]);
         phases::zero(previous);
@@ -183,7 +196,15 @@ where
             solve_with_walls(&mut self.mass, &mut self.constraints, next)
                 .map_err(|source| self.mass_failure(source))?;
             // The velocity projection's filter: w ← M⁻¹ M_c w.
-            consistent_mass_product(&self.evals, &self.particles.mass, next, scratch);
+            consistent_mass_product(
+                &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
+                &self.particles.mass,
+                next,
+                scratch,
+            );
             for (w, m) in next.iter_mut().zip(scratch.iter()) {
                 w.copy_from_slice(m);
             }
@@ -201,7 +222,16 @@ where
             }
             std::mem::swap(previous, current);
             m += 1;
-            stiffness_product(&self.evals, &self.particles.volume, lame, next, k_current);
+            stiffness_product(
+                &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
+                &self.particles.volume,
+                lame,
+                next,
+                k_current,
+            );
             beta = dot(next, k_current).max(0.0).sqrt();
             // A Krylov space exhausted to round-off: T holds the whole spectrum.
             if beta.is_nan() || beta <= 1e-12 * a.abs() {
@@ -487,35 +517,46 @@ fn norm<T: Scalar>(v: &[Vec<T>]) -> f64 {
 /// `σ = λ_p tr(ε) I + 2 μ_p ε`, `ε = sym ∇v`, and the Lamé constants `lame(p)` of
 /// each particle's material (the stiffness applied to `v`; with bodies of several
 /// materials, each particle's own, so the estimate is that of the stiffest mode of
-/// the whole system).
+/// the whole system). Summed element by element on the pool and gathered in
+/// element order, as the step's forces are: the same bits for any thread count.
+#[allow(clippy::too_many_arguments)]
 fn stiffness_product<T: Scalar, const D: usize>(
     evals: &phases::Evaluations<T, D>,
+    bins: &phases::Bins,
+    gather: &phases::Gather,
+    local: &mut phases::Local<T, D>,
     volume: &[T],
-    lame: impl Fn(usize) -> (f64, f64),
+    lame: impl Fn(usize) -> (f64, f64) + Sync,
     v: &[Vec<T>],
     f: &mut [Vec<T>],
 ) {
     phases::zero(f);
-    for p in 0..volume.len() {
-        let (lambda, mu) = lame(p);
-        let mut grad = SMatrix::<T, D, D>::zeros();
-        for (s, i) in evals.entries(p) {
-            for k in 0..D {
-                for l in 0..D {
-                    grad[(k, l)] += v[k][i] * evals.grad_phi[s][l];
+    local.par_vectors(bins).for_each(|(e, lv)| {
+        let functions = evals.element_functions(e);
+        for &p in bins.particles(e) {
+            let p = p as usize;
+            let (lambda, mu) = lame(p);
+            let range = evals.range(p);
+            let mut grad = SMatrix::<T, D, D>::zeros();
+            for (s, &i) in range.clone().zip(functions) {
+                for k in 0..D {
+                    for l in 0..D {
+                        grad[(k, l)] += v[k][i as usize] * evals.grad_phi[s][l];
+                    }
+                }
+            }
+            let eps = (grad + grad.transpose()) * T::of(0.5);
+            let sigma = SMatrix::<T, D, D>::identity() * (T::of(lambda) * eps.trace())
+                + eps * T::of(2.0 * mu);
+            for (a, s) in range.enumerate() {
+                let g = sigma * evals.grad_phi[s] * volume[p];
+                for k in 0..D {
+                    lv[a * D + k] += g[k];
                 }
             }
         }
-        let eps = (grad + grad.transpose()) * T::of(0.5);
-        let sigma =
-            SMatrix::<T, D, D>::identity() * (T::of(lambda) * eps.trace()) + eps * T::of(2.0 * mu);
-        for (s, i) in evals.entries(p) {
-            let g = sigma * evals.grad_phi[s] * volume[p];
-            for k in 0..D {
-                f[k][i] += g[k];
-            }
-        }
-    }
+    });
+    gather.functions(local, false, f);
 }
 
 /// Lanczos steps at most ([`Driver::lanczos_critical`]).
@@ -556,26 +597,36 @@ impl<T: Scalar> Lanczos<T> {
 }
 
 /// `out = M_c v`, `M_c = Σ_p m_p phi(x_p) phi(x_p)ᵀ` the consistent mass of the
-/// particles (paper eq. (13)), per component, without the matrix.
+/// particles (paper eq. (13)), per component, without the matrix; element by
+/// element like [`stiffness_product`].
 fn consistent_mass_product<T: Scalar, const D: usize>(
     evals: &phases::Evaluations<T, D>,
+    bins: &phases::Bins,
+    gather: &phases::Gather,
+    local: &mut phases::Local<T, D>,
     mass: &[T],
     v: &[Vec<T>],
     out: &mut [Vec<T>],
 ) {
     phases::zero(out);
-    for (p, &m) in mass.iter().enumerate() {
-        for k in 0..D {
-            let mut at = T::zero();
-            for (s, i) in evals.entries(p) {
-                at += evals.phi[s] * v[k][i];
-            }
-            let at = at * m;
-            for (s, i) in evals.entries(p) {
-                out[k][i] += evals.phi[s] * at;
+    local.par_vectors(bins).for_each(|(e, lv)| {
+        let functions = evals.element_functions(e);
+        for &p in bins.particles(e) {
+            let p = p as usize;
+            let range = evals.range(p);
+            for k in 0..D {
+                let mut at = T::zero();
+                for (s, &i) in range.clone().zip(functions) {
+                    at += evals.phi[s] * v[k][i as usize];
+                }
+                let at = at * mass[p];
+                for (a, s) in range.clone().enumerate() {
+                    lv[a * D + k] += evals.phi[s] * at;
+                }
             }
         }
-    }
+    });
+    gather.functions(local, false, out);
 }
 
 /// `Σ_k x_k · y_k` in `f64`.
@@ -654,6 +705,9 @@ mod tests {
             v[col / n][col % n] = 1.0;
             stiffness_product(
                 &driver.evals,
+                &driver.bins,
+                &driver.gather,
+                &mut driver.local,
                 &driver.particles.volume,
                 |_| (lambda, mu),
                 &v,
