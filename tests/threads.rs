@@ -26,6 +26,9 @@ fn row_bits(r: &StepReport) -> Vec<u64> {
         r.momentum()[1].to_bits(),
         r.max_speed.to_bits(),
         r.condition.map_or(0, f64::to_bits),
+        r.substeps as u64,
+        r.dt_critical.map_or(0, f64::to_bits),
+        r.dt_critical_latest.map_or(0, f64::to_bits),
         m.active as u64,
         m.lumped_rows as u64,
         m.deactivated as u64,
@@ -115,6 +118,26 @@ fn damped_column_is_the_same_for_any_threads() {
     s.set_dt(1e-5);
     s.time.t_end = 2e-4;
     same_for_any_threads(&s, "PS partial, damped");
+}
+
+/// A block falling across an empty mesh (`tests/data/falling-block.toml`, 24 × 24
+/// particles per block, 4 608): the watch over the critical step estimates it
+/// again as the block covers new functions (its stiffness and mass products on
+/// the pool) and splits steps; the estimates, the splits and the state are the
+/// same bits for any thread count.
+#[test]
+fn split_steps_of_a_falling_block_are_the_same_for_any_threads() {
+    let text = std::fs::read_to_string("tests/data/falling-block.toml").unwrap();
+    let mut s = Scene::from_toml(&text, "falling-block.toml").unwrap();
+    s.set_particles_per_block([24, 24]);
+    s.time.t_end = 0.16;
+    let (_, rows) = run_bits(&s, 1);
+    let split = rows.iter().filter(|r| r[11] > 1).count();
+    assert!(
+        split > 0,
+        "no step was split: the watch's products are not exercised"
+    );
+    same_for_any_threads(&s, "PS default, falling block with split steps");
 }
 
 /// The step report's energies (per-particle terms in parallel, summed in particle
