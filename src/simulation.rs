@@ -106,6 +106,12 @@ pub struct Summary {
     pub split_steps: usize,
     /// The most sub-steps of one step (1 when none was split).
     pub most_substeps: usize,
+    /// Steps the watch split further than the critical step needs, to keep every
+    /// particle's move within its element (or a contact wall's reach):
+    /// `crate::driver::critical::ADVECTION_SHARE`.
+    pub advected_steps: usize,
+    /// The largest particle speed that split a step so, when one did.
+    pub fastest_speed: Option<f64>,
     /// Largest condition-number estimate (when requested).
     pub max_condition: Option<f64>,
     /// Total energy at the start.
@@ -944,21 +950,10 @@ fn error<const D: usize, B: Basis<f64, D>>(
                         // `σ⁰`, so the law alone does not give the settled height
                         // of a point; the weight above its reference height does.
                         let y0 = parts.x0[p][D - 1] - origin[D - 1];
-                        exact::column_equilibrium_stress_at_reference(
-                            y0,
-                            height,
-                            density,
-                            gravity.abs(),
-                        )
+                        exact::bar_equilibrium_stress_at_reference(y0, height, density, gravity)
                     } else {
                         let y = parts.x[p][D - 1] - origin[D - 1];
-                        exact::column_equilibrium_stress_linear(
-                            y,
-                            height,
-                            density,
-                            gravity.abs(),
-                            young,
-                        )
+                        exact::bar_equilibrium_stress_linear(y, height, density, gravity, young)
                     };
                     (parts.sigma[p][(D - 1, D - 1)] - exact).abs() / sigma_base
                 })
@@ -1263,6 +1258,8 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             }),
             split_steps: watched.map_or(0, |w| w.split_steps),
             most_substeps: watched.map_or(1, |w| w.most_substeps),
+            advected_steps: watched.map_or(0, |w| w.advected_steps),
+            fastest_speed: watched.and_then(|w| w.fastest.map(|(v, _)| v)),
             courant: scene.time.courant,
             max_condition,
             energy_initial: tally.verdict.initial_energy(),

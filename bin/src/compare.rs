@@ -348,6 +348,9 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                 if let Some(line) = crate::run::watched_line(s) {
                     println!("{} {}: {line}", s.basis, s.mass);
                 }
+                if let Some(line) = crate::run::advected_line(s) {
+                    println!("{} {}: {line}", s.basis, s.mass);
+                }
                 if let Some(reason) = &s.failure {
                     println!("{} {}: {reason}", s.basis, s.mass);
                 } else if !s.stable {

@@ -670,7 +670,12 @@ fn verdict(
              force): {particles}"
         ),
         (false, false) if double_particles.is_some_and(|r| r > 1.0 + LIMITING_GAIN) => {
-            if smooth {
+            if smooth && scene.reference.is_some() {
+                "more particles raise the error, so neither h, dt nor quadrature limits it: \
+                 the reference's own assumptions may (check that the scene is the case its \
+                 `[reference]` describes: its loads, its fixed ends, small strain)"
+                    .into()
+            } else if smooth {
                 "more particles raise the error, so neither h, dt nor quadrature limits it: \
                  the reference's own error may (against the finest level, that level's; give \
                  the scene a `[reference]` where one exists)"

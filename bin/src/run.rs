@@ -853,6 +853,26 @@ pub fn watched_line(summary: &Summary) -> Option<String> {
     ))
 }
 
+/// `steps split for the particles' speeds: …`, when the watch split steps further
+/// than the critical step needs, so that no particle crossed more than half its
+/// element's width (or a quarter of its contact distance near a contact wall) in
+/// one sub-step.
+pub fn advected_line(summary: &Summary) -> Option<String> {
+    if summary.advected_steps == 0 {
+        return None;
+    }
+    Some(format!(
+        "steps split for the particles' speeds: {} of the {} steps {} taken in up to {} sub-steps (speeds up to {}) so that no particle crossed more than {} of its element's width, or {} of its contact distance near a contact wall, in one sub-step",
+        summary.advected_steps,
+        summary.steps,
+        if summary.advected_steps == 1 { "was" } else { "were" },
+        summary.most_substeps,
+        summary.fastest_speed.map_or("-".into(), sci),
+        psmpm::driver::ADVECTION_SHARE,
+        psmpm::driver::CONTACT_SHARE,
+    ))
+}
+
 /// `time step … · critical step … · Courant number …`, printed at the start of a run.
 pub fn time_step_line(r: &StepReport) -> String {
     match r.dt_critical {
@@ -870,7 +890,7 @@ pub fn time_step_line(r: &StepReport) -> String {
         ),
         None => format!(
             "time step {} · critical step not estimated (the mass system could not be \
-             solved at the start; the first step says why)",
+             solved at the start: see the warning below)",
             sci(r.dt)
         ),
     }
@@ -1027,6 +1047,9 @@ pub fn summary_text(summary: &Summary) -> String {
         summary.max_lumped_rows,
     );
     if let Some(line) = watched_line(summary) {
+        out += &format!("{line}\n");
+    }
+    if let Some(line) = advected_line(summary) {
         out += &format!("{line}\n");
     }
     if let Some(reason) = &summary.failure {

@@ -13,7 +13,7 @@ use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
 use psmpm_basis::Basis;
-use rayon::iter::ParallelIterator;
+use rayon::iter::{IntoParallelIterator, ParallelIterator};
 
 /// Power iterations of the critical-step estimate.
 pub const CRITICAL_ITERATIONS: usize = 40;
@@ -297,6 +297,13 @@ where
             substeps: 1,
             split_steps: 0,
             most_substeps: 1,
+            advection_substeps: 1,
+            advected_steps: 0,
+            speed: 0.0,
+            fastest: None,
+            pending: (1, 1),
+            contact_walls: (0..self.basis.num_elements())
+                .any(|e| self.effects.iter().any(|f| f.walls_element(e))),
             since_check: 0,
             interval: WATCH_EVERY,
             counts: (self.last_report.active, self.last_report.treated()),
@@ -309,10 +316,127 @@ where
         self.watch = Some(watch);
     }
 
-    /// The number of sub-steps of this step (1 without the watch or when it is not
-    /// due): at the state the step has just factorised (see
-    /// [`Driver::watch_critical_step`]).
+    /// The number of sub-steps of this step (1 without the watch): the larger of
+    /// what the critical step needs ([`Driver::critical_substeps`]) and what the
+    /// particles' speeds need ([`Driver::advection_substeps`]).
     pub(super) fn substeps(&mut self) -> Result<usize, StepError> {
+        let critical = self.critical_substeps()?;
+        if self.watch.is_none() {
+            return Ok(critical);
+        }
+        let advection = self.advection_substeps()?;
+        let w = self.watch.as_mut().expect("the watch is on");
+        w.pending = (critical, advection);
+        Ok(critical.max(advection))
+    }
+
+    /// Books the sub-steps of a step taken whole ([`Driver::substeps`]): in the
+    /// watch's counts only once the step completed.
+    pub(super) fn book_substeps(&mut self) {
+        let step = self.step;
+        let Some(w) = self.watch.as_mut() else {
+            return;
+        };
+        let (critical, advection) = w.pending;
+        if advection > critical {
+            w.advected_steps += 1;
+            if w.fastest.is_none_or(|(speed, _)| w.speed > speed) {
+                w.fastest = Some((w.speed, step));
+            }
+        } else if critical > 1 {
+            w.split_steps += 1;
+        }
+        w.most_substeps = w.most_substeps.max(critical.max(advection));
+    }
+
+    /// The sub-steps that keep every particle's move in a (sub-)step within
+    /// [`ADVECTION_SHARE`] of its element's width (the smallest altitude), and,
+    /// in a scene with a contact wall, within [`CONTACT_SHARE`] of its contact
+    /// distance: the critical step knows the stiffness, not the speed, and
+    /// a fast body crosses elements, or a contact wall's reach, in one step (a
+    /// soft block at 60 m/s moved 3.3 elements per step at `courant` 0.4 and
+    /// passed through a slip wall; a contact wall's springs stop a body arriving
+    /// at `v` within about `v Δt / κ`, `κ = 1/2`). The particle speed `|v_p|`
+    /// bounds the speed that moves it. Fewer sub-steps than now only where they
+    /// stay below [`ADVECTION_RELEASE`] of the limit (a hysteresis).
+    fn advection_substeps(&mut self) -> Result<usize, StepError> {
+        let dt = self.dt_outer;
+        let (x, v, element, volume0) = (
+            &self.particles.x,
+            &self.particles.v,
+            &self.particles.element,
+            &self.particles.volume0,
+        );
+        let width = &self.element_width;
+        let contact = self.watch.as_ref().is_some_and(|w| w.contact_walls);
+        // The largest share of its allowed move a particle makes in `dt`, and its
+        // speed (the larger share wins; ties to the lower particle: the same for
+        // any thread count).
+        let worst = (0..x.len())
+            .into_par_iter()
+            .map(|p| {
+                let speed = v[p].norm().to_f64();
+                let e = element[p];
+                let mut allowed = ADVECTION_SHARE * width[e];
+                // Every particle, not only those already within a wall's reach: a
+                // fast one crosses the reach in one step from outside it.
+                if contact {
+                    let d = crate::contact::contact_distance::<D>(volume0[p].to_f64());
+                    allowed = allowed.min(CONTACT_SHARE * d);
+                }
+                (speed * dt / allowed, speed, p)
+            })
+            .reduce(
+                || (0.0, 0.0, usize::MAX),
+                |a, b| {
+                    if b.0 > a.0 || (b.0 == a.0 && b.2 < a.2) {
+                        b
+                    } else {
+                        a
+                    }
+                },
+            );
+        let (share, speed, particle) = worst;
+        let w = self.watch.as_mut().expect("the watch is on");
+        w.speed = speed;
+        let needed = share.ceil().max(1.0);
+        let mut k = needed.max(w.advection_substeps as f64);
+        while k > needed && share / (k - 1.0) <= ADVECTION_RELEASE {
+            k -= 1.0;
+        }
+        if !share.is_finite() || k > MAX_SUBSTEPS as f64 {
+            let at = crate::driver::failure::point(
+                &x[particle].iter().map(|c| c.to_f64()).collect::<Vec<_>>(),
+            );
+            // A step that the largest split would carry with a margin.
+            let shorter = 0.75 * MAX_SUBSTEPS as f64 / share;
+            let lower = match self.dt_critical {
+                Some(c) if c.is_finite() && c > 0.0 => format!(
+                    "`time.courant` to {} (or `dt` to {:.2e})",
+                    crate::scene::limits::echo_significant(shorter * dt / c, 2),
+                    shorter * dt
+                ),
+                _ => format!("`dt` to {:.2e}", shorter * dt),
+            };
+            let how_far = if contact {
+                "half its element's width, or a quarter of its contact distance in a scene with contact walls"
+            } else {
+                "half its element's width"
+            };
+            return Err(StepError::TooFast {
+                step: self.step + 1,
+                reason: format!(
+                    "particle {particle} at {at} moves at {speed:.3e}: a step of {dt:.3e} carries it {share:.0} times as far as it may go in one sub-step ({how_far}), more than the {MAX_SUBSTEPS} sub-steps a step may be split into; lower {lower}; if that speed is not one the scene gives (its initial velocities and what its loads add), the run became unstable earlier (see the energy column)"
+                ),
+            });
+        }
+        w.advection_substeps = k as usize;
+        Ok(k as usize)
+    }
+
+    /// The sub-steps the critical step needs (1 when the watch is not due): at the
+    /// state the step has just factorised (see [`Driver::watch_critical_step`]).
+    fn critical_substeps(&mut self) -> Result<usize, StepError> {
         let Some(mut watch) = self.watch.take() else {
             return Ok(1);
         };
@@ -389,10 +513,52 @@ where
         }
         let k = k as usize;
         watch.substeps = k;
-        watch.most_substeps = watch.most_substeps.max(k);
         self.watch = Some(watch);
         Ok(k)
     }
+}
+
+/// The share of its element's width (smallest altitude) a particle may cross in
+/// one (sub-)step ([`Driver::advection_substeps`]).
+pub const ADVECTION_SHARE: f64 = 0.5;
+/// The share of its contact distance a particle within a contact wall's reach may
+/// cross in one (sub-)step ([`Driver::advection_substeps`]).
+pub const CONTACT_SHARE: f64 = 0.25;
+/// Split steps return to fewer sub-steps for the speeds only where the particles'
+/// moves stay below this share of what they may cross.
+pub const ADVECTION_RELEASE: f64 = 0.8;
+
+/// The width of each element: its smallest altitude `2 A / L` (`A` its area, `L`
+/// its longest edge; in 1D its length), from its polynomial pieces.
+pub(super) fn element_widths<T: Scalar, const D: usize, B: Basis<T, D>>(basis: &B) -> Vec<f64> {
+    let mut pieces = Vec::new();
+    (0..basis.num_elements())
+        .map(|e| {
+            pieces.clear();
+            basis.polynomial_pieces(e, &mut pieces);
+            let mut diameter = 0.0f64;
+            for a in &pieces {
+                for b in &pieces {
+                    diameter = diameter.max((a - b).norm());
+                }
+            }
+            if D == 1 {
+                return diameter;
+            }
+            let area: f64 = pieces
+                .chunks(D + 1)
+                .map(|s| {
+                    let (u, w) = (s[1] - s[0], s[2] - s[0]);
+                    0.5 * (u[0] * w[1] - u[1] * w[0]).abs()
+                })
+                .sum();
+            if diameter > 0.0 {
+                2.0 * area / diameter
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// The sub-steps of a step `Δt = dt` at the critical step `estimate`, with
@@ -442,10 +608,24 @@ pub(super) struct Watch<T> {
     pub lowest: Option<(f64, usize, f64)>,
     /// The sub-steps of the current step.
     pub substeps: usize,
-    /// Steps taken in more than one sub-step.
+    /// Steps taken in more than one sub-step for the critical step.
     pub split_steps: usize,
     /// The most sub-steps of one step.
     pub most_substeps: usize,
+    /// The sub-steps the particles' speeds need now
+    /// ([`Driver::advection_substeps`]).
+    pub advection_substeps: usize,
+    /// Steps split further for the particles' speeds than the critical step needs.
+    pub advected_steps: usize,
+    /// The largest particle speed at this step's check of the speeds.
+    pub speed: f64,
+    /// The largest speed that split a step for the speeds, and the step (1-based).
+    pub fastest: Option<(f64, usize)>,
+    /// The sub-steps of the step under way for the critical step and for the
+    /// speeds, booked once it completes ([`Driver::book_substeps`]).
+    pub pending: (usize, usize),
+    /// The scene has a contact wall (an effect that walls an element).
+    pub contact_walls: bool,
     /// Steps since the last check.
     pub since_check: usize,
     /// Steps between checks, from [`WATCH_EVERY`] to [`WATCH_EVERY_MOST`].
@@ -466,10 +646,14 @@ pub struct WatchReport {
     pub latest: Option<f64>,
     /// The lowest estimate, the step (1-based) and the time at the start of it.
     pub lowest: Option<(f64, usize, f64)>,
-    /// Steps taken in more than one sub-step.
+    /// Steps taken in more than one sub-step for the critical step.
     pub split_steps: usize,
     /// The most sub-steps of one step.
     pub most_substeps: usize,
+    /// Steps split further for the particles' speeds than the critical step
+    /// needs, and the largest speed that split one (with its step, 1-based).
+    pub advected_steps: usize,
+    pub fastest: Option<(f64, usize)>,
 }
 
 /// Steps between two checks of the critical step while the bodies move, after a

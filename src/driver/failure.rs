@@ -390,10 +390,17 @@ where
                     "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
                     point(&to_f64_point(&self.basis.function_point(i)))
                 ),
-                None => format!(
-                    "functions with almost no particle in their support make `{}` singular: use the default mass strategy (`extended-hybrid`), or `partial` / `lumped`",
-                    self.mass.spec()
-                ),
+                None => {
+                    let spec = self.mass.spec();
+                    let others = if spec.starts_with("partial") {
+                        "`lumped`"
+                    } else {
+                        "`partial` or `lumped`"
+                    };
+                    format!(
+                        "functions with almost no particle in their support make `{spec}` singular: use the default mass strategy (`extended-hybrid`), or {others}"
+                    )
+                }
             }
         };
         StepError::MassNotPositiveDefinite {
@@ -476,6 +483,15 @@ pub enum StepError {
         /// What makes the mass system nearly singular, with its fix, when the driver
         /// sees it.
         cause: Option<String>,
+    },
+    /// A particle so fast that keeping its move within its element would take
+    /// more than [`super::critical::MAX_SUBSTEPS`] sub-steps
+    /// ([`super::Driver::watch_critical_step`], the advection limit).
+    #[error("step {step}: {reason}")]
+    TooFast {
+        step: usize,
+        /// The particle, its speed and what to change.
+        reason: String,
     },
     /// A body compressed to a few percent of its volume: judged by the caller, who
     /// knows the material (see `crate::material::COLLAPSED_JACOBIAN`).

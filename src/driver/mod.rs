@@ -31,7 +31,8 @@ mod failure;
 pub mod phases;
 
 pub use critical::{
-    WatchReport, CRITICAL_ITERATIONS, MAX_SUBSTEPS, WATCH_EVERY, WATCH_ITERATIONS, WATCH_SEED_SHARE,
+    WatchReport, ADVECTION_SHARE, CONTACT_SHARE, CRITICAL_ITERATIONS, MAX_SUBSTEPS, WATCH_EVERY,
+    WATCH_ITERATIONS, WATCH_SEED_SHARE,
 };
 pub(crate) use failure::point;
 pub use failure::{SetupError, StepError, NEARLY_SINGULAR};
@@ -161,6 +162,9 @@ where
     walled: Vec<bool>,
     /// `fixed[k][i]`: component `k` of function `i` is held at zero (`fix`).
     fixed: Vec<Vec<bool>>,
+    /// Each element's width, its smallest altitude (the advection limit of the
+    /// watch, [`Driver::watch_critical_step`]).
+    element_width: Vec<f64>,
     constraints: Constraints<T, D>,
     effects: Vec<Box<dyn Effect<T, D>>>,
     pattern: SymmetricPattern,
@@ -418,6 +422,7 @@ where
             constraints: Constraints::new(general, n),
             walled,
             fixed,
+            element_width: critical::element_widths(&basis),
             inputs,
             last_condition: None,
             phases: PhaseTimes::default(),
@@ -549,6 +554,8 @@ where
             lowest: w.lowest,
             split_steps: w.split_steps,
             most_substeps: w.most_substeps,
+            advected_steps: w.advected_steps,
+            fastest: w.fastest,
         })
     }
     /// The material.
@@ -575,16 +582,12 @@ where
         let substeps = self.substeps()?;
         times.solve += clock.elapsed().as_secs_f64();
         self.set_substep_dt(self.dt_outer / substeps as f64);
-        if substeps > 1 {
-            if let Some(w) = self.watch.as_mut() {
-                w.split_steps += 1;
-            }
-        }
         let mut report = self.advance(0, substeps, &mut times)?;
         for j in 1..substeps {
             self.prepare_system(&mut times)?;
             report = self.advance(j, substeps, &mut times)?;
         }
+        self.book_substeps();
         self.phases = times;
         report.phases = times;
         report.substeps = substeps;

@@ -15,6 +15,7 @@
 //! | [`AxisAligned`] | B4 | paper (40)–(46) |
 //! | [`column_equilibrium_stress`] | B5c | paper (48) |
 //! | [`column_equilibrium_stress_linear`], [`column_equilibrium_position_linear`] | B5c | exact equilibrium of the project's linear law |
+//! | [`bar_equilibrium_stress_linear`], [`bar_equilibrium_stress_at_reference`] | B5c, a bar standing or hanging | the same with signed `g` |
 //! | [`RmsPositionError`] | B4 | paper (47) |
 //!
 //! # Conventions
@@ -449,7 +450,30 @@ pub fn column_equilibrium_stress_linear(
     gravity_magnitude: f64,
     young: f64,
 ) -> f64 {
-    let a = density * gravity_magnitude.abs() / young;
+    bar_equilibrium_stress_linear(y_eq, height, density, -gravity_magnitude.abs(), young)
+}
+
+/// Exact equilibrium stress of a bar of length `H` fixed at its end `y = 0`
+/// under its weight, at current position `y_eq` above that end, for the linear
+/// law `σ = E (F − 1)`, with `gravity` the signed acceleration along the bar
+/// (from the fixed end to the free one): `g < 0` toward the fixed end, a column
+/// standing on it in compression ([`column_equilibrium_stress_linear`]);
+/// `g > 0` away from it, a bar hanging from it in tension.
+///
+/// In the reference position `Y`: `σ = ρ g (H − Y)`, `y = Y − a (HY − Y²/2)` with
+/// `a = −ρ g / E`, the free end at `y_top = H (1 − a H / 2)`. At `d = y_top − y_eq`
+/// the depth `H − Y = 2d / (1 + √(1 − 2 a d))` and `σ = −E a (H − Y)`.
+///
+/// Domain: `H, ρ, E > 0`, `ρ|g|H < E` for `g < 0` (so `F > 0` at the fixed end),
+/// `0 ≤ y_eq ≤ y_top`.
+pub fn bar_equilibrium_stress_linear(
+    y_eq: f64,
+    height: f64,
+    density: f64,
+    gravity: f64,
+    young: f64,
+) -> f64 {
+    let a = -density * gravity / young;
     let y_top = height * (1.0 - 0.5 * a * height);
     let d = y_top - y_eq;
     let depth_ref = 2.0 * d / (1.0 + (1.0 - 2.0 * a * d).sqrt());
@@ -473,7 +497,20 @@ pub fn column_equilibrium_stress_at_reference(
     density: f64,
     gravity_magnitude: f64,
 ) -> f64 {
-    -density * gravity_magnitude.abs() * (height - y0)
+    bar_equilibrium_stress_at_reference(y0, height, density, -gravity_magnitude.abs())
+}
+
+/// The stress of [`column_equilibrium_stress_at_reference`] with `gravity` the
+/// signed acceleration along the bar from its fixed end `Y = 0` to its free one:
+/// `σ = ρ g (H − Y)`, compression for a column standing on the fixed end
+/// (`g < 0`), tension for a bar hanging from it (`g > 0`).
+pub fn bar_equilibrium_stress_at_reference(
+    y0: f64,
+    height: f64,
+    density: f64,
+    gravity: f64,
+) -> f64 {
+    density * gravity * (height - y0)
 }
 
 /// Exact equilibrium height `y_eq(Y) = Y − (ρ|g|/E)(HY − Y²/2)` of the point at
@@ -719,6 +756,32 @@ mod tests {
         // Unstressed at rest.
         assert_eq!(b.body_force(x0, 0.0), [0.0, 0.0]);
         assert_eq!(b.cauchy_stress(x0, 0.0), [0.0, 0.0]);
+    }
+
+    /// A bar hanging from its fixed end (`g > 0`, away from it) is in tension,
+    /// `σ = ρ g (L − X)`, at the position `x = X + (ρg/E)(LX − X²/2)` the linear
+    /// law gives; with `g < 0` the signed forms are the column's.
+    #[test]
+    fn a_hanging_bar_is_in_tension_and_a_standing_one_in_compression() {
+        let (l, rho, g, e) = (2.0, 1e3, 9.81, 1e6);
+        for k in 0..=10 {
+            let x0 = l * k as f64 / 10.0;
+            let x = x0 + rho * g / e * (l * x0 - 0.5 * x0 * x0);
+            let sigma = bar_equilibrium_stress_linear(x, l, rho, g, e);
+            assert!(
+                (sigma - rho * g * (l - x0)).abs() < 1e-9 * rho * g * l,
+                "{k}: {sigma}"
+            );
+            assert_eq!(
+                bar_equilibrium_stress_at_reference(x0, l, rho, g),
+                rho * g * (l - x0)
+            );
+            let y = column_equilibrium_position_linear(x0, l, rho, g, e);
+            assert_eq!(
+                bar_equilibrium_stress_linear(y, l, rho, -g, e),
+                column_equilibrium_stress_linear(y, l, rho, g, e)
+            );
+        }
     }
 
     #[test]

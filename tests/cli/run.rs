@@ -427,8 +427,11 @@ courant = 0.5
 t_end = 2.0
 "#,
     );
+    // Without the watch, whose limit on a particle's move per step
+    // (`ADVECTION_SHARE`) now splits these steps: the body then collapses on the
+    // floor instead of crossing it.
     let out = cli()
-        .args(["run", file.arg(), "--diag-every", "0"])
+        .args(["run", file.arg(), "--diag-every", "0", "--no-watch"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1), "{out:?}");
@@ -1124,4 +1127,82 @@ fn succeeds(args: &[&str]) -> (String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// A user's soft block thrown at 60 m/s across a long empty mesh (`courant =
+/// 0.4`): the critical step knows the stiffness, not the speed, and the block
+/// moved 3.3 elements per step (against a slip wall it passed through it). The
+/// watch splits its steps so that no particle crosses more than half its
+/// element's width in a sub-step, says so, and the free translation stays exact;
+/// toward a contact wall a quarter of the contact distance would take more than
+/// 64 sub-steps, and the run stops at step 1 naming the `courant` to take.
+#[test]
+fn a_fast_body_is_stepped_within_its_elements() {
+    let text = |wall: &str| {
+        format!(
+            r#"name = "fast"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 20.0]
+y = [0.0, 4.0]
+blocks = [40, 8]
+[material]
+model = "neo-hookean"
+young = 5e3
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.0, 1.5]
+max = [2.0, 2.5]
+per_block = [4, 4]
+initial_velocity = {{ kind = "uniform", value = [60.0, 0.0] }}
+{wall}
+[time]
+courant = 0.4
+t_end = 0.25
+"#
+        )
+    };
+    let free = SceneFile::new("fast", &text(""));
+    let (stdout, _) = succeeds(&["run", free.arg(), "--diag-every", "0", "--format", "json"]);
+    let summary: Value = serde_json::from_str(&stdout).unwrap();
+    let (advected, steps) = (
+        summary["advected_steps"].as_u64().unwrap(),
+        summary["steps"].as_u64().unwrap(),
+    );
+    assert!(advected == steps && steps > 0, "{summary}");
+    // 60 m/s × Δt against half an element's width (0.5 × 0.3536 of a block of
+    // 0.5 split in two): Δt = 0.25 / 9 gives 9.4, so 10 sub-steps or more.
+    assert!(
+        summary["most_substeps"].as_u64().unwrap() >= 10,
+        "{summary}"
+    );
+    assert!(
+        summary["fastest_speed"].as_f64().unwrap() > 59.9,
+        "{summary}"
+    );
+    assert_eq!(summary["stable"], Value::Bool(true), "{summary}");
+    let (table, _) = succeeds(&["run", free.arg(), "--diag-every", "0"]);
+    assert!(
+        table.contains("steps split for the particles' speeds:"),
+        "{table}"
+    );
+    let walled = SceneFile::new(
+        "fast-wall",
+        &text("[[effect]]\nkind = \"contact-wall\"\ntag = \"right\""),
+    );
+    let out = cli()
+        .args(["run", walled.arg(), "--diag-every", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("step 1: particle")
+            && stderr.contains("more than the 64 sub-steps")
+            && stderr.contains("lower `time.courant` to"),
+        "{stderr}"
+    );
 }
