@@ -565,8 +565,8 @@ fn wave_speed_hint(scene: &Scene) -> String {
         return String::new();
     };
     format!(
-        "The critical step is the time the fastest wave takes to cross the basis's smallest spacing, and here that wave runs at √(E/ρ) = {} (young = {}, density = {}): check that `young` and `density` are in one system of units (in SI, Pa and kg/m³: steel is 2e11 and 7800, 5.1e3 m/s; rubber 1e6 and 1000, 32 m/s); if they are, shorten `t_end` or coarsen the mesh",
-        format!("{:.2e}", (m.young / m.density).sqrt()),
+        "The critical step is the time the fastest wave takes to cross the basis's smallest spacing, and here that wave runs at √(E/ρ) = {:.2e} (young = {}, density = {}): check that `young` and `density` are in one system of units (in SI, Pa and kg/m³: steel is 2e11 and 7800, 5.1e3 m/s; rubber 1e6 and 1000, 32 m/s); if they are, shorten `t_end` or coarsen the mesh",
+        (m.young / m.density).sqrt(),
         short(m.young),
         short(m.density)
     )
