@@ -279,6 +279,11 @@ where
     /// middle of `courant` and `trigger` (a hysteresis: each change of the step's
     /// length near the critical step moves energy into the fastest modes). The
     /// step's end time and everything reported per step stay those of `Δt`.
+    /// Every step the watch also limits each particle's move per sub-step to
+    /// [`ADVECTION_SHARE`] of its element's width, and to [`CONTACT_SHARE`] of its
+    /// contact distance in a scene with a contact wall (the critical step knows
+    /// the stiffness, not the speed): the step takes the larger of the two counts
+    /// of sub-steps.
     /// Allocates the watch's buffers; call once, before the steps (after
     /// [`Driver::critical_time_step`], whose vector it starts from).
     pub fn watch_critical_step(&mut self, courant: f64, trigger: f64) {
@@ -519,10 +524,10 @@ where
 }
 
 /// The share of its element's width (smallest altitude) a particle may cross in
-/// one (sub-)step ([`Driver::advection_substeps`]).
+/// one (sub-)step ([`Driver::watch_critical_step`], the limit on the speeds).
 pub const ADVECTION_SHARE: f64 = 0.5;
-/// The share of its contact distance a particle within a contact wall's reach may
-/// cross in one (sub-)step ([`Driver::advection_substeps`]).
+/// The share of its contact distance a particle of a scene with a contact wall
+/// may cross in one (sub-)step ([`Driver::watch_critical_step`]).
 pub const CONTACT_SHARE: f64 = 0.25;
 /// Split steps return to fewer sub-steps for the speeds only where the particles'
 /// moves stay below this share of what they may cross.
