@@ -281,7 +281,7 @@ where
     /// step's end time and everything reported per step stay those of `Δt`.
     /// Every step the watch also limits each particle's move per sub-step to
     /// [`ADVECTION_SHARE`] of its element's width, and to [`CONTACT_SHARE`] of its
-    /// contact distance in a scene with a contact wall (the critical step knows
+    /// contact distance near a contact wall (the critical step knows
     /// the stiffness, not the speed): the step takes the larger of the two counts
     /// of sub-steps.
     /// Allocates the watch's buffers; call once, before the steps (after
@@ -307,8 +307,7 @@ where
             speed: 0.0,
             fastest: None,
             pending: (1, 1),
-            contact_walls: (0..self.basis.num_elements())
-                .any(|e| self.effects.iter().any(|f| f.walls_element(e))),
+            near_contact: self.near_contact_walls(),
             since_check: 0,
             interval: WATCH_EVERY,
             counts: (self.last_report.active, self.last_report.treated()),
@@ -356,8 +355,8 @@ where
 
     /// The sub-steps that keep every particle's move in a (sub-)step within
     /// [`ADVECTION_SHARE`] of its element's width (the smallest altitude), and,
-    /// in a scene with a contact wall, within [`CONTACT_SHARE`] of its contact
-    /// distance: the critical step knows the stiffness, not the speed, and
+    /// near a contact wall ([`Driver::near_contact_walls`]), within
+    /// [`CONTACT_SHARE`] of its contact distance: the critical step knows the stiffness, not the speed, and
     /// a fast body crosses elements, or a contact wall's reach, in one step (a
     /// soft block at 60 m/s moved 3.3 elements per step at `courant` 0.4 and
     /// passed through a slip wall; a contact wall's springs stop a body arriving
@@ -373,7 +372,8 @@ where
             &self.particles.volume0,
         );
         let width = &self.element_width;
-        let contact = self.watch.as_ref().is_some_and(|w| w.contact_walls);
+        let near = self.watch.as_ref().map_or(&[][..], |w| &w.near_contact[..]);
+        let contact = !near.is_empty();
         // The largest share of its allowed move a particle makes in `dt`, and its
         // speed (the larger share wins; ties to the lower particle: the same for
         // any thread count).
@@ -383,11 +383,17 @@ where
                 let speed = v[p].norm().to_f64();
                 let e = element[p];
                 let mut allowed = ADVECTION_SHARE * width[e];
-                // Every particle, not only those already within a wall's reach: a
-                // fast one crosses the reach in one step from outside it.
-                if contact {
+                // Not only the particles already within a wall's reach: one on
+                // the next ring crosses the reach in a step of half its element.
+                if contact && near[e] {
                     let d = crate::contact::contact_distance::<D>(volume0[p].to_f64());
                     allowed = allowed.min(CONTACT_SHARE * d);
+                }
+                // A speed that is not a number is the step's own failure to report
+                // (`StepError::NotFinite`), and an element without width has none to
+                // cross.
+                if speed.is_nan() || allowed <= 0.0 {
+                    return (0.0, speed, p);
                 }
                 (speed * dt / allowed, speed, p)
             })
@@ -424,7 +430,7 @@ where
                 _ => format!("`dt` to {:.2e}", shorter * dt),
             };
             let how_far = if contact {
-                "half its element's width, or a quarter of its contact distance in a scene with contact walls"
+                "half its element's width, or a quarter of its contact distance near a contact wall"
             } else {
                 "half its element's width"
             };
@@ -437,6 +443,30 @@ where
         }
         w.advection_substeps = k as usize;
         Ok(k as usize)
+    }
+
+    /// `near[e]`: element `e` lies within a contact wall's reach
+    /// ([`crate::effect::Effect::walls_element`]) or shares a function with one
+    /// that does (a particle there reaches the wall's reach within a sub-step of
+    /// half its element's width); empty without contact walls.
+    fn near_contact_walls(&self) -> Vec<bool> {
+        let n = self.basis.num_elements();
+        let walled: Vec<usize> = (0..n)
+            .filter(|&e| self.effects.iter().any(|f| f.walls_element(e)))
+            .collect();
+        if walled.is_empty() {
+            return Vec::new();
+        }
+        let mut near = vec![false; n];
+        for e in walled {
+            near[e] = true;
+            for &i in self.basis.element_functions(e) {
+                for &f in self.basis.function_support(i) {
+                    near[f] = true;
+                }
+            }
+        }
+        near
     }
 
     /// The sub-steps the critical step needs (1 when the watch is not due): at the
@@ -526,8 +556,8 @@ where
 /// The share of its element's width (smallest altitude) a particle may cross in
 /// one (sub-)step ([`Driver::watch_critical_step`], the limit on the speeds).
 pub const ADVECTION_SHARE: f64 = 0.5;
-/// The share of its contact distance a particle of a scene with a contact wall
-/// may cross in one (sub-)step ([`Driver::watch_critical_step`]).
+/// The share of its contact distance a particle near a contact wall may cross in
+/// one (sub-)step ([`Driver::watch_critical_step`]).
 pub const CONTACT_SHARE: f64 = 0.25;
 /// Split steps return to fewer sub-steps for the speeds only where the particles'
 /// moves stay below this share of what they may cross.
@@ -629,8 +659,9 @@ pub(super) struct Watch<T> {
     /// The sub-steps of the step under way for the critical step and for the
     /// speeds, booked once it completes ([`Driver::book_substeps`]).
     pub pending: (usize, usize),
-    /// The scene has a contact wall (an effect that walls an element).
-    pub contact_walls: bool,
+    /// The elements within a contact wall's reach and those sharing a function
+    /// with one ([`Driver::near_contact_walls`]); empty without contact walls.
+    pub near_contact: Vec<bool>,
     /// Steps since the last check.
     pub since_check: usize,
     /// Steps between checks, from [`WATCH_EVERY`] to [`WATCH_EVERY_MOST`].

@@ -1134,8 +1134,9 @@ fn succeeds(args: &[&str]) -> (String, String) {
 /// moved 3.3 elements per step (against a slip wall it passed through it). The
 /// watch splits its steps so that no particle crosses more than half its
 /// element's width in a sub-step, says so, and the free translation stays exact;
-/// toward a contact wall a quarter of the contact distance would take more than
-/// 64 sub-steps, and the run stops at step 1 naming the `courant` to take.
+/// toward a contact wall, a quarter of the contact distance near it would take
+/// more than 64 sub-steps, and the run stops as the block nears the wall, naming
+/// the `courant` to take.
 #[test]
 fn a_fast_body_is_stepped_within_its_elements() {
     let text = |wall: &str| {
@@ -1191,7 +1192,8 @@ t_end = 0.25
     );
     let walled = SceneFile::new(
         "fast-wall",
-        &text("[[effect]]\nkind = \"contact-wall\"\ntag = \"right\""),
+        &text("[[effect]]\nkind = \"contact-wall\"\ntag = \"right\"")
+            .replace("t_end = 0.25", "t_end = 0.4"),
     );
     let out = cli()
         .args(["run", walled.arg(), "--diag-every", "0"])
@@ -1200,7 +1202,7 @@ t_end = 0.25
     assert_eq!(out.status.code(), Some(1), "{out:?}");
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
-        stderr.contains("step 1: particle")
+        stderr.contains("moves at 6.000e1")
             && stderr.contains("more than the 64 sub-steps")
             && stderr.contains("lower `time.courant` to"),
         "{stderr}"
