@@ -163,6 +163,22 @@ where
                 );
             }
         }
+        // Thrown faster than its material's P-wave speed: the strains of an impact
+        // are of the order of `v / c`, beyond any elastic law, whatever the step
+        // or the particles (a user's soft block thrown at 5 times its wave speed
+        // at a wall was told to add particles, and inverted again with 4 times
+        // more). The scene's own speeds at the start, not a blow-up's.
+        let (lambda, mu) = self.material.elastic(particle).lame(D);
+        let density = (self.particles.mass[particle] / self.particles.volume0[particle]).to_f64();
+        let wave = ((lambda + 2.0 * mu) / density).sqrt();
+        if wave > 0.0 && self.initial_speed > wave {
+            let speed = self.particles.v[particle].norm().to_f64();
+            return format!(
+                "the element around it inverted (speed {speed:.3e}): the bodies started at up to {:.3e}, {:.1} times this material's P-wave speed √((λ + 2μ)/ρ) = {wave:.3e}, so an impact strains it by the order of that ratio, beyond what an elastic body survives whatever the step or the particles: if that is not the physics meant, check the speeds and the units of `young` and `density`",
+                self.initial_speed,
+                self.initial_speed / wave
+            );
+        }
         // A spinning or turning body of the paper's non-objective law: that law
         // first, then what else the driver sees.
         let rotated = self.non_objective_rotation(particle);

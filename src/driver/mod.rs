@@ -165,6 +165,9 @@ where
     /// Each element's width, its smallest altitude (the advection limit of the
     /// watch, [`Driver::watch_critical_step`]).
     element_width: Vec<f64>,
+    /// The largest particle speed at the start (the scene's own speeds, which a
+    /// blow-up's are not).
+    initial_speed: f64,
     constraints: Constraints<T, D>,
     effects: Vec<Box<dyn Effect<T, D>>>,
     pattern: SymmetricPattern,
@@ -423,6 +426,11 @@ where
             walled,
             fixed,
             element_width: critical::element_widths(&basis),
+            initial_speed: particles
+                .v
+                .iter()
+                .map(|v| v.norm().to_f64())
+                .fold(0.0, f64::max),
             inputs,
             last_condition: None,
             phases: PhaseTimes::default(),
@@ -704,8 +712,9 @@ where
                 // Half the step; for an impact (a fast particle) at most 0.25, which
                 // impacts on contact walls want: a disk dropped onto a contact floor
                 // at 0.8 went through again at the half, 0.4, and held at 0.25.
+                // The step the scene's `courant` sets, before any split.
                 let courant = self.dt_critical.map_or(String::new(), |critical| {
-                    let now = self.dt.to_f64() / critical;
+                    let now = self.dt_outer / critical;
                     let impact = moved >= 0.25 * distance;
                     let to = if impact { (0.5 * now).min(0.25) } else { 0.5 * now };
                     format!(
@@ -714,6 +723,25 @@ where
                         crate::scene::limits::echo_significant(to, 2)
                     )
                 });
+                // Steps split for the particles' speeds keep their sub-steps as the
+                // step shrinks, until `courant` falls below the sub-steps' own.
+                if let (Some((critical, speeds)), Some(c)) =
+                    (self.watch.as_ref().map(|w| w.pending), self.dt_critical)
+                {
+                    if speeds > critical.max(1) {
+                        let sub = self.dt.to_f64() / c;
+                        return StepError::ParticleLeftMesh {
+                            step: self.step + 1,
+                            particle: p,
+                            position: to_f64(&self.particles.x[p]),
+                            hint: format!(
+                                "it moved {moved:.3e} in the last sub-step at speed {speed:.3e}, {how}, and went through a contact wall, although the step was split {speeds} ways for the particles' speeds, each sub-step at a Courant number of {}: a `courant` above that changes nothing; take {} (a wall's springs are `m (κ/Δt)²` stiff, so half the sub-step makes them four times stiffer) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); an impact much faster than the body's wave speed √(E/ρ) crushes the body whatever the step; if the speed is unphysical, the run became unstable earlier (see the energy column)",
+                                crate::scene::limits::echo_significant(sub, 2),
+                                crate::scene::limits::echo_significant(0.5 * sub, 2)
+                            ),
+                        };
+                    }
+                }
                 format!(
                     "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )

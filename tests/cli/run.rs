@@ -1207,4 +1207,72 @@ t_end = 0.25
             && stderr.contains("lower `time.courant` to"),
         "{stderr}"
     );
+    // At the `courant` named the steps are split for the speed, and the body,
+    // at 27 times its wave speed, is pressed through the wall's springs: the
+    // message says that a `courant` above the sub-steps' own changes nothing.
+    let out = cli()
+        .args([
+            "run",
+            walled.arg(),
+            "--diag-every",
+            "0",
+            "--courant",
+            "0.14",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("went through a contact wall, although the step was split")
+            && stderr.contains("a `courant` above that changes nothing"),
+        "{stderr}"
+    );
+}
+
+/// A user's block thrown at 60 m/s, about 5 times its P-wave speed, at a slip
+/// wall: its elements invert at the impact, and the message was to add
+/// particles (which did not help). It now names the speed against the wave
+/// speed, a strain no elastic body survives, and the units to check.
+#[test]
+fn an_impact_faster_than_the_wave_speed_is_named_so() {
+    let file = SceneFile::new(
+        "supersonic",
+        r#"name = "supersonic"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 10.0]
+y = [0.0, 2.0]
+blocks = [40, 8]
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.0, 0.75]
+max = [1.5, 1.25]
+per_block = [4, 4]
+initial_velocity = { kind = "uniform", value = [60.0, 0.0] }
+[[boundary]]
+tag = "right"
+fix = ["normal"]
+[time]
+courant = 0.4
+t_end = 0.183
+"#,
+    );
+    let out = cli()
+        .args(["run", file.arg(), "--diag-every", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("inverted")
+            && stderr.contains("times this material's P-wave speed")
+            && !stderr.contains("use more particles per element"),
+        "{stderr}"
+    );
 }
