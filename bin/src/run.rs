@@ -812,20 +812,9 @@ pub fn long_run_note(scene: &psmpm::scene::Scene, steps: usize, dt: f64) -> Opti
         } else {
             // The fastest material's wave speed, with the units to check (a
             // density in g/cm³ beside a modulus in Pa runs 30 times too fast).
-            let fastest = (0..scene.bodies.len().max(1))
-                .map(|b| {
-                    let m = scene.body_material(b);
-                    let elastic = psmpm::material::Elastic {
-                        young: m.young,
-                        poisson: m.poisson,
-                        density: m.density,
-                    };
-                    (elastic.p_modulus(scene.dim) / m.density).sqrt()
-                })
-                .fold(0.0, f64::max);
             format!(
                 ": the step is the element size over the P-wave speed √((λ + 2μ) / ρ), {} here; if that is far above your material's speed of sound (in SI about 6e3 m/s for steel, 50 for rubber), check the units of `young` and `density`",
-                sci(fastest)
+                sci(scene.wave_speed())
             )
         };
         format!(

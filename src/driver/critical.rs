@@ -63,6 +63,22 @@ where
         self.power_iteration(Some(&lumped))
     }
 
+    /// `f = K v`, the small-strain stiffness of the particles' own materials
+    /// ([`stiffness_product`]).
+    fn apply_stiffness(&mut self, v: &[Vec<T>], f: &mut [Vec<T>]) {
+        let material = &self.material;
+        stiffness_product(
+            &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
+            &self.particles.volume,
+            |p| material.elastic(p).lame(D),
+            v,
+            f,
+        );
+    }
+
     /// `2 / √(a λ_max(M⁻¹K))` by power iteration from [`seed`], `M` the strategy's
     /// system (`None`) or the diagonal `lumped` (its zero entries, functions without
     /// particles, left out), `a` the effects' amplification of the forces. With the
@@ -80,17 +96,7 @@ where
             v.iter_mut()
                 .flat_map(|c| c.iter_mut())
                 .for_each(|a| *a /= T::of(nv));
-            let material = &self.material;
-            stiffness_product(
-                &self.evals,
-                &self.bins,
-                &self.gather,
-                &mut self.local,
-                &self.particles.volume,
-                |p| material.elastic(p).lame(D),
-                &v,
-                &mut f,
-            );
+            self.apply_stiffness(&v, &mut f);
             match lumped {
                 None => solve_with_walls(&mut self.mass, &mut self.constraints, &mut f)
                     .map_err(|source| self.mass_failure(source))?,
@@ -152,22 +158,11 @@ where
             next,
             scratch,
         } = buffers;
-        let material = &self.material;
-        let lame = |p: usize| material.elastic(p).lame(D);
         // r = start, u = K r, β₀ = √(rᵀ u).
         for (n, s) in next.iter_mut().zip(start.iter()) {
             n.copy_from_slice(s);
         }
-        stiffness_product(
-            &self.evals,
-            &self.bins,
-            &self.gather,
-            &mut self.local,
-            &self.particles.volume,
-            lame,
-            next,
-            k_current,
-        );
+        self.apply_stiffness(next, k_current);
         let mut beta = dot(next, k_current).max(0.0).sqrt();
         let (mut alpha, mut betas) = ([0.0; MAX_LANCZOS], [0.0; MAX_LANCZOS]);
         phases::zero(previous);
@@ -222,16 +217,7 @@ where
             }
             std::mem::swap(previous, current);
             m += 1;
-            stiffness_product(
-                &self.evals,
-                &self.bins,
-                &self.gather,
-                &mut self.local,
-                &self.particles.volume,
-                lame,
-                next,
-                k_current,
-            );
+            self.apply_stiffness(next, k_current);
             beta = dot(next, k_current).max(0.0).sqrt();
             // A Krylov space exhausted to round-off: T holds the whole spectrum.
             if beta.is_nan() || beta <= 1e-12 * a.abs() {
