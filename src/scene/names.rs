@@ -145,8 +145,9 @@ pub(crate) fn did_you_mean(message: String) -> String {
 /// The candidate nearest to `name` by the optimal string alignment distance
 /// (edits and transpositions), compared in lower case without `-`, `_` and
 /// spaces, when it is near enough to be a typo: none for names of up to 3
-/// letters (`nx` is not `x`), 1 edit up to 5, 2 up to 9, 3 beyond; `None` for
-/// none, or for `name` itself.
+/// letters (`nx` is not `x`), 1 edit up to 5, 2 up to 9, 3 beyond; else the
+/// longest candidate of 4 letters or more that `name` starts with (a long form,
+/// `youngs_modulus`); `None` for none, or for `name` itself.
 fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
     let plain = |s: &str| -> String {
         s.chars()
@@ -161,13 +162,26 @@ fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
         6..=9 => 2,
         _ => 3,
     };
-    candidates
+    let near = candidates
         .iter()
         .filter(|c| !c.is_empty() && **c != name)
         .map(|c| (strsim::osa_distance(&wanted, &plain(c)), *c))
         .filter(|(d, _)| *d <= allowed)
         .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
+        .map(|(_, c)| c);
+    // A long form of a name (`youngs_modulus`, `poisson_ratio`): the longest
+    // candidate of 4 letters or more that the name starts with.
+    near.or_else(|| {
+        candidates
+            .iter()
+            .filter(|c| **c != name)
+            .filter(|c| {
+                let c = plain(c);
+                c.chars().count() >= 4 && wanted.starts_with(&c)
+            })
+            .max_by_key(|c| plain(c).chars().count())
+            .copied()
+    })
 }
 
 #[cfg(test)]
@@ -190,6 +204,14 @@ mod tests {
             (
                 "unknown field `radious`, expected one of `shape`, `centre`, `radius`",
                 "(did you mean `radius`?)",
+            ),
+            (
+                "unknown field `youngs_modulus`, expected one of `model`, `young`, `poisson`, `density`",
+                "unknown field `youngs_modulus` (did you mean `young`?)",
+            ),
+            (
+                "unknown field `poisson_ratio`, expected one of `model`, `young`, `poisson`, `density`",
+                "(did you mean `poisson`?)",
             ),
             (
                 "unknown basis `PS` (known: ps, pl, bspline, pl1d)",

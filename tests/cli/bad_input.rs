@@ -404,7 +404,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .expect("mesh: unknown field `nx`, expected one of `x`, `y`, `blocks`, `layout`"),
         case("unknown-field-in-material", BAR)
             .edit("density = 1.0", "density = 1.0\n@@young_modulus = 3.0")
-            .expect("material.young_modulus: unknown field `young_modulus`, expected one of `model`, `young`, `poisson`, `density`"),
+            .expect("material.young_modulus: unknown field `young_modulus` (did you mean `young`?), expected one of `model`, `young`, `poisson`, `density`"),
         case("unknown-field-in-body", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, 4]\n@@speed = 1.0")
             .expect("body[0].speed: unknown field `speed` (did you mean `seed`?), expected one of `shape`, `min`, `max`, `outline`, `holes`, `centre`, `radius`, `file`, `surface`, `per_triangle`, `subdivide`, `per_block`, `count`, `spacing`, `jitter`, `seed`, `material`, `initial_velocity`"),
