@@ -627,7 +627,8 @@ pub(super) struct Watch<T> {
     pub latest_step: usize,
     /// The lowest estimate, with the step (1-based) and the time at which it was made.
     pub lowest: Option<(f64, usize, f64)>,
-    /// The sub-steps of the current step.
+    /// The sub-steps the critical step needs now ([`Driver::critical_substeps`]; the
+    /// step takes the larger of this and [`Watch::advection_substeps`]).
     pub substeps: usize,
     /// Steps taken in more than one sub-step for the critical step.
     pub split_steps: usize,
