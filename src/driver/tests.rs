@@ -52,16 +52,7 @@ fn hybrid_block_with(
     mass: &str,
     v: impl Fn(nalgebra::Vector2<f64>) -> nalgebra::Vector2<f64>,
     extra: &[nalgebra::Vector2<f64>],
-) -> super::Driver<
-    f64,
-    2,
-    psmpm_basis::basis::powell_sabin::PowellSabin<f64>,
-    Box<dyn crate::mass::MassStrategy<f64>>,
-    NeoHookean,
-> {
-    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
-    let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 1.0, 0.0, 1.0, 4, 4).unwrap();
-    let basis = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+) -> HybridDriver {
     let (n, h) = (10usize, 0.05);
     let x: Vec<_> = (0..n * n)
         .map(|p| {
@@ -72,9 +63,28 @@ fn hybrid_block_with(
         })
         .chain(extra.iter().copied())
         .collect();
+    ps_driver(1.0, 4, x, h * h, 1e3, mass, v)
+}
+
+/// A PS driver on `[0, extent]²` in `blocks × blocks` blocks, neo-Hookean
+/// (E = 1e4, ν = 0.3, `density`), with particles at `x` of volume `volume` each,
+/// velocity `v`, and the mass strategy `mass`.
+fn ps_driver(
+    extent: f64,
+    blocks: usize,
+    x: Vec<nalgebra::Vector2<f64>>,
+    volume: f64,
+    density: f64,
+    mass: &str,
+    v: impl Fn(nalgebra::Vector2<f64>) -> nalgebra::Vector2<f64>,
+) -> HybridDriver {
+    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+    let mesh = psmpm_basis::mesh::generators::block_grid(0.0, extent, 0.0, extent, blocks, blocks)
+        .unwrap();
+    let basis = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
     let np = x.len();
-    let constants = Elastic::new(1e4, 0.3, 1e3).unwrap();
-    let mut particles = crate::particles::Particles::new(x, vec![h * h; np], constants.density);
+    let constants = Elastic::new(1e4, 0.3, density).unwrap();
+    let mut particles = crate::particles::Particles::new(x, vec![volume; np], constants.density);
     for p in 0..np {
         particles.v[p] = v(particles.x[p]);
     }
@@ -259,27 +269,13 @@ fn the_affine_correction_keeps_the_total_momentum() {
 /// conditioned.
 #[test]
 fn a_body_sampled_on_the_mesh_edges_keeps_the_default_system_definite() {
-    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
-    let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 2.0, 0.0, 2.0, 8, 8).unwrap();
-    let basis = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
     let h = 0.125;
     let x: Vec<_> = (0..49)
         .map(|p| nalgebra::Vector2::new(0.25 + (p % 7) as f64 * h, 0.25 + (p / 7) as f64 * h))
         .collect();
-    let np = x.len();
-    let constants = Elastic::new(1e4, 0.3, 1.0).unwrap();
-    let particles = crate::particles::Particles::new(x, vec![h * h; np], constants.density);
-    let strategy = crate::mass::MassKind::parse("default").unwrap().build();
-    let mut driver = super::Driver::new(
-        basis,
-        particles,
-        NeoHookean::new(constants, 2),
-        strategy,
-        &[],
-        Vec::new(),
-        1e-9,
-    )
-    .unwrap();
+    let mut driver = ps_driver(2.0, 8, x, h * h, 1.0, "default", |_| {
+        nalgebra::Vector2::zeros()
+    });
     let critical = driver
         .critical_time_step()
         .expect("the start's mass system solves");

@@ -543,32 +543,14 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
     }
 }
 
-/// What sets a critical step too small for the run: the fastest wave speed
-/// `√(E/ρ)` of the scene's materials, with the units to check (a modulus in Pa
+/// What sets a critical step too small for the run: the scene's fastest P-wave
+/// speed ([`Scene::wave_speed`]), with the units to check (a modulus in Pa
 /// beside a density in g/cm³ gives a wave 30 times too fast, a step 30 times too
 /// short) and the fixes that keep the physics.
 fn wave_speed_hint(scene: &Scene) -> String {
-    use crate::scene::limits::echo_number;
-    // The shorter of the plain and the exponent forms (2e11, 7.8).
-    let short = |x: f64| {
-        let (plain, exponent) = (echo_number(x), format!("{x:e}"));
-        if exponent.len() < plain.len() {
-            exponent
-        } else {
-            plain
-        }
-    };
-    let fastest = (0..scene.bodies.len().max(1))
-        .map(|b| scene.body_material(b))
-        .max_by(|a, b| (a.young / a.density).total_cmp(&(b.young / b.density)));
-    let Some(m) = fastest else {
-        return String::new();
-    };
     format!(
-        "The critical step is the time the fastest wave takes to cross the basis's smallest spacing, and here that wave runs at √(E/ρ) = {:.2e} (young = {}, density = {}): check that `young` and `density` are in one system of units (in SI, Pa and kg/m³: steel is 2e11 and 7800, 5.1e3 m/s; rubber 1e6 and 1000, 32 m/s); if they are, shorten `t_end` or coarsen the mesh",
-        (m.young / m.density).sqrt(),
-        short(m.young),
-        short(m.density)
+        "The critical step is the time the fastest wave takes to cross the basis's smallest spacing, and here the materials' fastest P-wave speed √((λ + 2μ)/ρ) is {:.2e}: check that `young` and `density` are in one system of units (in SI, Pa and kg/m³: about 6e3 m/s for steel, 50 for rubber); if they are, shorten `t_end` or coarsen the mesh",
+        scene.wave_speed()
     )
 }
 
