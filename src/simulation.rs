@@ -25,7 +25,7 @@ pub use crate::arrangement::{
 };
 use crate::body_contact::PerBody;
 use crate::diagnostics::Verdict;
-use crate::driver::{PhaseTimes, StepError, StepReport};
+use crate::driver::{BodySampling, PhaseTimes, StepError, StepReport};
 use crate::particles::Particles;
 use crate::scene::limits::{echo_fixed, echo_number};
 use crate::scene::{Scene, SceneError};
@@ -403,6 +403,8 @@ struct Tally {
     max_rotation_non_objective: f64,
     /// Particles per occupied element at the start.
     sampling: f64,
+    /// The worst-sampled body at the start.
+    sampled: Sampled,
     /// [`stray_particles`] at the start.
     stray_at_start: usize,
     /// The number of [`pieces`] at the start.
@@ -587,12 +589,81 @@ pub fn particle_keys(scene: &Scene) -> &'static str {
     }
 }
 
-/// The warning for bodies sampled by `sampling` particles per occupied element at
-/// the start, if that is below [`SPARSE_SAMPLING`]; `keys` from [`particle_keys`].
-pub fn sparse_sampling_warning(sampling: f64, keys: &str) -> Option<String> {
-    (sampling < SPARSE_SAMPLING).then(|| {
+/// The worst-sampled body at the start, as the sampling warnings name it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sampled {
+    /// Its particles per element of the mesh under it ([`BodySampling::per_element`]).
+    pub value: f64,
+    /// `(body, bodies)` where the bodies are sampled differently; `None` for one
+    /// body or bodies sampled alike (within [`SAMPLING_ALIKE`]).
+    body: Option<(usize, usize)>,
+    sampling: BodySampling,
+}
+
+/// Bodies whose particles per element differ by less than this factor are
+/// sampled alike: the sampling warnings speak of "the bodies".
+pub const SAMPLING_ALIKE: f64 = 1.1;
+
+impl Sampled {
+    /// The worst-sampled of `bodies` (the first of equals).
+    pub fn of(bodies: &[BodySampling]) -> Self {
+        let worst = (0..bodies.len())
+            .min_by(|&a, &b| bodies[a].per_element().total_cmp(&bodies[b].per_element()))
+            .unwrap_or(0);
+        let sampling = bodies.get(worst).copied().unwrap_or(BodySampling {
+            per_occupied: 0.0,
+            volume_over_elements: 1.0,
+        });
+        let value = sampling.per_element();
+        let alike = bodies
+            .iter()
+            .all(|b| b.per_element() <= SAMPLING_ALIKE * value && !b.fills_in_part());
+        Sampled {
+            value,
+            body: (bodies.len() > 1 && !alike).then_some((worst, bodies.len())),
+            sampling,
+        }
+    }
+
+    /// One body (or bodies alike) whose particles fill their elements, sampled by
+    /// `value` particles per occupied element.
+    pub fn uniform(value: f64) -> Self {
+        Self::of(&[BodySampling {
+            per_occupied: value,
+            volume_over_elements: 1.0,
+        }])
+    }
+
+    /// "the bodies are sampled by 1.00 particles per occupied element at the start",
+    /// naming the body where they differ and saying why where elements between its
+    /// particles hold none; `element` names the mesh's elements.
+    fn phrase(&self, element: &str, digits: usize) -> String {
+        let (who, it, its) = match self.body {
+            None => ("the bodies are".to_string(), "them", "their"),
+            Some((b, n)) => (format!("body {} of {n} is", b + 1), "it", "its"),
+        };
+        let value = self.value;
+        if self.sampling.fills_in_part() {
+            format!(
+                "{who} sampled by {value:.digits$} particles per {element} under {it} at the start ({:.2} per {element} holding one of {its} particles, whose volume is {:.1} times the size of those {element}s: the {element}s between {its} particles hold none)",
+                self.sampling.per_occupied, self.sampling.volume_over_elements
+            )
+        } else {
+            format!(
+                "{who} sampled by {value:.digits$} particles per occupied {element} at the start"
+            )
+        }
+    }
+}
+
+/// The warning for a body sampled by about one particle per element or fewer at
+/// the start ([`Sampled::value`] below [`SPARSE_SAMPLING`]); `keys` from
+/// [`particle_keys`].
+pub fn sparse_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
+    (sampled.value < SPARSE_SAMPLING).then(|| {
         format!(
-            "the bodies are sampled by {sampling:.2} particles per occupied element at the start: with about one particle per element or fewer, the elements between particles hold none, the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element ({keys})"
+            "{}: with about one particle per element or fewer, the elements between particles hold none, the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element ({keys})",
+            sampled.phrase("element", 2)
         )
     })
 }
@@ -697,18 +768,24 @@ pub fn spin_loss_warning(scene: &Scene, start: Spin, end: Spin) -> Option<String
 /// error can grow with refinement.
 pub const PS_SAMPLING: f64 = 3.0;
 
-/// The warning for a PS body sampled by `sampling` particles per occupied triangle,
-/// if that is below [`PS_SAMPLING`] (and not already below [`SPARSE_SAMPLING`]).
+/// The warning for a PS body sampled by fewer than [`PS_SAMPLING`] particles per
+/// triangle (and not already below [`SPARSE_SAMPLING`]).
 /// Measured on `scenes/column-large.toml` (default mass, `--courant 0.5`), 3 × 3
 /// particles per block (2.25 per triangle) on 1 × 10, 2 × 20, 4 × 40 blocks:
 /// UNSTABLE, then det F failures at steps 2441 and 3057; 6 × 6 per block: stable,
 /// E_u 2.7e-4, 1.2e-4, 1.1e-4.
 ///
 /// `keys` from [`particle_keys`].
-pub fn ps_sampling_warning(sampling: f64, keys: &str) -> Option<String> {
-    (SPARSE_SAMPLING..PS_SAMPLING).contains(&sampling).then(|| {
+pub fn ps_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
+    (SPARSE_SAMPLING..PS_SAMPLING).contains(&sampled.value).then(|| {
+        let edges = if sampled.sampling.fills_in_part() {
+            ""
+        } else {
+            "; a body whose edges cut triangles fills those in part, which lowers this average below what its lattice gives inside: place its edges on block lines, or give more per block"
+        };
         format!(
-            "the bodies are sampled by {sampling:.2} particles per occupied triangle at the start, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle ({keys}; `per_block` 4 × 4 on block meshes); a body whose edges cut triangles fills those in part, which lowers this average below what its lattice gives inside: place its edges on block lines, or give more per block"
+            "{}, fewer than the 3 a PS triangle needs (each holds 9 functions, quadratic on its Powell–Sabin sub-triangles): the sums over particles no longer integrate them, and the error can grow as the mesh is refined (B5b's column with 2.25 per triangle fails on 2 × 20 and 4 × 40 blocks, with 9 per triangle its E_u falls to 1.1e-4); use 3 or more per triangle ({keys}; `per_block` 4 × 4 on block meshes){edges}",
+            sampled.phrase("triangle", 2)
         )
     })
 }
@@ -808,6 +885,7 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
+    let sampled = Sampled::of(&driver.sampling_by_body(&run.body_sizes));
     let at_start = fragments(&driver.particles, &run.body_sizes);
     let (stray_at_start, pieces_at_start) = (at_start.stray, at_start.pieces.len());
     let spin_at_start = Spin::of(&driver.particles);
@@ -896,6 +974,7 @@ where
         max_rotation,
         max_rotation_non_objective,
         sampling,
+        sampled,
         spin_at_start,
         stray_at_start,
         pieces_at_start,
@@ -1287,7 +1366,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(split_steps_warning(scene, run.dt, run.dt_critical, watched))
                 .chain(self_weight.clone())
-                .chain(sparse_sampling_warning(tally.sampling, keys))
+                .chain(sparse_sampling_warning(&tally.sampled, keys))
                 .chain(dense_sampling_warning(tally.sampling, keys))
                 .chain(
                     failure
@@ -1303,7 +1382,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .chain(
                     (scene.basis == crate::bases::BasisKind::Ps)
-                        .then(|| ps_sampling_warning(tally.sampling, keys))
+                        .then(|| ps_sampling_warning(&tally.sampled, keys))
                         .flatten(),
                 )
                 .chain(body_contact_warning(scene))
@@ -1397,7 +1476,8 @@ mod tests {
             both.contains("`per_block`") && both.contains("`subdivide`"),
             "{both}"
         );
-        let w = sparse_sampling_warning(1.0, particle_keys(&scene(gmsh))).unwrap();
+        let w =
+            sparse_sampling_warning(&Sampled::uniform(1.0), particle_keys(&scene(gmsh))).unwrap();
         assert!(
             w.contains("(`per_triangle` and `subdivide` of the Gmsh bodies)"),
             "{w}"

@@ -16,6 +16,7 @@ pub const SLIVER_ASPECT: f64 = 20.0;
 use crate::mass::{MassError, MassStrategy, SupportFacts};
 use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
+use nalgebra::SVector;
 use psmpm_basis::Basis;
 use psmpm_basis::BasisError;
 
@@ -109,6 +110,48 @@ where
             .count()
             .max(1);
         self.particles.len() as f64 / occupied as f64
+    }
+
+    /// How each body is sampled at the last location (`body_sizes`: the numbers of
+    /// particles of the bodies, whose particles follow each other in that order;
+    /// empty or not adding up: one body).
+    pub fn sampling_by_body(&self, body_sizes: &[usize]) -> Vec<BodySampling> {
+        let n = self.particles.len();
+        let sizes = if body_sizes.iter().sum::<usize>() == n && !body_sizes.is_empty() {
+            body_sizes.to_vec()
+        } else {
+            vec![n]
+        };
+        let mut seen = vec![usize::MAX; self.basis.num_elements()];
+        let mut pieces = Vec::new();
+        let mut first = 0;
+        sizes
+            .iter()
+            .enumerate()
+            .map(|(b, &size)| {
+                let (mut occupied, mut size_of_elements, mut volume) = (0usize, 0.0, 0.0);
+                for p in first..first + size {
+                    volume += self.particles.volume0[p].to_f64();
+                    let e = self.particles.element[p];
+                    if seen[e] != b {
+                        seen[e] = b;
+                        occupied += 1;
+                        pieces.clear();
+                        self.basis.polynomial_pieces(e, &mut pieces);
+                        size_of_elements += pieces.chunks(D + 1).map(simplex_measure).sum::<f64>();
+                    }
+                }
+                first += size;
+                BodySampling {
+                    per_occupied: size as f64 / occupied.max(1) as f64,
+                    volume_over_elements: if size_of_elements > 0.0 {
+                        volume / size_of_elements
+                    } else {
+                        1.0
+                    },
+                }
+            })
+            .collect()
     }
 
     /// The basis's largest number of functions on one element.
@@ -549,4 +592,52 @@ pub(crate) fn point(x: &[f64]) -> String {
         })
         .collect();
     format!("[{}]", coordinates.join(", "))
+}
+
+/// How one body is sampled ([`Driver::sampling_by_body`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodySampling {
+    /// Its particles per element holding at least one of them.
+    pub per_occupied: f64,
+    /// Its particles' volume over the size (area, length) of the elements holding
+    /// them: about 1 for a body whose particles fill their elements, below where
+    /// the body's edges cut elements, above where elements between its particles
+    /// hold none (a lattice coarser than the mesh: 4 for one particle per block of
+    /// four triangles).
+    pub volume_over_elements: f64,
+}
+
+/// A body's particles whose volume exceeds the size of the elements holding them
+/// by more than this factor leave elements between them empty (jittered lattices
+/// and round-off stay near 1).
+pub const EMPTY_BETWEEN: f64 = 1.25;
+
+impl BodySampling {
+    /// Whether elements between its particles hold none: their volume exceeds
+    /// the size of the elements that hold them by more than [`EMPTY_BETWEEN`].
+    pub fn fills_in_part(&self) -> bool {
+        self.volume_over_elements > EMPTY_BETWEEN
+    }
+
+    /// Its particles per element of the mesh under it: per occupied element,
+    /// divided by [`volume_over_elements`](Self::volume_over_elements) where
+    /// elements between its particles hold none.
+    pub fn per_element(&self) -> f64 {
+        if self.fills_in_part() {
+            self.per_occupied / self.volume_over_elements
+        } else {
+            self.per_occupied
+        }
+    }
+}
+
+/// The measure of a simplex of `D + 1` points (a length, an area).
+fn simplex_measure<const D: usize>(s: &[SVector<f64, D>]) -> f64 {
+    match D {
+        1 => (s[1] - s[0]).norm(),
+        _ => {
+            let (u, w) = (s[1] - s[0], s[2] - s[0]);
+            0.5 * (u[0] * w[1] - u[1] * w[0]).abs()
+        }
+    }
 }

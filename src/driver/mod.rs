@@ -35,7 +35,7 @@ pub use critical::{
     WATCH_ITERATIONS, WATCH_SEED_SHARE,
 };
 pub(crate) use failure::point;
-pub use failure::{SetupError, StepError, NEARLY_SINGULAR};
+pub use failure::{BodySampling, SetupError, StepError, NEARLY_SINGULAR};
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
