@@ -502,6 +502,43 @@ pub fn self_weight_warning<const D: usize>(
     })
 }
 
+/// A density from which a material is a solid of metal, rock, concrete or soil in
+/// kg/m³ ([`dense_gel_warning`]).
+pub const DENSE_SOLID: f64 = 1500.0;
+/// The P-wave speed below which such a dense material is as soft as a gel: steel
+/// with `young` in MPa (2.1e5) runs at 5.2 m/s, concrete (3e4 MPa) at 4 m/s, the
+/// softest clays in Pa at about 25 m/s.
+pub const GEL_WAVE_SPEED: f64 = 10.0;
+
+/// The warning for a body as dense as a metal, rock or soil in kg/m³ whose P-wave
+/// speed `√((λ + 2μ)/ρ)` is that of a gel: most often `young` in MPa or kPa beside
+/// `density` in kg/m³ (a user's steel cantilever with E = 2.1e5 sagged until it
+/// left the mesh, told to add a wall).
+pub fn dense_gel_warning(scene: &Scene) -> Option<String> {
+    (0..scene.bodies.len()).find_map(|b| {
+        let m = scene.body_material(b);
+        let e = crate::material::Elastic {
+            young: m.young,
+            poisson: m.poisson,
+            density: m.density,
+        };
+        let speed = (e.p_modulus(scene.dim) / m.density).sqrt();
+        (m.density >= DENSE_SOLID && speed < GEL_WAVE_SPEED).then(|| {
+            let who = if scene.bodies.len() > 1 {
+                format!("body {}'s material", b + 1)
+            } else {
+                "the material".to_string()
+            };
+            format!(
+                "{who} is as dense as a metal, rock or soil in kg/m³ (density = {}) and as soft as a gel (young = {:e}: a P-wave speed of {speed:.1} m/s, where steel has about 5900 and soils 100 or more): if `young` is in MPa, write it in Pa ({:e} here: × 1e6), in kPa × 1e3",
+                echo_number(m.density),
+                m.young,
+                m.young * 1e6,
+            )
+        })
+    })
+}
+
 /// The warning for a geostatic stress over bodies of several densities of which
 /// some are Gmsh bodies: a Gmsh body has no region the other bodies' weight can be
 /// integrated over, so it starts with its own density times the depth, and a layer
@@ -1366,6 +1403,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .chain(end_time_warning(scene, run.dt, run.steps))
                 .chain(split_steps_warning(scene, run.dt, run.dt_critical, watched))
                 .chain(self_weight.clone())
+                .chain(dense_gel_warning(scene))
                 .chain(sparse_sampling_warning(&tally.sampled, keys))
                 .chain(dense_sampling_warning(tally.sampling, keys))
                 .chain(
@@ -1482,6 +1520,28 @@ mod tests {
             w.contains("(`per_triangle` and `subdivide` of the Gmsh bodies)"),
             "{w}"
         );
+    }
+
+    /// A material as dense as steel and as soft as a gel is warned about (`young`
+    /// in MPa beside `density` in kg/m³); steel in Pa, a soft clay in Pa and a
+    /// unitless teaching scene are not.
+    #[test]
+    fn young_in_mpa_beside_a_density_in_kg_per_m3_is_warned_about() {
+        let scene = |young: f64, density: f64| {
+            Scene::from_toml(
+                &format!("name = \"u\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"blocks\"\nx = [0.0, 1.0]\ny = [0.0, 1.0]\nblocks = [2, 2]\n[material]\nyoung = {young:e}\ndensity = {density:e}\n[[body]]\nmin = [0.0, 0.0]\nmax = [1.0, 0.5]\ncount = [2, 2]\n[time]\ndt = 0.1\nt_end = 1.0\n"),
+                "u.toml",
+            )
+            .unwrap()
+        };
+        let w = dense_gel_warning(&scene(2.1e5, 7850.0)).expect("steel in MPa");
+        assert!(
+            w.contains("a P-wave speed of 5.2 m/s") && w.contains("write it in Pa (2.1e11 here"),
+            "{w}"
+        );
+        assert!(dense_gel_warning(&scene(2.1e11, 7850.0)).is_none());
+        assert!(dense_gel_warning(&scene(1e6, 1800.0)).is_none());
+        assert!(dense_gel_warning(&scene(100.0, 1.0)).is_none());
     }
 
     /// Gmsh layers of two densities under a geostatic stress are warned about; box
