@@ -891,6 +891,10 @@ impl Scene {
     /// A TOML parse error, located in the file.
     fn parse_error(text: &str, file: &str, e: &toml::de::Error) -> SceneFileError {
         let (at, field, message) = locate::parse_error(text, e);
+        let (field, message) = match missing_sections(text, e.message().trim()) {
+            Some((first, message)) => (Some(first), message),
+            None => (field, message),
+        };
         let (line, column) = locate::line_column(text, at);
         SceneFileError {
             file: file.to_string(),
@@ -905,6 +909,87 @@ impl Scene {
     /// The scene as TOML that [`Scene::from_toml`] reads back.
     pub fn to_toml(&self) -> String {
         toml::to_string(self).unwrap_or_else(|e| format!("# cannot serialise: {e}\n"))
+    }
+}
+
+/// The top-level keys and sections every scene file gives, with what to write for
+/// each (`docs/scenes.md` has them all).
+const REQUIRED_TOP_LEVEL: [(&str, &str); 7] = [
+    ("name", "`name = \"my-scene\"`"),
+    ("dim", "`dim = 2` (or 1)"),
+    (
+        "basis",
+        "`basis = \"ps\"` (2D: `ps`, `pl`; 1D: `bspline`, `pl1d`)",
+    ),
+    (
+        "mesh",
+        "a `[mesh]` section (`kind = \"blocks\"` with `x`, `y` and `blocks`; or `interval`, `polygon`, `gmsh`)",
+    ),
+    (
+        "material",
+        "a `[material]` section (`young`, `poisson`, `density`), or a `material` table in every `[[body]]`",
+    ),
+    (
+        "body",
+        "a `[[body]]` section per body (`min`, `max` and `per_block`, or a `shape`)",
+    ),
+    (
+        "time",
+        "a `[time]` section (`t_end`, and `courant = 0.5` or `dt`)",
+    ),
+];
+
+/// Where the parser reports a missing top-level key or section (it names the first
+/// only, at the top of the file): every missing one, each with what to write, and
+/// the first as the field.
+fn missing_sections(text: &str, message: &str) -> Option<(String, String)> {
+    let reported = message.strip_prefix("missing field `")?.strip_suffix('`')?;
+    let table = text.parse::<toml::Table>().ok()?;
+    let missing: Vec<&(&str, &str)> = REQUIRED_TOP_LEVEL
+        .iter()
+        .filter(|(key, _)| !table.contains_key(*key))
+        .collect();
+    if !missing.iter().any(|(key, _)| *key == reported) {
+        return None;
+    }
+    if missing.len() == REQUIRED_TOP_LEVEL.len() {
+        return Some((
+            "name".to_string(),
+            "the file holds none of a scene's keys and sections (`name`, `dim`, `basis`, [mesh], [material], [[body]], [time]): start from a whole scene, `mpm-cli scene show column-small` (docs/scenes.md lists every key)".to_string(),
+        ));
+    }
+    let names: Vec<String> = missing
+        .iter()
+        .map(|(key, _)| match *key {
+            "mesh" | "material" | "time" => format!("[{key}]"),
+            "body" => "[[body]]".to_string(),
+            _ => format!("`{key}`"),
+        })
+        .collect();
+    let adds: Vec<&str> = missing.iter().map(|(_, add)| *add).collect();
+    Some((
+        missing[0].0.to_string(),
+        format!(
+            "the scene has no {}: add {} (docs/scenes.md lists every key; `mpm-cli scene show column-small` prints a whole scene)",
+            join_and(&names),
+            adds.join("; ")
+        ),
+    ))
+}
+
+/// "a", "a and b", "a, b and c".
+fn join_and(items: &[impl AsRef<str>]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.as_ref().to_string(),
+        [init @ .., last] => format!(
+            "{} and {}",
+            init.iter()
+                .map(|s| s.as_ref())
+                .collect::<Vec<_>>()
+                .join(", "),
+            last.as_ref()
+        ),
     }
 }
 

@@ -982,7 +982,7 @@ fn missing_cases() -> Vec<Case> {
         case("missing-name", BAR)
             .edit("# A small", "@@# A small")
             .edit("name = \"bar\"\n", "")
-            .expect("missing field `name`"),
+            .expect("the scene has no `name`: add `name = \"my-scene\"` (docs/scenes.md lists every key; `mpm-cli scene show column-small` prints a whole scene)"),
         case("missing-material", BAR)
             .edit("[material]\nmodel = \"linear-elastic\"\nyoung = 100.0\npoisson = 0.25\ndensity = 1.0\n", "")
             .edit("[[body]]", "@@[[body]]")
@@ -990,11 +990,16 @@ fn missing_cases() -> Vec<Case> {
         case("missing-body", BAR)
             .edit("# A small", "@@# A small")
             .edit("[[body]]\nmin = [0.0, 0.0]\nmax = [4.0, 1.0]\nper_block = [4, 4]\n", "")
-            .expect("missing field `body`"),
+            .expect("the scene has no [[body]]: add a `[[body]]` section per body (`min`, `max` and `per_block`, or a `shape`) (docs/scenes.md lists every key; `mpm-cli scene show column-small` prints a whole scene)"),
         case("missing-time", BAR)
             .edit("# A small", "@@# A small")
             .edit("[time]\ndt = 1e-3\nt_end = 0.01\n", "")
-            .expect("missing field `time`"),
+            .expect("the scene has no [time]: add a `[time]` section (`t_end`, and `courant = 0.5` or `dt`) (docs/scenes.md lists every key; `mpm-cli scene show column-small` prints a whole scene)"),
+        case("missing-time-and-body", BAR)
+            .edit("# A small", "@@# A small")
+            .edit("[[body]]\nmin = [0.0, 0.0]\nmax = [4.0, 1.0]\nper_block = [4, 4]\n", "")
+            .edit("[time]\ndt = 1e-3\nt_end = 0.01\n", "")
+            .expect("the scene has no [[body]] and [time]: add a `[[body]]` section per body (`min`, `max` and `per_block`, or a `shape`); a `[time]` section (`t_end`, and `courant = 0.5` or `dt`) (docs/scenes.md lists every key; `mpm-cli scene show column-small` prints a whole scene)"),
         case("missing-young", BAR)
             .edit("[material]", "@@[material]")
             .edit("young = 100.0\n", "")
@@ -1021,7 +1026,7 @@ fn missing_cases() -> Vec<Case> {
             .expect("effect[0].g: missing field `g`"),
         case("empty-file", "")
             .map(|_| "@@".into())
-            .expect("missing field `name`"),
+            .expect("the file holds none of a scene's keys and sections (`name`, `dim`, `basis`, [mesh], [material], [[body]], [time]): start from a whole scene, `mpm-cli scene show column-small` (docs/scenes.md lists every key)"),
     ]
 }
 
