@@ -144,8 +144,9 @@ pub(crate) fn did_you_mean(message: String) -> String {
 
 /// The candidate nearest to `name` by the optimal string alignment distance
 /// (edits and transpositions), compared in lower case without `-`, `_` and
-/// spaces, when it is near enough to be a typo: none for names of up to 3
-/// letters (`nx` is not `x`), 1 edit up to 5, 2 up to 9, 3 beyond; else the
+/// spaces, when it is near enough to be a typo: none for names of up to 2
+/// letters (`nx` is not `x`), 1 edit up to 5 (`pll` is `pl`), 2 up to 9, 3
+/// beyond; else the
 /// longest candidate of 4 letters or more that `name` starts with (a long form,
 /// `youngs_modulus`); `None` for none, or for `name` itself.
 fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
@@ -157,8 +158,8 @@ fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
     };
     let wanted = plain(name);
     let allowed = match wanted.chars().count() {
-        0..=3 => 0,
-        4..=5 => 1,
+        0..=2 => 0,
+        3..=5 => 1,
         6..=9 => 2,
         _ => 3,
     };
@@ -212,6 +213,10 @@ mod tests {
             (
                 "unknown field `poisson_ratio`, expected one of `model`, `young`, `poisson`, `density`",
                 "(did you mean `poisson`?)",
+            ),
+            (
+                "unknown basis `pll` (known: ps, pl, bspline, pl1d)",
+                "unknown basis `pll` (did you mean `pl`?) (known: ps, pl, bspline, pl1d)",
             ),
             (
                 "unknown basis `PS` (known: ps, pl, bspline, pl1d)",
