@@ -428,12 +428,19 @@ pub const UNSEEN_KINETIC: f64 = 0.05;
 /// Measured on a user's block dropped 1 m onto a slip floor (PS, default mass): 424
 /// J of `kinetic` against 60 J of motion after the bounce, out of 3 125 J; the block
 /// still rebounds to 75 % of its drop's potential energy.
-pub fn unseen_velocity_warning(unseen: (f64, f64, f64), scale: f64) -> Option<String> {
+/// `walls`: the scene has walls (fixed or contact), which the message then speaks
+/// of; without, of bodies striking each other.
+pub fn unseen_velocity_warning(unseen: (f64, f64, f64), scale: f64, walls: bool) -> Option<String> {
     use crate::scene::limits::echo_significant;
     let (extra, time, kinetic) = unseen;
+    let held = if walls {
+        "a body rebounding from a wall gets most of it back (taking it out at the walls makes impacts plastic: docs/stability.md, \"The walls take no impulse from the particles\")"
+    } else {
+        "bodies that part after striking each other get most of it back"
+    };
     (scale > 0.0 && extra > UNSEEN_KINETIC * scale).then(|| {
         format!(
-            "at t = {} the particles' velocities held {} of kinetic energy of which {} ({:.0} % of the energy scale) moved no particle: the update of eq. (18) carries from step to step the velocity the basis does not see (after impacts above all), and `kinetic`, the energy balance and the verdict count it; `kinetic_motion` (diagnostics.csv, --format json) is the kinetic energy of the motion. That energy is held, not lost: a body rebounding from a wall gets most of it back (taking it out at the walls makes impacts plastic: docs/stability.md, \"The walls take no impulse from the particles\")",
+            "at t = {} the particles' velocities held {} of kinetic energy of which {} ({:.0} % of the energy scale) moved no particle: the update of eq. (18) carries from step to step the velocity the basis does not see (after impacts above all), and `kinetic`, the energy balance and the verdict count it; `kinetic_motion` (diagnostics.csv, --format json) is the kinetic energy of the motion. That energy is held, not lost: {held}",
             echo_significant(time, 5),
             echo_significant(kinetic, 4),
             echo_significant(extra, 4),
@@ -1425,7 +1432,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .chain(body_contact_warning(scene))
                 .chain(layered_gmsh_geostatic_warning(scene))
-                .chain(unseen_velocity_warning(tally.unseen, tally.verdict.scale()))
+                .chain(unseen_velocity_warning(
+                    tally.unseen,
+                    tally.verdict.scale(),
+                    scene.contact_walls() || scene.boundaries.iter().any(|b| !b.fix.is_empty()),
+                ))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .chain(crate::arrangement::irregularity_warning(
                     &irregularity,
@@ -1482,13 +1493,13 @@ mod tests {
 
     #[test]
     fn velocity_that_moves_no_particle_is_warned_about_above_its_share() {
-        assert!(unseen_velocity_warning((4.9, 0.5, 100.0), 100.0).is_none());
-        let w = unseen_velocity_warning((483.9, 0.49155, 1887.0), 2500.0).unwrap();
+        assert!(unseen_velocity_warning((4.9, 0.5, 100.0), 100.0, true).is_none());
+        let w = unseen_velocity_warning((483.9, 0.49155, 1887.0), 2500.0, true).unwrap();
         assert!(
             w.starts_with("at t = 0.49155 the particles' velocities held 1887 of kinetic energy of which 483.9 (19 % of the energy scale) moved no particle"),
             "{w}"
         );
-        assert!(unseen_velocity_warning((1.0, 0.1, 1.0), 0.0).is_none());
+        assert!(unseen_velocity_warning((1.0, 0.1, 1.0), 0.0, true).is_none());
     }
 
     /// A warning's fix names the keys the scene's bodies take: `subdivide` for a

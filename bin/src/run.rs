@@ -1010,7 +1010,9 @@ pub fn summary_text(summary: &Summary) -> String {
         plural(summary.particles, "particle", "particles"),
         plural(summary.steps, "step", "steps"),
         sci(summary.dt),
-        short(summary.t_end)
+        // Six digits: a run that stopped early ends at a step's time, whose last
+        // digits are noise (1.148648649).
+        short(psmpm::scene::limits::significant(summary.t_end, 6))
     );
     let error = match (summary.error, summary.error_measure) {
         (Some(e), Some(m)) => format!("error {m} = {}", sci(e)),

@@ -330,7 +330,7 @@ fn short_time(t: f64) -> String {
     if t == 0.0 || !t.is_finite() {
         return format!("{t}");
     }
-    format!("{}", crate::scene::limits::significant(t, 6))
+    format!("{}", crate::scene::limits::significant(t, 4))
 }
 
 #[cfg(test)]
