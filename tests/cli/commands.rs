@@ -378,7 +378,9 @@ fn converge_explains_a_falling_order_with_two_probes() {
     }
     let table = stdout(&["converge", "vibrating-bar-1d", "--levels", "4"]);
     assert!(
-        table.contains("pl1d level 3: the order falls to -2.46") && table.contains("--particles"),
+        table.contains("pl1d level 3: the order falls to -2.46")
+            && table.contains("--particles")
+            && table.contains("crossing element edges"),
         "{table}"
     );
 }
