@@ -138,3 +138,25 @@ fn only_declared_effects_are_evaluated() {
     }
     assert_eq!(CALLS.load(Ordering::SeqCst), 5);
 }
+
+/// Every scene file the docs give as an example (`docs/examples`) parses and
+/// validates: a figure in the docs is only as good as the file behind its command.
+#[test]
+fn every_documented_example_parses() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/examples");
+    let mut count = 0;
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let text = std::fs::read_to_string(&path).unwrap();
+        if let Err(e) = Scene::from_toml(&text, &path.display().to_string()) {
+            panic!("{e}");
+        }
+        count += 1;
+    }
+    assert!(count >= 29, "{count} examples");
+}
