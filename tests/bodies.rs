@@ -558,11 +558,12 @@ fn rotation_warnings(disk: &str, block: &str) -> Vec<String> {
     let summary = simulation::run(&s, &mut |_| {}).unwrap();
     assert!(summary.failure.is_none(), "{:?}", summary.failure);
     assert!(summary.max_rotation > 0.1, "{}", summary.max_rotation);
-    // The disk's 8 × 8 lattice is also below 3 particles per triangle (2.95).
+    // The disk's 8 × 8 lattice is also below 3 particles per triangle (2.95), and
+    // the block's 2 × 2 about one per triangle under it: the sampling warnings.
     summary
         .warnings
         .into_iter()
-        .filter(|w| !w.contains("particles per occupied triangle"))
+        .filter(|w| !w.contains(" sampled by "))
         .collect()
 }
 

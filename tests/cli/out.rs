@@ -881,7 +881,7 @@ fn particles_svg_shows_the_first_middle_and_last_frame() {
     let middle = (steps / 2) as f64 * dt;
     for title in [
         "t = 0\n".to_string(),
-        format!("t = {}\n", format!("{middle:.5e}").parse::<f64>().unwrap()),
+        format!("t = {}\n", format!("{middle:.3e}").parse::<f64>().unwrap()),
         "t = 0.1\n".to_string(),
         "settle: σ_yy (pl, extended-hybrid mass)".to_string(),
         "32 particles".to_string(),
