@@ -26,8 +26,8 @@ def main():
     ap.add_argument("--threads", type=int, default=1)
     # As many steps as the peer times (100, after its 20 of warm-up): over 10, the
     # first step and the watch's first checks of the critical step (at steps 4 and
-    # 12, then every 32 at most) weigh more than in a run (2026-12-06: PS
-    # consistent 0.59 of the peer over 10 steps, 0.65 over 100).
+    # 12, then every 32 at most) weigh more than in a run (docs/performance.md,
+    # "Against a peer").
     ap.add_argument("--steps", type=int, default=100, help="psmpm steps per variant")
     ap.add_argument("--peer", default="../shared/tools/peer_mpm88.py")
     ap.add_argument("--cli", default="target/release/mpm-cli")

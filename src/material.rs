@@ -315,7 +315,7 @@ pub fn collapse_reason(
     law: &AnyMaterial,
 ) -> String {
     let fix = match law {
-        AnyMaterial::NeoHookean(_) => "the neo-Hookean pressure grows without bound as det F → 0, so the collapse is the discretisation's: a step too long for the impact (lower `time.courant`) or too few particles where the body is crushed (raise `per_block`, `count` or `spacing`)".to_string(),
+        AnyMaterial::NeoHookean(_) => "the neo-Hookean pressure grows without bound as det F → 0, so the collapse is the discretisation's: a step too long for the impact (lower `time.courant`) or too few particles where the body is crushed (raise `per_block` or `count`, or lower `spacing`)".to_string(),
         AnyMaterial::Linear(_) | AnyMaterial::Corotational(_) => {
             let name = if matches!(law, AnyMaterial::Linear(_)) {
                 "linear-elastic"

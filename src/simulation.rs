@@ -405,6 +405,8 @@ struct Tally {
     sampling: f64,
     /// The worst-sampled body at the start.
     sampled: Sampled,
+    /// PL's particles on element edges at the start ([`pl_edge_particles_warning`]).
+    on_edges: Option<String>,
     /// [`stray_particles`] at the start.
     stray_at_start: usize,
     /// The number of [`pieces`] at the start.
@@ -712,6 +714,54 @@ pub fn sparse_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> 
     })
 }
 
+/// The warning for a 2D scene measured against a 1D reference (`vibrating-bar`,
+/// `column-self-weight`: the bar's `E_u` with `c = √(E/ρ)`) with a Poisson's ratio
+/// other than 0: the 2D body is then stiffer than the bar the reference describes
+/// (a user's confined block in its first P-wave mode, ν = 0.25: E_u 2.93e-5
+/// against the reference, where the errors against its own exact mode were
+/// 2.9e-7 with PS and 1.5e-8 with PL; recomputed with `√(E/ρ)` the reference
+/// gave 2.932e-5 exactly).
+pub fn reference_poisson_warning(scene: &Scene) -> Option<String> {
+    use crate::scene::Reference;
+    let name = match scene.reference {
+        Some(Reference::VibratingBar { .. }) => "vibrating-bar",
+        Some(Reference::ColumnSelfWeight {}) => "column-self-weight",
+        _ => return None,
+    };
+    let nu = scene.body_material(0).poisson;
+    (scene.dim == 2 && nu != 0.0).then(|| {
+        format!(
+            "the `{name}` reference is the 1D bar's, with the wave speed √(E/ρ) of uniaxial stress; with poisson = {} this 2D body is stiffer (held at its faces, its P-wave speed √((λ + 2μ)/ρ) is {:.3} times that), and the error measures that difference as well: set `poisson = 0` to compare with the reference",
+            echo_number(nu),
+            ((1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))).sqrt()
+        )
+    })
+}
+
+/// The share of the particles on element edges at the start from which a PL run
+/// warns ([`pl_edge_particles_warning`]).
+pub const PL_EDGE_SHARE: f64 = 0.1;
+
+/// The warning for a PL run with [`PL_EDGE_SHARE`] or more of its `particles` on
+/// element edges or vertices at the start (`on_edges` of them): PL's gradient jumps
+/// there and each such particle takes one side's, which biases the internal force.
+/// Square lattices on blocks of four triangles put half their particles on the
+/// block diagonals (`per_block = [4, 4]`: 8 of 16). Measured on a user's standing
+/// P-wave mode (a 1 × 0.5 block, walls holding x at the ends and y on the faces,
+/// E = 1000, ν = 0.25, ρ = 1, to 2.25 periods; `mpm-cli run FILE --basis pl
+/// --blocks B --particles P --out DIR`, `E_u` against the exact mode): 4 × 4 per
+/// block 1.04e-5, 8.54e-6, 8.43e-6 on 8 × 4, 16 × 8, 32 × 16 blocks (the
+/// amplitude 18 % low, the period 4.7 % long), 3 × 4 (none on an edge) 2.35e-7,
+/// 5.58e-8, 1.47e-8 (order 2).
+pub fn pl_edge_particles_warning(on_edges: usize, particles: usize) -> Option<String> {
+    (particles > 0 && on_edges as f64 >= PL_EDGE_SHARE * particles as f64).then(|| {
+        format!(
+            "{on_edges} of the {particles} particles ({:.0} %) lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4], or `jitter`), or the smooth basis `ps`",
+            100.0 * on_edges as f64 / particles as f64
+        )
+    })
+}
+
 /// Particles per occupied element at the start above which a run warns that the
 /// mesh, not the particles, sets its error: B4's error on h = 0.25 falls from 16 to
 /// 260 particles per element and then holds (1.96e-4 at 260, 1.9644e-4 at 1040;
@@ -930,6 +980,11 @@ where
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
     let sampled = Sampled::of(&driver.sampling_by_body(&run.body_sizes));
+    let on_edges = (scene.basis == crate::bases::BasisKind::Pl)
+        .then(|| {
+            pl_edge_particles_warning(driver.particles_on_element_edges(), driver.particles.len())
+        })
+        .flatten();
     let at_start = fragments(&driver.particles, &run.body_sizes);
     let (stray_at_start, pieces_at_start) = (at_start.stray, at_start.pieces.len());
     let spin_at_start = Spin::of(&driver.particles);
@@ -1019,6 +1074,7 @@ where
         max_rotation_non_objective,
         sampling,
         sampled,
+        on_edges,
         spin_at_start,
         stray_at_start,
         pieces_at_start,
@@ -1412,6 +1468,8 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .chain(self_weight.clone())
                 .chain(dense_gel_warning(scene))
                 .chain(sparse_sampling_warning(&tally.sampled, keys))
+                .chain(tally.on_edges.clone())
+                .chain(reference_poisson_warning(scene))
                 .chain(dense_sampling_warning(tally.sampling, keys))
                 .chain(
                     failure
@@ -1531,6 +1589,19 @@ mod tests {
             w.contains("(`per_triangle` and `subdivide` of the Gmsh bodies)"),
             "{w}"
         );
+    }
+
+    /// A 2D scene with a Poisson's ratio measured against a 1D reference is warned
+    /// about; the built-in B2 (ν = 0) and a 1D bar are not.
+    #[test]
+    fn a_one_dimensional_reference_for_a_body_with_poisson_is_warned_about() {
+        let mut bar = Scene::builtin("vibrating-bar").unwrap();
+        assert!(reference_poisson_warning(&bar).is_none());
+        bar.material.poisson = 0.25;
+        bar.bodies.iter_mut().for_each(|b| b.material = None);
+        let w = reference_poisson_warning(&bar).expect("ν = 0.25");
+        assert!(w.contains("is 1.095 times that"), "{w}");
+        assert!(reference_poisson_warning(&Scene::builtin("vibrating-bar-1d").unwrap()).is_none());
     }
 
     /// A material as dense as steel and as soft as a gel is warned about (`young`

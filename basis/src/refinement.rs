@@ -44,7 +44,9 @@ impl Refinement {
     /// Refines `mesh` with split points of the given kind.
     ///
     /// Errors with [`BasisError::InvalidSplitPoint`] when a segment between the split
-    /// points of two neighbours misses their common edge (possible for centroids).
+    /// points of two neighbours misses their common edge (possible for centroids),
+    /// and with [`BasisError::SliverSplit`] when incentres do that or cross it next
+    /// to an end (a sliver triangle).
     pub fn new(mesh: &TriMesh, kind: SplitPoint) -> Result<Self, BasisError> {
         let mut split = Vec::with_capacity(mesh.num_triangles());
         let mut split_bary = Vec::with_capacity(mesh.num_triangles());
@@ -74,9 +76,10 @@ impl Refinement {
                     let cross = |u: Vec2, v: Vec2| u.x * v.y - u.y * v.x;
                     let s = cross(split[t1] - va, d) / cross(vb - va, d);
                     if !(s > EDGE_POINT_MARGIN && s < 1.0 - EDGE_POINT_MARGIN && s.is_finite()) {
-                        return Err(BasisError::InvalidSplitPoint {
-                            t1: t1.min(t2),
-                            t2: t1.max(t2),
+                        let (t1, t2) = (t1.min(t2), t1.max(t2));
+                        return Err(match kind {
+                            SplitPoint::Centroid => BasisError::InvalidSplitPoint { t1, t2 },
+                            _ => BasisError::SliverSplit { t1, t2 },
                         });
                     }
                     s

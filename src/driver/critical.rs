@@ -140,9 +140,7 @@ where
     /// tridiagonal `T` whose largest eigenvalue approaches `λ_max(A)` from below,
     /// much faster than a power iteration where the top of the spectrum is crowded
     /// (a body half over new functions). Per step: a stiffness product, a
-    /// consistent-mass product and two solves, or a stiffness product and one solve
-    /// where `M⁻¹ M_c M⁻¹ = M⁻¹` (the strategy solved `M` itself this step); no
-    /// allocation. The rigid modes
+    /// consistent-mass product and two solves; no allocation. The rigid modes
     /// (`Kx = 0`) drop out of the product, which is what the largest eigenvalue
     /// needs.
     pub(super) fn lanczos_critical(
@@ -160,8 +158,6 @@ where
             next,
             scratch,
         } = buffers;
-        let projection_is_identity =
-            self.mass.solves_consistent_mass() && self.constraints.is_empty();
         // r = start, u = K r, β₀ = √(rᵀ u).
         for (n, s) in next.iter_mut().zip(start.iter()) {
             n.copy_from_slice(s);
@@ -194,25 +190,21 @@ where
             }
             solve_with_walls(&mut self.mass, &mut self.constraints, next)
                 .map_err(|source| self.mass_failure(source))?;
-            // The velocity projection's filter: w ← M⁻¹ M_c w, the identity where
-            // the strategy solves `M` itself and the walls only hold rows at zero
-            // (`MassStrategy::solves_consistent_mass`).
-            if !projection_is_identity {
-                consistent_mass_product(
-                    &self.evals,
-                    &self.bins,
-                    &self.gather,
-                    &mut self.local,
-                    &self.particles.mass,
-                    next,
-                    scratch,
-                );
-                for (w, m) in next.iter_mut().zip(scratch.iter()) {
-                    w.copy_from_slice(m);
-                }
-                solve_with_walls(&mut self.mass, &mut self.constraints, next)
-                    .map_err(|source| self.mass_failure(source))?;
+            // The velocity projection's filter: w ← M⁻¹ M_c w.
+            consistent_mass_product(
+                &self.evals,
+                &self.bins,
+                &self.gather,
+                &mut self.local,
+                &self.particles.mass,
+                next,
+                scratch,
+            );
+            for (w, m) in next.iter_mut().zip(scratch.iter()) {
+                w.copy_from_slice(m);
             }
+            solve_with_walls(&mut self.mass, &mut self.constraints, next)
+                .map_err(|source| self.mass_failure(source))?;
             let a = dot(next, k_current);
             alpha[m] = a;
             betas[m] = beta;

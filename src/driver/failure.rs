@@ -154,6 +154,22 @@ where
             .collect()
     }
 
+    /// The particles on the closure of another element than their own (on an edge
+    /// or a vertex of the mesh), at the last location.
+    pub fn particles_on_element_edges(&self) -> usize {
+        (0..self.particles.len())
+            .filter(|&p| {
+                let mut other = false;
+                self.basis.other_elements_at(
+                    self.particles.element[p],
+                    &self.particles.x[p],
+                    &mut |_| other = true,
+                );
+                other
+            })
+            .count()
+    }
+
     /// The basis's largest number of functions on one element.
     pub fn functions_per_element(&self) -> usize {
         self.basis.max_functions_per_element()

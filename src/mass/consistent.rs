@@ -41,7 +41,4 @@ impl<T: Scalar> MassStrategy<T> for Consistent<T> {
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }
-    fn solves_consistent_mass(&self) -> bool {
-        true
-    }
 }

@@ -67,7 +67,4 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }
-    fn solves_consistent_mass(&self) -> bool {
-        true
-    }
 }

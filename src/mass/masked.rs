@@ -327,11 +327,6 @@ impl<T: Scalar> MaskedCholesky<T> {
         Ok(())
     }
 
-    /// Whether no row of the system last factorised was lumped.
-    pub fn lumps_nothing(&self) -> bool {
-        !self.lumped.iter().any(|&l| l)
-    }
-
     pub fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
         self.mask(k, rhs);
         let s = self.solver_of[k];

@@ -509,16 +509,6 @@ pub trait MassStrategy<T: Scalar>: Send {
     fn lumped_rows(&self) -> Option<&[bool]> {
         None
     }
-    /// Whether the system last factorised is `M` itself on every row it solves for
-    /// (the rows it holds at zero aside: fixed, without particles, deactivated),
-    /// with no row lumped, extended or filled from other functions. Then, with `P`
-    /// the rows solved for, `M'⁻¹ = P (P M P)⁻¹ P` and `M'⁻¹ M M'⁻¹ = M'⁻¹`: the
-    /// velocity projection leaves the update's operator `M'⁻¹ M M'⁻¹ K` equal to
-    /// `M'⁻¹ K`, and the critical-step watch skips the projection's product and
-    /// solve (`driver::critical`).
-    fn solves_consistent_mass(&self) -> bool {
-        false
-    }
     /// For a strategy whose [`Needs::correction`] is [`Correction::InMass`]: the
     /// functions of the step classified from `context` and the assembled `values`
     /// of `M`, before [`factorize`](Self::factorize); returns the functions whose
@@ -565,9 +555,6 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn lumped_rows(&self) -> Option<&[bool]> {
         (**self).lumped_rows()
-    }
-    fn solves_consistent_mass(&self) -> bool {
-        (**self).solves_consistent_mass()
     }
     fn classify(
         &mut self,

@@ -107,7 +107,4 @@ impl<T: Scalar> MassStrategy<T> for Partial<T> {
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }
-    fn solves_consistent_mass(&self) -> bool {
-        self.solver.lumps_nothing()
-    }
 }

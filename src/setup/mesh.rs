@@ -53,6 +53,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let h = smallest_edge(&mesh);
     check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
+    let warnings = slip_bend_warning(&mesh, &walls).into_iter().collect();
     let contacts = contact_walls(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
@@ -69,6 +70,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
         h,
         walls,
         contacts,
+        warnings,
     })
 }
 
@@ -101,6 +103,7 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
         h,
         walls,
         contacts: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 
@@ -223,6 +226,53 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
         walls.push((bc.tag.clone(), [n[0], n[1]]));
     }
     Ok(walls)
+}
+
+/// Slip walls whose normals differ by at most this angle (radians) meet at a bend a
+/// body is meant to slide over, not at a corner ([`slip_bend_warning`]).
+pub const SLIP_BEND: f64 = std::f64::consts::FRAC_PI_4;
+
+/// The warning for two slip walls that meet at a vertex at a bend (their normals
+/// differ by more than round-off and at most [`SLIP_BEND`]): each holds the
+/// velocity along its own normal there, so the vertex holds still and a body
+/// sliding over the bend stops on it (a user's block slid down a 21.8° slope onto
+/// one of 16.7°, stopped at the bend and slid back). Names the first such vertex
+/// and how many there are.
+fn slip_bend_warning(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> Option<String> {
+    let mut bends = Vec::new();
+    for (a, (tag_a, na)) in walls.iter().enumerate() {
+        for (tag_b, nb) in &walls[a + 1..] {
+            let angle = (na[0] * nb[1] - na[1] * nb[0])
+                .atan2(na[0] * nb[0] + na[1] * nb[1])
+                .abs();
+            if angle <= STRAIGHT_WALL || angle > SLIP_BEND {
+                continue;
+            }
+            let (ia, ib) = (mesh.tag_id(tag_a).ok()?, mesh.tag_id(tag_b).ok()?);
+            let at = |id: usize| {
+                mesh.edges()
+                    .iter()
+                    .filter(move |e| e.tag == Some(id))
+                    .flat_map(|e| e.vertices)
+            };
+            let shared: Vec<usize> = at(ia).filter(|v| at(ib).any(|w| w == *v)).collect();
+            if let Some(&v) = shared.first() {
+                bends.push((tag_a.clone(), tag_b.clone(), v, angle));
+            }
+        }
+    }
+    let (tag_a, tag_b, v, angle) = bends.first()?;
+    let p = mesh.vertices()[*v];
+    let more = match bends.len() {
+        1 => String::new(),
+        n => format!(" (and {} more such bends)", n - 1),
+    };
+    Some(format!(
+        "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend stops on it; for a floor that bends, make its sides contact walls (`[[effect]]` with `kind = \"contact-wall\"` and each side's `tag`, in place of their `[[boundary]]`), which take bends",
+        crate::scene::limits::echo_significant(p[0], 6),
+        crate::scene::limits::echo_significant(p[1], 6),
+        angle.to_degrees(),
+    ))
 }
 
 /// The geometry of every contact wall, in the order of the scene's effects: the

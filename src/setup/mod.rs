@@ -50,6 +50,9 @@ pub(crate) struct Domain<B> {
     pub walls: Vec<(String, [f64; 2])>,
     /// The geometry of each contact wall, in the order of the scene's effects.
     pub contacts: Vec<crate::contact::WallGeometry>,
+    /// What the mesh and walls make the run warn about (slip walls meeting at a
+    /// bend).
+    pub warnings: Vec<String>,
 }
 
 impl<B> Domain<B> {
@@ -62,6 +65,7 @@ impl<B> Domain<B> {
             h,
             walls,
             contacts,
+            warnings,
         } = self;
         (
             basis,
@@ -70,6 +74,7 @@ impl<B> Domain<B> {
                 h,
                 walls,
                 contacts,
+                warnings,
             },
         )
     }
@@ -83,6 +88,7 @@ impl Domain<()> {
             h: self.h,
             walls: self.walls,
             contacts: self.contacts,
+            warnings: self.warnings,
         }
     }
 }
@@ -159,7 +165,11 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     let body_sizes = std::mem::take(&mut lattice.body_sizes);
     drop(lattice);
     let Domain {
-        basis, h, walls, ..
+        basis,
+        h,
+        walls,
+        warnings: domain_warnings,
+        ..
     } = domain;
     let functions = basis.num_functions();
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
@@ -203,7 +213,8 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         }
     }
     driver.set_body_sizes(&body_sizes);
-    let mut warnings = held_traction_warnings(scene, &driver);
+    let mut warnings = domain_warnings;
+    warnings.extend(held_traction_warnings(scene, &driver));
     let (dt, steps, dt_critical, failed) = time_steps(scene, &mut driver, dt)?;
     warnings.extend(failed);
     if let (Some(critical), None, false) = (

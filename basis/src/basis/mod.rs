@@ -107,6 +107,8 @@ pub enum BasisError {
     Mesh(#[from] crate::mesh::MeshError),
     #[error("the centroid split point is not valid on this mesh: the line between the centroids of triangles {t1} and {t2} does not cross their common edge; use incentres")]
     InvalidSplitPoint { t1: usize, t2: usize },
+    #[error("the Powell–Sabin refinement cannot be built on this mesh: the line between the incentres of triangles {t1} and {t2} crosses their common edge at or next to one of its ends, which a sliver (a triangle of almost no area, a vertex nearly on the opposite edge) does; remesh without slivers (Gmsh: `Mesh.Optimize = 1`, or move the stray vertex), or use the `pl` basis, which takes them")]
+    SliverSplit { t1: usize, t2: usize },
     #[error("no control triangle found for vertex {vertex}")]
     NoControlTriangle { vertex: usize },
     #[error("invalid basis parameter: {0}")]

@@ -601,10 +601,6 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.fill_ghosts(k, rhs);
         result
     }
-    /// Solved directly with nothing extended, lumped or filled in (no ghost).
-    fn solves_consistent_mass(&self) -> bool {
-        self.direct && !self.any_lumped && self.ghosts.is_empty()
-    }
     /// `κ(Eᵀ M E)` on the solved functions, from Lanczos steps (no solves).
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         if self.direct {
