@@ -630,7 +630,7 @@ pub const EMPTY_BETWEEN: f64 = 1.25;
 
 impl BodySampling {
     /// Whether elements between its particles hold none: their volume exceeds
-    /// the size of the elements that hold them by more than [`EMPTY_BETWEEN`].
+    /// the size of the elements that hold them by more than `EMPTY_BETWEEN`.
     pub fn fills_in_part(&self) -> bool {
         self.volume_over_elements > EMPTY_BETWEEN
     }
