@@ -282,9 +282,9 @@ impl Recorder {
             .with_encoding(options.encoding);
         let mesh = scene.dim == 2;
         let mut edges = Vec::new();
-        if mesh {
-            let triangulation =
-                simulation::triangulation(scene).map_err(|e| CliError::Input(e.to_string()))?;
+        // A mesh that cannot be built is the run's set-up to report, with the scene's
+        // file and line, after which the run discards this directory.
+        if let (true, Ok(triangulation)) = (mesh, simulation::triangulation(scene)) {
             out.write_mesh(&triangulation, None).map_err(output_error)?;
             let v = triangulation.vertices();
             edges = triangulation

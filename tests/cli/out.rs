@@ -1018,3 +1018,35 @@ print(len(files))
         frames.to_string()
     );
 }
+
+/// A scene whose mesh cannot be built is refused at set-up with its file, line and
+/// field, and leaves no `--out` folder behind (a user's Gmsh mesh with a duplicated
+/// triangle left an empty folder, and the error named no line, since the folder's
+/// mesh file was written before the run).
+#[test]
+fn a_mesh_that_cannot_be_built_leaves_no_out_folder() {
+    let dir = TempDir::new("bad-mesh");
+    let scene = dir.path().with_extension("toml");
+    std::fs::write(
+        &scene,
+        "name = \"bad-mesh\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"polygon\"\noutline = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]\nedge_length = 0.25\n[material]\nyoung = 1e5\ndensity = 1000.0\n[[body]]\nmin = [0.1, 0.1]\nmax = [0.3, 0.3]\ncount = [4, 4]\n[time]\ncourant = 0.5\nt_end = 0.01\n",
+    )
+    .unwrap();
+    let out = cli()
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.path().to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains(&format!("{}:6:", scene.display())) && stderr.contains("mesh.outline"),
+        "{stderr}"
+    );
+    assert!(!dir.path().exists(), "the folder was left behind");
+    std::fs::remove_file(&scene).ok();
+}
