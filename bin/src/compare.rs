@@ -210,32 +210,48 @@ fn print_tracked(summaries: &[Summary]) {
     let one_d = summaries
         .first()
         .is_some_and(|s| matches!(s.basis, "bspline" | "pl1d"));
-    let mut header = vec!["basis", "mass", "u_x"];
+    let near = |x: f64| psmpm::scene::limits::echo_significant(x, 4);
+    let point = |x: &[f64]| {
+        if one_d {
+            format!("x = {}", near(x[0]))
+        } else {
+            format!("({}, {})", near(x[0]), near(x[1]))
+        }
+    };
+    // Variants whose lattices differ (`[[resolution]]`, `--particles`) track
+    // different particles: each row then says which.
+    let same = summaries
+        .iter()
+        .all(|s| s.tracked_end.first().is_none_or(|(x, _)| x == x0));
+    let mut header = vec!["basis", "mass"];
+    if !same {
+        header.push("started at");
+    }
+    header.push("u_x");
     if !one_d {
         header.push("u_y");
     }
     header.push("at t");
     let mut table = Table::new(&header);
     for s in summaries {
-        let u = s.tracked_end.first().map(|(_, u)| *u);
-        let mut row = vec![
-            s.basis.to_string(),
-            s.mass.clone(),
-            u.map_or_else(|| "-".into(), |u| sci(u[0])),
-        ];
+        let first = s.tracked_end.first();
+        let u = first.map(|(_, u)| *u);
+        let mut row = vec![s.basis.to_string(), s.mass.clone()];
+        if !same {
+            row.push(first.map_or_else(|| "-".into(), |(x, _)| point(x)));
+        }
+        row.push(u.map_or_else(|| "-".into(), |u| sci(u[0])));
         if !one_d {
             row.push(u.map_or_else(|| "-".into(), |u| sci(u[1])));
         }
         row.push(crate::table::short(s.t_end));
         table.push(row);
     }
-    let near = |x: f64| psmpm::scene::limits::echo_significant(x, 4);
-    let at = if one_d {
-        format!("x = {}", near(x0[0]))
+    if same {
+        println!("displacement of the tracked particle that started at {}, at the end of each run (output.tracked; the histories: run --out, tracked.csv):", point(x0));
     } else {
-        format!("({}, {})", near(x0[0]), near(x0[1]))
-    };
-    println!("displacement of the tracked particle that started at {at}, at the end of each run (output.tracked; the histories: run --out, tracked.csv):");
+        println!("displacement of each run's tracked particle, the one nearest the first tracked point (the variants' particles differ), at the end of each run (output.tracked; the histories: run --out, tracked.csv):");
+    }
     print!("{}", table.render());
 }
 

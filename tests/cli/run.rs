@@ -1398,3 +1398,53 @@ t_end = 0.183
         "{stderr}"
     );
 }
+
+/// `compare` of variants whose lattices differ (`[[resolution]]`) tracks a
+/// different particle per variant, and each row says which (a user's rows were
+/// headed by the PS particle's start point alone).
+#[test]
+fn compare_names_each_variants_tracked_particle_where_they_differ() {
+    let file = SceneFile::new(
+        "compare-lattices",
+        r#"name = "lattices"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 1.0]
+y = [0.0, 1.0]
+blocks = [4, 4]
+[material]
+young = 1000.0
+density = 1.0
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 1.0]
+per_block = [4, 4]
+[initial_velocity]
+kind = "uniform"
+value = [0.1, 0.0]
+[time]
+courant = 0.5
+t_end = 0.01
+[output]
+tracked = [[0.5, 0.5]]
+[[resolution]]
+basis = "pl"
+per_block = [3, 4]
+"#,
+    );
+    let out = cli()
+        .args(["compare", file.arg(), "--basis", "ps,pl"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        stdout.contains("displacement of each run's tracked particle")
+            && stdout.contains("started at")
+            && stdout.contains("(0.4688, 0.4688)")
+            && stdout.contains("(0.5417, 0.4688)"),
+        "{stdout}"
+    );
+}
