@@ -154,20 +154,35 @@ where
             .collect()
     }
 
-    /// The particles on the closure of another element than their own (on an edge
-    /// or a vertex of the mesh), at the last location.
-    pub fn particles_on_element_edges(&self) -> usize {
-        (0..self.particles.len())
-            .filter(|&p| {
-                let mut other = false;
-                self.basis.other_elements_at(
-                    self.particles.element[p],
-                    &self.particles.x[p],
-                    &mut |_| other = true,
-                );
-                other
+    /// Per body, its particles on the closure of another element than their own
+    /// (on an edge or a vertex of the mesh) and its particles, at the last location
+    /// (`body_sizes` as [`Driver::sampling_by_body`]).
+    pub fn particles_on_element_edges(&self, body_sizes: &[usize]) -> Vec<(usize, usize)> {
+        let n = self.particles.len();
+        let sizes = if body_sizes.iter().sum::<usize>() == n && !body_sizes.is_empty() {
+            body_sizes.to_vec()
+        } else {
+            vec![n]
+        };
+        let mut first = 0;
+        sizes
+            .iter()
+            .map(|&size| {
+                let on = (first..first + size)
+                    .filter(|&p| {
+                        let mut other = false;
+                        self.basis.other_elements_at(
+                            self.particles.element[p],
+                            &self.particles.x[p],
+                            &mut |_| other = true,
+                        );
+                        other
+                    })
+                    .count();
+                first += size;
+                (on, size)
             })
-            .count()
+            .collect()
     }
 
     /// The basis's largest number of functions on one element.

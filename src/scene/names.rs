@@ -148,7 +148,8 @@ pub(crate) fn did_you_mean(message: String) -> String {
 /// letters (`nx` is not `x`), 1 edit up to 5 (`pll` is `pl`), 2 up to 9, 3
 /// beyond; else the
 /// longest candidate of 4 letters or more that `name` starts with (a long form,
-/// `youngs_modulus`); `None` for none, or for `name` itself.
+/// `youngs_modulus`), or the one `name` is the plural of (`bodies`); `None` for
+/// none, or for `name` itself.
 fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
     let plain = |s: &str| -> String {
         s.chars()
@@ -170,9 +171,19 @@ fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
         .filter(|(d, _)| *d <= allowed)
         .min_by_key(|(d, _)| *d)
         .map(|(_, c)| c);
+    // A plural of a name (`[[bodies]]`, `effects`): the candidate it is the plural of.
+    let plural = || {
+        candidates.iter().copied().find(|c| {
+            let c = plain(c);
+            wanted == format!("{c}s")
+                || wanted == format!("{c}es")
+                || c.strip_suffix('y')
+                    .is_some_and(|stem| wanted == format!("{stem}ies"))
+        })
+    };
     // A long form of a name (`youngs_modulus`, `poisson_ratio`): the longest
     // candidate of 4 letters or more that the name starts with.
-    near.or_else(|| {
+    near.or_else(plural).or_else(|| {
         candidates
             .iter()
             .filter(|c| **c != name)
@@ -213,6 +224,10 @@ mod tests {
             (
                 "unknown field `poisson_ratio`, expected one of `model`, `young`, `poisson`, `density`",
                 "(did you mean `poisson`?)",
+            ),
+            (
+                "unknown field `bodies`, expected one of `name`, `dim`, `body`, `time`",
+                "unknown field `bodies` (did you mean `body`?), expected one of",
             ),
             (
                 "unknown basis `pll` (known: ps, pl, bspline, pl1d)",
