@@ -691,7 +691,7 @@ impl Sampled {
         let value = self.value;
         if self.sampling.fills_in_part() {
             format!(
-                "{who} sampled by {value:.digits$} particles per {element} under {it} at the start ({:.2} per {element} holding one of {its} particles, whose volume is {:.1} times the size of those {element}s: the {element}s between {its} particles hold none)",
+                "{who} sampled by {value:.digits$} particles per {element} under {it} at the start ({:.2} per {element} holding one of {its} particles, whose total volume is {:.1} times the total size of those {element}s: the {element}s between {its} particles hold none)",
                 self.sampling.per_occupied, self.sampling.volume_over_elements
             )
         } else {

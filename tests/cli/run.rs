@@ -748,7 +748,7 @@ fn a_body_sampled_by_one_particle_per_element_is_warned_about() {
     let sparse = run(&["--blocks", "16x16", "--particles", "1x1"]);
     assert!(
         sparse.contains(
-            "warning: the bodies are sampled by 0.25 particles per element under them at the start (1.00 per element holding one of their particles, whose volume is 4.0 times the size of those elements"
+            "warning: the bodies are sampled by 0.25 particles per element under them at the start (1.00 per element holding one of their particles, whose total volume is 4.0 times the total size of those elements"
         ) && sparse.contains("use 3 or more particles per element"),
         "{sparse}"
     );
@@ -815,7 +815,7 @@ t_end = 0.01
     };
     let sparse = warnings("[1, 1]");
     assert!(
-        sparse.contains("warning: body 1 of 2 is sampled by 0.25 particles per element under it at the start (1.00 per element holding one of its particles, whose volume is 4.0 times the size of those elements: the elements between its particles hold none)"),
+        sparse.contains("warning: body 1 of 2 is sampled by 0.25 particles per element under it at the start (1.00 per element holding one of its particles, whose total volume is 4.0 times the total size of those elements: the elements between its particles hold none)"),
         "{sparse}"
     );
     let thin = warnings("[3, 3]");
