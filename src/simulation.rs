@@ -519,11 +519,13 @@ pub const DENSE_SOLID: f64 = 1500.0;
 /// softest clays in Pa at about 25 m/s.
 pub const GEL_WAVE_SPEED: f64 = 10.0;
 
-/// The warning for a body as dense as a metal, rock or soil in kg/m³ whose P-wave
-/// speed `√((λ + 2μ)/ρ)` is that of a gel: most often `young` in MPa or kPa beside
-/// `density` in kg/m³ (a user's steel cantilever with E = 2.1e5 sagged until it
-/// left the mesh, told to add a wall).
-pub fn dense_gel_warning(scene: &Scene) -> Option<String> {
+/// The first body whose material and P-wave speed `√((λ + 2μ)/ρ)` pass `test`:
+/// how a warning names it ("the material" for one body, "body 2's material"
+/// among several), its material and that speed.
+fn first_material_where(
+    scene: &Scene,
+    test: impl Fn(&crate::scene::MaterialSpec, f64) -> bool,
+) -> Option<(String, &crate::scene::MaterialSpec, f64)> {
     (0..scene.bodies.len()).find_map(|b| {
         let m = scene.body_material(b);
         let e = crate::material::Elastic {
@@ -532,20 +534,31 @@ pub fn dense_gel_warning(scene: &Scene) -> Option<String> {
             density: m.density,
         };
         let speed = (e.p_modulus(scene.dim) / m.density).sqrt();
-        (m.density >= DENSE_SOLID && speed < GEL_WAVE_SPEED).then(|| {
+        test(m, speed).then(|| {
             let who = if scene.bodies.len() > 1 {
                 format!("body {}'s material", b + 1)
             } else {
                 "the material".to_string()
             };
-            format!(
-                "{who} is as dense as a metal, rock or soil in kg/m³ (density = {}) and as soft as a gel (young = {:e}: a P-wave speed of {speed:.1} m/s, where steel has about 5900 and soils 100 or more): if `young` is in MPa, write it in Pa ({:e} here: × 1e6), in kPa × 1e3",
-                echo_number(m.density),
-                m.young,
-                m.young * 1e6,
-            )
+            (who, m, speed)
         })
     })
+}
+
+/// The warning for a body as dense as a metal, rock or soil in kg/m³ whose P-wave
+/// speed `√((λ + 2μ)/ρ)` is that of a gel: most often `young` in MPa or kPa beside
+/// `density` in kg/m³ (a user's steel cantilever with E = 2.1e5 sagged until it
+/// left the mesh, told to add a wall).
+pub fn dense_gel_warning(scene: &Scene) -> Option<String> {
+    let (who, m, speed) = first_material_where(scene, |m, speed| {
+        m.density >= DENSE_SOLID && speed < GEL_WAVE_SPEED
+    })?;
+    Some(format!(
+        "{who} is as dense as a metal, rock or soil in kg/m³ (density = {}) and as soft as a gel (young = {:e}: a P-wave speed of {speed:.1} m/s, where steel has about 5900 and soils 100 or more): if `young` is in MPa, write it in Pa ({:e} here: × 1e6), in kPa × 1e3",
+        echo_number(m.density),
+        m.young,
+        m.young * 1e6,
+    ))
 }
 
 /// The warning for a geostatic stress over bodies of several densities of which
@@ -720,32 +733,15 @@ pub fn sparse_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> 
 pub const FASTEST_SOLID: f64 = 2.5e4;
 
 /// The warning for a material faster than any solid (a user's steel with
-/// `density = 7.85`: 1.6e5 m/s, 483 092 steps and 99 s where 2.2 s served in
-/// kg/m³).
+/// `density = 7.85`: 1.85e5 m/s, 483 092 steps and 99 s).
 pub fn featherweight_warning(scene: &Scene) -> Option<String> {
-    (0..scene.bodies.len()).find_map(|b| {
-        let m = scene.body_material(b);
-        let e = crate::material::Elastic {
-            young: m.young,
-            poisson: m.poisson,
-            density: m.density,
-        };
-        let speed = (e.p_modulus(scene.dim) / m.density).sqrt();
-        (speed > FASTEST_SOLID).then(|| {
-            let who = if scene.bodies.len() > 1 {
-                format!("body {}'s material", b + 1)
-            } else {
-                "the material".to_string()
-            };
-            format!(
-                "{who} has a P-wave speed of {:.2e} m/s (young = {:e}, density = {}), faster than any solid (steel about 5 900, diamond 18 000), which makes the time step that small: if `density` is in g/cm³, write it in kg/m³ ({} here: × 1000)",
-                speed,
-                m.young,
-                echo_number(m.density),
-                echo_number(m.density * 1e3),
-            )
-        })
-    })
+    let (who, m, speed) = first_material_where(scene, |_, speed| speed > FASTEST_SOLID)?;
+    Some(format!(
+        "{who} has a P-wave speed of {speed:.2e} m/s (young = {:e}, density = {}), faster than any solid (steel about 5 900, diamond 18 000), which makes the time step that small: if `density` is in g/cm³, write it in kg/m³ ({} here: × 1000)",
+        m.young,
+        echo_number(m.density),
+        echo_number(m.density * 1e3),
+    ))
 }
 
 /// The warning for a scene with a `[reference]` and several bodies: the reference
