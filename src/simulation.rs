@@ -527,13 +527,7 @@ fn first_material_where(
     test: impl Fn(&crate::scene::MaterialSpec, f64) -> bool,
 ) -> Option<(String, &crate::scene::MaterialSpec, f64)> {
     (0..scene.bodies.len()).find_map(|b| {
-        let m = scene.body_material(b);
-        let e = crate::material::Elastic {
-            young: m.young,
-            poisson: m.poisson,
-            density: m.density,
-        };
-        let speed = (e.p_modulus(scene.dim) / m.density).sqrt();
+        let (m, speed) = (scene.body_material(b), scene.body_wave_speed(b));
         test(m, speed).then(|| {
             let who = if scene.bodies.len() > 1 {
                 format!("body {}'s material", b + 1)

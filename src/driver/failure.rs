@@ -116,12 +116,7 @@ where
     /// particles of the bodies, whose particles follow each other in that order;
     /// empty or not adding up: one body).
     pub fn sampling_by_body(&self, body_sizes: &[usize]) -> Vec<BodySampling> {
-        let n = self.particles.len();
-        let sizes = if body_sizes.iter().sum::<usize>() == n && !body_sizes.is_empty() {
-            body_sizes.to_vec()
-        } else {
-            vec![n]
-        };
+        let sizes = bodies_or_one(body_sizes, self.particles.len());
         let mut seen = vec![usize::MAX; self.basis.num_elements()];
         let mut pieces = Vec::new();
         let mut first = 0;
@@ -158,12 +153,7 @@ where
     /// (on an edge or a vertex of the mesh) and its particles, at the last location
     /// (`body_sizes` as [`Driver::sampling_by_body`]).
     pub fn particles_on_element_edges(&self, body_sizes: &[usize]) -> Vec<(usize, usize)> {
-        let n = self.particles.len();
-        let sizes = if body_sizes.iter().sum::<usize>() == n && !body_sizes.is_empty() {
-            body_sizes.to_vec()
-        } else {
-            vec![n]
-        };
+        let sizes = bodies_or_one(body_sizes, self.particles.len());
         let mut first = 0;
         sizes
             .iter()
@@ -670,5 +660,15 @@ fn simplex_measure<const D: usize>(s: &[SVector<f64, D>]) -> f64 {
             let (u, w) = (s[1] - s[0], s[2] - s[0]);
             0.5 * (u[0] * w[1] - u[1] * w[0]).abs()
         }
+    }
+}
+
+/// The numbers of particles of the bodies, `body_sizes`, where they add up to all
+/// `n` particles; else one body of all of them.
+fn bodies_or_one(body_sizes: &[usize], n: usize) -> Vec<usize> {
+    if body_sizes.iter().sum::<usize>() == n && !body_sizes.is_empty() {
+        body_sizes.to_vec()
+    } else {
+        vec![n]
     }
 }

@@ -132,16 +132,19 @@ impl Scene {
     /// The fastest P-wave speed `√((λ + 2μ) / ρ)` of the bodies' materials.
     pub fn wave_speed(&self) -> f64 {
         (0..self.bodies.len().max(1))
-            .map(|b| {
-                let m = self.body_material(b);
-                let e = crate::material::Elastic {
-                    young: m.young,
-                    poisson: m.poisson,
-                    density: m.density,
-                };
-                (e.p_modulus(self.dim) / m.density).sqrt()
-            })
+            .map(|b| self.body_wave_speed(b))
             .fold(0.0, f64::max)
+    }
+
+    /// The P-wave speed `√((λ + 2μ)/ρ)` of body `b`'s material.
+    pub fn body_wave_speed(&self, b: usize) -> f64 {
+        let m = self.body_material(b);
+        let e = crate::material::Elastic {
+            young: m.young,
+            poisson: m.poisson,
+            density: m.density,
+        };
+        (e.p_modulus(self.dim) / m.density).sqrt()
     }
 
     /// Steps to reach `t_end` with a fixed `dt` (rounded to the nearest integer); for
