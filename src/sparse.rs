@@ -13,11 +13,13 @@
 //! owned by the struct, so that a time step allocates nothing.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::utils::{permute_self_adjoint_scratch, permute_self_adjoint_to_unsorted};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use psmpm_basis::{Basis, Real};
@@ -208,13 +210,34 @@ pub const SUPERNODAL_FROM: usize = 4096;
 
 /// Sparse Cholesky `A = L Lᵀ` of a symmetric positive definite matrix with a fixed
 /// [`SymmetricPattern`]: symbolic analysis once, numeric factorisation per call.
+///
+/// The fill-reducing order (AMD) is found once, and the matrix is handed to faer
+/// already in that order: the set-up runs faer's own permutation once on the
+/// entries' positions, which gives where each entry of the caller's upper
+/// triangle lands in the permuted triangle faer factorises (`gather`), and the
+/// factorisation is then analysed in the identity order. Each numeric
+/// factorisation gathers the values into place instead of faer permuting the
+/// whole matrix (index arrays and values) on every call, 2–3 % of a PS step in the
+/// profile (`docs/performance.md`); the factor, and every solve, are the same to
+/// the last bit as with faer's own permutation (`same_bits_as_faers_ordering`).
 pub struct SparseCholesky<T: Scalar> {
     symbolic: SymbolicCholesky<usize>,
     col_ptr: Arc<[usize]>,
     row_idx: Arc<[usize]>,
+    /// `perm_fwd[k]`: the original row at position `k` of the fill-reducing order.
+    perm_fwd: Vec<usize>,
+    /// The permuted triangle faer factorises (lower for a supernodal factor,
+    /// upper for a simplicial one): its pattern, and `gather[t]` = the entry of
+    /// the caller's upper triangle at its position `t`.
+    permuted_col_ptr: Vec<usize>,
+    permuted_row_idx: Vec<usize>,
+    gather: Vec<usize>,
+    permuted_values: Vec<T>,
     l_values: Vec<T>,
     factorised: bool,
     scratch: MemBuffer,
+    /// Right-hand sides in the fill-reducing order.
+    permuted_rhs: Vec<T>,
     rhs_columns: usize,
 }
 
@@ -248,21 +271,77 @@ impl<T: Scalar> SparseCholesky<T> {
 
     fn shared(col_ptr: Arc<[usize]>, row_idx: Arc<[usize]>, rhs_columns: usize) -> Self {
         let n = col_ptr.len() - 1;
+        let nnz = row_idx.len();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let symbolic = factorize_symbolic_cholesky(
+        let threshold = if n >= SUPERNODAL_FROM {
+            SupernodalThreshold::FORCE_SUPERNODAL
+        } else {
+            SupernodalThreshold::AUTO
+        };
+        let ordered = factorize_symbolic_cholesky(
             sym,
             Side::Upper,
             SymmetricOrdering::Amd,
             CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
+                supernodal_flop_ratio_threshold: threshold,
+                ..Default::default()
+            },
+        )
+        .expect("symbolic Cholesky of a valid pattern");
+        let supernodal = matches!(ordered.raw(), SymbolicCholeskyRaw::Supernodal(_));
+        let (perm_fwd, perm_inv) = match ordered.perm() {
+            Some(perm) => {
+                let (fwd, inv) = perm.arrays();
+                (fwd.to_vec(), inv.to_vec())
+            }
+            None => ((0..n).collect(), (0..n).collect()),
+        };
+        let perm = PermRef::new_checked(&perm_fwd, &perm_inv, n);
+        // faer's permutation of the entries' positions: where each entry lands, in
+        // the side the symbolic analysis reads (upper) and the one the numeric
+        // factorisation reads (lower for supernodal, as faer does).
+        let positions: Vec<f64> = (0..nnz).map(|t| t as f64).collect();
+        let source = SparseColMatRef::new(sym, &positions[..]);
+        let permuted = |out_side: Side| {
+            let (mut values, mut cp, mut ri) =
+                (vec![0.0f64; nnz], vec![0usize; n + 1], vec![0usize; nnz]);
+            let mut stack = MemBuffer::new(permute_self_adjoint_scratch::<usize>(n));
+            permute_self_adjoint_to_unsorted(
+                &mut values,
+                &mut cp,
+                &mut ri,
+                source,
+                perm,
+                Side::Upper,
+                out_side,
+                MemStack::new(&mut stack),
+            );
+            (
+                cp,
+                ri,
+                values.into_iter().map(|t| t as usize).collect::<Vec<_>>(),
+            )
+        };
+        let (upper_cp, upper_ri, _) = permuted(Side::Upper);
+        let symbolic = factorize_symbolic_cholesky(
+            SymbolicSparseColMatRef::new_unsorted_checked(n, n, &upper_cp, None, &upper_ri),
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: if supernodal {
                     SupernodalThreshold::FORCE_SUPERNODAL
                 } else {
-                    SupernodalThreshold::AUTO
+                    SupernodalThreshold::FORCE_SIMPLICIAL
                 },
                 ..Default::default()
             },
         )
         .expect("symbolic Cholesky of a valid pattern");
+        let (permuted_col_ptr, permuted_row_idx, gather) = if supernodal {
+            permuted(Side::Lower)
+        } else {
+            permuted(Side::Upper)
+        };
         let par = Par::Seq;
         let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<T>(par, Default::default()),
@@ -273,9 +352,15 @@ impl<T: Scalar> SparseCholesky<T> {
             symbolic,
             col_ptr,
             row_idx,
+            perm_fwd,
+            permuted_col_ptr,
+            permuted_row_idx,
+            gather,
+            permuted_values: vec![T::zero(); nnz],
             l_values,
             factorised: false,
             scratch: MemBuffer::new(req),
+            permuted_rhs: vec![T::zero(); n * rhs_columns.max(1)],
             rhs_columns: rhs_columns.max(1),
         }
     }
@@ -289,13 +374,26 @@ impl<T: Scalar> SparseCholesky<T> {
     /// (in the order of the pattern). Allocation-free.
     pub fn factorize(&mut self, values: &[T]) -> Result<(), NotPositiveDefinite> {
         let n = self.col_ptr.len() - 1;
-        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-        let a = SparseColMatRef::new(sym, values);
+        for (v, &t) in self.permuted_values.iter_mut().zip(&self.gather) {
+            *v = values[t];
+        }
+        let sym = SymbolicSparseColMatRef::new_unsorted_checked(
+            n,
+            n,
+            &self.permuted_col_ptr,
+            None,
+            &self.permuted_row_idx,
+        );
+        let a = SparseColMatRef::new(sym, &self.permuted_values[..]);
+        let side = match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(_) => Side::Lower,
+            SymbolicCholeskyRaw::Simplicial(_) => Side::Upper,
+        };
         self.factorised = false;
         let result = self.symbolic.factorize_numeric_llt::<T>(
             &mut self.l_values,
             a,
-            Side::Upper,
+            side,
             Default::default(),
             Par::Seq,
             MemStack::new(&mut self.scratch),
@@ -325,12 +423,146 @@ impl<T: Scalar> SparseCholesky<T> {
             "more right-hand sides than scratch allows"
         );
         let n = self.col_ptr.len() - 1;
-        let b = MatMut::from_column_major_slice_mut(rhs, n, columns);
+        let x = &mut self.permuted_rhs[..n * columns];
+        for j in 0..columns {
+            let (b, x) = (&rhs[j * n..(j + 1) * n], &mut x[j * n..(j + 1) * n]);
+            for (xi, &f) in x.iter_mut().zip(&self.perm_fwd) {
+                *xi = b[f];
+            }
+        }
+        let b = MatMut::from_column_major_slice_mut(x, n, columns);
         LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
             Conj::No,
             b,
             Par::Seq,
             MemStack::new(&mut self.scratch),
         );
+        for j in 0..columns {
+            let (b, x) = (
+                &mut rhs[j * n..(j + 1) * n],
+                &self.permuted_rhs[j * n..(j + 1) * n],
+            );
+            for (&xi, &f) in x.iter().zip(&self.perm_fwd) {
+                b[f] = xi;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The upper pattern and values of a symmetric positive definite matrix on an
+    /// `m × m` grid of nodes with 9-point couplings (diagonally dominant).
+    fn grid_matrix(m: usize) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+        let n = m * m;
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            let (jx, jy) = (j % m, j / m);
+            let mut rows: Vec<usize> = Vec::new();
+            for dy in -1i64..=1 {
+                for dx in -1i64..=1 {
+                    let (x, y) = (jx as i64 + dx, jy as i64 + dy);
+                    if x >= 0 && y >= 0 && (x as usize) < m && (y as usize) < m {
+                        let i = y as usize * m + x as usize;
+                        if i <= j {
+                            rows.push(i);
+                        }
+                    }
+                }
+            }
+            rows.sort_unstable();
+            for i in rows {
+                row_idx.push(i);
+                values.push(if i == j {
+                    9.0 + (j % 7) as f64 * 0.1
+                } else {
+                    -0.5 - ((i * 31 + j * 17) % 13) as f64 * 0.03
+                });
+            }
+            col_ptr.push(row_idx.len());
+        }
+        (col_ptr, row_idx, values)
+    }
+
+    /// Factor and solve through faer's own AMD permutation, as faer does it.
+    fn faer_ordered(
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        values: &[f64],
+        b: &mut [f64],
+    ) -> Vec<f64> {
+        let n = col_ptr.len() - 1;
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            sym,
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
+                    SupernodalThreshold::FORCE_SUPERNODAL
+                } else {
+                    SupernodalThreshold::AUTO
+                },
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let mut l = vec![0.0; symbolic.len_val()];
+        let mut scratch = MemBuffer::new(StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]));
+        symbolic
+            .factorize_numeric_llt::<f64>(
+                &mut l,
+                SparseColMatRef::new(sym, values),
+                Side::Upper,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .unwrap();
+        LltRef::new(&symbolic, &l).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(b, n, 1),
+            Par::Seq,
+            MemStack::new(&mut scratch),
+        );
+        l
+    }
+
+    /// The factor and the solution through the gathered, pre-permuted matrix are
+    /// those of faer's own permutation to the last bit, simplicial (small) and
+    /// supernodal (from `SUPERNODAL_FROM` functions).
+    #[test]
+    fn same_bits_as_faers_ordering() {
+        for m in [12, 70] {
+            let (col_ptr, row_idx, values) = grid_matrix(m);
+            let n = m * m;
+            let b: Vec<f64> = (0..n)
+                .map(|i| ((i * 37) % 101) as f64 / 101.0 - 0.4)
+                .collect();
+            let mut expected = b.clone();
+            let l = faer_ordered(&col_ptr, &row_idx, &values, &mut expected);
+            let mut ours = SparseCholesky::<f64>::from_upper(col_ptr, row_idx, 1);
+            ours.factorize(&values).unwrap();
+            assert_eq!(ours.l_values.len(), l.len());
+            assert!(ours
+                .l_values
+                .iter()
+                .zip(&l)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+            let mut x = b.clone();
+            ours.solve_in_place(&mut x, 1);
+            assert!(
+                x.iter()
+                    .zip(&expected)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "m = {m}"
+            );
+        }
     }
 }
