@@ -267,6 +267,7 @@ mod assemble {
                 &mut self.values,
                 &mut self.force,
                 coverage.then_some((&mut volume[..], &mut count[..])),
+                None,
             );
         }
     }

@@ -198,8 +198,9 @@ pub(super) fn packed(stride: usize, a: usize, b: usize) -> usize {
     a * stride - a * a.saturating_sub(1) / 2 + (b - a)
 }
 
-/// An element's local blocks: its mass block, vector coefficients and coverage sums.
-pub(super) type ElementBlocks<'a, T> = (&'a mut [T], &'a mut [T], &'a mut [T]);
+/// An element's local blocks: its mass block, vector coefficients, coverage sums
+/// and body-force coefficients.
+pub(super) type ElementBlocks<'a, T> = (&'a mut [T], &'a mut [T], &'a mut [T], &'a mut [T]);
 
 /// Element-local sums: per element an upper-triangular `stride × stride` block of
 /// the mass matrix and `stride × D` coefficients of a vector field (local
@@ -217,6 +218,10 @@ pub struct Local<T: Scalar, const D: usize> {
     /// `Σ_p V_p phi_a(x_p)` and `Σ_p phi_a(x_p)` (the coverage), written by the
     /// assembly of phase 2a alongside the mass matrix.
     pub(super) coverage: Vec<T>,
+    /// Per element `stride × D`, when asked for ([`Local::with_body_forces`], else
+    /// empty): the forces of the effects that act per particle,
+    /// `Σ_p phi_a(x_p) f_p`, summed by the assembly of phase 2a in the same pass.
+    pub(super) body: Vec<T>,
     /// Per element: its blocks may hold nonzero values.
     dirty: Vec<bool>,
 }
@@ -231,12 +236,12 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
         self.occupied_blocks(bins, true)
-            .map(|(e, (lm, lv, _))| (e, (lm, lv)))
+            .map(|(e, (lm, lv, _, _))| (e, (lm, lv)))
     }
 
-    /// [`Local::par_elements`] with each element's coverage block (empty without
-    /// [`Local::with_coverage`]; not zeroed: its writer overwrites it):
-    /// `(e, (matrix, vector, coverage))`.
+    /// [`Local::par_elements`] with each element's coverage and body-force blocks
+    /// (empty without [`Local::with_coverage`] and [`Local::with_body_forces`]; not
+    /// zeroed: their writer overwrites them): `(e, (matrix, vector, coverage, body))`.
     pub(super) fn par_elements_with_coverage<'a>(
         &'a mut self,
         bins: &'a Bins,
@@ -251,11 +256,12 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         bins: &'a Bins,
     ) -> impl ParallelIterator<Item = (usize, &'a mut [T])> + 'a {
         self.occupied_blocks(bins, false)
-            .map(|(e, (_, lv, _))| (e, lv))
+            .map(|(e, (_, lv, _, _))| (e, lv))
     }
 
     /// The blocks of the occupied elements, the vector zeroed and the matrix block
-    /// too with `matrix` (the coverage block is left to its writer); an element
+    /// too with `matrix` (the coverage and body-force blocks are left to their
+    /// writer); an element
     /// emptied since the last call has all its blocks zeroed and is skipped, so
     /// that every unoccupied element's blocks stay zero.
     fn occupied_blocks<'a>(
@@ -271,16 +277,21 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         } else {
             rayon::iter::Either::Right(self.coverage.par_chunks_mut(2 * stride))
         };
+        let body = if self.body.is_empty() {
+            rayon::iter::Either::Left((0..elements).into_par_iter().map(|_| &mut [][..]))
+        } else {
+            rayon::iter::Either::Right(self.body.par_chunks_mut(stride * D))
+        };
         (
             self.matrix.par_chunks_mut(packed_len(stride)),
             self.vector.par_chunks_mut(stride * D),
-            coverage,
+            (coverage, body),
             self.dirty.par_iter_mut(),
         )
             .into_par_iter()
             .with_min_len(ELEMENT_CHUNK)
             .enumerate()
-            .filter_map(move |(e, (lm, lv, lc, dirty))| {
+            .filter_map(move |(e, (lm, lv, (lc, lb), dirty))| {
                 let occupied = bins.occupied(e);
                 if (occupied && matrix) || (!occupied && *dirty) {
                     lm.iter_mut().for_each(|v| *v = T::zero());
@@ -290,9 +301,10 @@ impl<T: Scalar, const D: usize> Local<T, D> {
                 }
                 if !occupied && *dirty {
                     lc.iter_mut().for_each(|v| *v = T::zero());
+                    lb.iter_mut().for_each(|v| *v = T::zero());
                 }
                 *dirty = occupied;
-                occupied.then_some((e, (lm, lv, lc)))
+                occupied.then_some((e, (lm, lv, lc, lb)))
             })
     }
 
@@ -303,8 +315,15 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             matrix: vec![T::zero(); elements * packed_len(stride)],
             vector: vec![T::zero(); elements * stride * D],
             coverage: Vec::new(),
+            body: Vec::new(),
             dirty: vec![false; elements],
         }
+    }
+
+    /// With the body-force blocks, for the per-particle forces summed in phase 2a.
+    pub fn with_body_forces(mut self) -> Self {
+        self.body = vec![T::zero(); self.dirty.len() * self.stride * D];
+        self
     }
 
     /// With the coverage blocks, for the coverage sums of phase 2a.
@@ -563,6 +582,42 @@ impl Gather {
         negate: bool,
         out: &mut [Vec<T>],
     ) {
+        self.functions_of::<T, D>(&local.vector, negate, out);
+    }
+
+    /// [`Gather::functions`] of the body-force blocks ([`Local::with_body_forces`]).
+    pub(super) fn body_forces<T: Scalar, const D: usize>(
+        &self,
+        local: &Local<T, D>,
+        out: &mut [Vec<T>],
+    ) {
+        self.functions_of::<T, D>(&local.body, false, out);
+    }
+
+    /// `out_{k,i} += source_{k,i}` for the live functions `i` (the others are
+    /// left alone, as a gather leaves them).
+    pub(super) fn add_live<T: Scalar>(&self, source: &[Vec<T>], out: &mut [Vec<T>]) {
+        for (out, source) in out.iter_mut().zip(source) {
+            out.par_iter_mut()
+                .with_min_len(ENTRY_CHUNK)
+                .zip(source.par_iter())
+                .enumerate()
+                .for_each(|(i, (o, s))| {
+                    if self.live[i] {
+                        *o += *s;
+                    }
+                });
+        }
+    }
+
+    /// `out_{k,i} += sign · Σ` of the local coefficients `source` (`stride × D`
+    /// per element) of function `i`, in element order.
+    fn functions_of<T: Scalar, const D: usize>(
+        &self,
+        source: &[T],
+        negate: bool,
+        out: &mut [Vec<T>],
+    ) {
         for (k, out) in out.iter_mut().enumerate() {
             out.par_iter_mut()
                 .with_min_len(ENTRY_CHUNK)
@@ -576,7 +631,7 @@ impl Gather {
                     let sources =
                         self.function_start[i] as usize..self.function_start[i + 1] as usize;
                     for &s in &self.function_source[sources] {
-                        sum += local.vector[s as usize * D + k];
+                        sum += source[s as usize * D + k];
                     }
                     if negate {
                         *o -= sum;
@@ -680,7 +735,7 @@ mod tests {
         }
         local
             .par_elements_with_coverage(bins)
-            .for_each(|(e, (lm, lv, lc))| {
+            .for_each(|(e, (lm, lv, lc, _))| {
                 for (k, v) in lm.iter_mut().enumerate() {
                     *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
                 }

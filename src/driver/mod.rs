@@ -209,6 +209,9 @@ where
     /// Per-particle forces of the effects that act per particle
     /// ([`Effect::particle_force`]); empty without any.
     particle_force: Vec<SVector<T, D>>,
+    /// `Σ_p phi_i(x_p) f_p` of the effects that act per particle and do no work,
+    /// summed in phase 2a's pass over the particles; empty without any.
+    body_force: Vec<Vec<T>>,
     /// `C_p` of the affine correction ([`phases::Affine`]); empty unless the
     /// strategy asks for it.
     affine_gradient: Vec<SMatrix<T, D, D>>,
@@ -387,16 +390,27 @@ where
             Vec::new()
         };
         let momentum_corrects = matches!(needs.correction, Correction::Rigid | Correction::Affine);
+        let fused_body_forces = effects
+            .iter()
+            .any(|e| e.acts_per_particle() && !e.does_work());
         Ok(Driver {
             scratch: (0..phases::chunks(np))
                 .map(|_| BasisEval::for_basis(&basis))
                 .collect(),
             evals: Evaluations::for_basis(&basis, np),
             bins: Bins::new(basis.num_elements(), np),
-            local: if needs.coverage {
-                Local::new(basis.num_elements(), stride).with_coverage()
-            } else {
-                Local::new(basis.num_elements(), stride)
+            local: {
+                let local = Local::new(basis.num_elements(), stride);
+                let local = if needs.coverage {
+                    local.with_coverage()
+                } else {
+                    local
+                };
+                if fused_body_forces {
+                    local.with_body_forces()
+                } else {
+                    local
+                }
             },
             gather: Gather::new(&basis, &pattern, stride),
             values: vec![T::zero(); pattern.nnz()],
@@ -419,6 +433,7 @@ where
             } else {
                 Vec::new()
             },
+            body_force: scratch(fused_body_forces),
             work: 0.0,
             first_half_power: None,
             dissipated: 0.0,
@@ -777,6 +792,7 @@ where
     /// Phase 2a: `M`, `F = −F^int` into `rhs`, and the facts the mass strategy
     /// asked for.
     fn assemble_mass(&mut self) {
+        let body = !self.body_force.is_empty() && self.fill_particle_forces(false);
         phases::assemble_mass_and_internal_force(
             &self.particles,
             &self.evals,
@@ -794,6 +810,7 @@ where
                 &mut self.inputs.particle_volume[..],
                 &mut self.inputs.particle_count[..],
             )),
+            body.then_some((&self.particle_force[..], &mut self.body_force[..])),
         );
         if self.inputs.needs.empty_elements {
             phases::mark_empty_elements(
@@ -869,9 +886,10 @@ where
                 effect.add_forces(&self.particles, &state, &mut self.rhs);
             }
         }
-        for work in [false, true] {
-            self.scatter_particle_forces(work);
+        if !self.body_force.is_empty() {
+            self.gather.add_live(&self.body_force, &mut self.rhs);
         }
+        self.scatter_working_particle_forces();
         if tracks_work {
             phases::add_into(&mut self.rhs, &self.work_force);
         }
@@ -890,12 +908,12 @@ where
     }
 
     /// The forces of the effects that act per particle and do work (`work`) or
-    /// not, summed per particle in the effects' order, then scattered into
-    /// `work_force` or `rhs`.
-    fn scatter_particle_forces(&mut self, work: bool) {
+    /// not, summed per particle in the effects' order into `particle_force`;
+    /// `false` (and nothing written) without such an effect.
+    fn fill_particle_forces(&mut self, work: bool) -> bool {
         let acting = move |e: &dyn Effect<T, D>| e.acts_per_particle() && e.does_work() == work;
         if !self.effects.iter().any(|e| acting(e.as_ref())) {
-            return;
+            return false;
         }
         let (effects, particles, time) = (&self.effects, &self.particles, self.time);
         self.particle_force
@@ -912,18 +930,23 @@ where
                     }
                 }
             });
-        let target = if work {
-            &mut self.work_force
-        } else {
-            &mut self.rhs
-        };
+        true
+    }
+
+    /// The forces of the effects that act per particle and do work, scattered
+    /// into `work_force` (those that do not are summed in phase 2a's pass,
+    /// `body_force`, and added to `rhs` by [`assemble_effects`](Self::assemble_effects)).
+    fn scatter_working_particle_forces(&mut self) {
+        if !self.fill_particle_forces(true) {
+            return;
+        }
         let (evals, forces) = (&self.evals, &self.particle_force);
         phases::scatter_by_elements(
             &self.bins,
             evals,
             &self.gather,
             &mut self.local,
-            target,
+            &mut self.work_force,
             |p, s| forces[p] * evals.phi[s],
         );
     }
