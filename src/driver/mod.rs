@@ -160,6 +160,10 @@ where
     /// `walled[i]`: a wall (`fix`) constrains function `i`, for the message of a
     /// particle that leaves the mesh through a wall.
     walled: Vec<bool>,
+    /// The functions and position of each vertex where two slip walls meet at a
+    /// bend ([`Driver::average_slip_bends`]), for the message of a particle that
+    /// leaves the mesh there.
+    slip_bends: Vec<(Vec<usize>, Vec<f64>)>,
     /// `fixed[k][i]`: component `k` of function `i` is held at zero (`fix`).
     fixed: Vec<Vec<bool>>,
     /// Each element's width, its smallest altitude (the advection limit of the
@@ -439,6 +443,7 @@ where
             dissipated: 0.0,
             constraints: Constraints::new(general, n),
             walled,
+            slip_bends: Vec::new(),
             fixed,
             element_width: critical::element_widths(&basis),
             initial_speed: particles
@@ -480,21 +485,137 @@ where
         let constraints = self.basis.dirichlet(tag, normal)?;
         let mut general = std::mem::take(&mut self.constraints.rows);
         for c in constraints {
-            let mut row = Vec::new();
-            for &(i, w) in &c.terms {
-                for k in 0..D {
-                    if normal[k] != T::zero() {
-                        row.push((k, i, w * normal[k]));
-                    }
-                }
-            }
-            general.push(row);
+            general.push(expand_row(&c.terms, normal));
         }
         if !self.inputs.on_wall.is_empty() {
             mark_terms(&mut self.inputs.on_wall, &general);
         }
+        mark_terms(&mut self.walled, &general);
         self.constraints = Constraints::new(general, self.basis.num_functions());
         Ok(())
+    }
+
+    /// Slip walls meeting at a bend share the bend's vertex through their mean
+    /// normal. Each wall holds, at each vertex of its edges, the value of the
+    /// velocity along its normal and that value's derivative along the wall (paper
+    /// §2.3's Dirichlet conditions for PS, `ps-splines.md` §5; the value alone for
+    /// PL). At a vertex shared by two walls at a bend the value is then held along
+    /// two directions, so the vertex holds still and a body sliding over the bend
+    /// strikes it (a block sliding from a 21.8° slope onto a 16.7° one stopped
+    /// there and slid back). Here the two value rows become one along the mean
+    /// normal `n̄ = (n_a + n_b) / |n_a + n_b|`, and each wall keeps its own
+    /// derivative row: the vertex moves along the mean tangent, and near it each
+    /// wall lets through `sin(θ/2)` of that velocity across itself (4.4 % at a 5°
+    /// bend). Call after [`Driver::add_slip_wall`] for the oblique walls, with every
+    /// bend between two slip walls (those along an axis included: the component
+    /// their [`Fix`] held at the vertex is released). Returns the number of bends
+    /// treated; a bend at a vertex a no-slip wall also holds is left as it is.
+    pub fn average_slip_bends(&mut self, bends: &[SlipBend<T, D>]) -> Result<usize, SetupError> {
+        let n = self.basis.num_functions();
+        let mut rows = std::mem::take(&mut self.constraints.rows);
+        let (mut treated, mut unfixed) = (0, false);
+        let mut at = BasisEval::for_basis(&self.basis);
+        for bend in bends {
+            let [na, nb] = bend.normals;
+            let sum = na + nb;
+            let mean = sum / T::of(sum.norm().to_f64());
+            // The basis at the vertex, from just inside the domain (a vertex on the
+            // boundary may fall outside every element by round-off).
+            let scale = 1.0
+                + bend
+                    .vertex
+                    .iter()
+                    .map(|x| x.to_f64().abs())
+                    .fold(0.0, f64::max);
+            let inside = bend.vertex - mean * T::of(1e-10 * scale);
+            let Some(e) = self
+                .basis
+                .locate(&bend.vertex, None)
+                .or_else(|| self.basis.locate(&inside, None))
+            else {
+                continue;
+            };
+            self.basis.eval(e, &bend.vertex, &mut at);
+            let m = at.len();
+            let size = (0..m).map(|q| at.phi[q].to_f64().abs()).fold(0.0, f64::max);
+            // The functions of the vertex: those with a value or a gradient there.
+            let tiny = 1e-12;
+            let of_vertex: Vec<usize> = (0..m)
+                .filter(|&q| {
+                    at.phi[q].to_f64().abs() > tiny * size
+                        || at.grad_phi[q]
+                            .iter()
+                            .any(|g| g.to_f64().abs() > tiny * size)
+                })
+                .collect();
+            let functions: Vec<usize> = of_vertex.iter().map(|&q| at.index[q]).collect();
+            // Each wall's rows at the vertex: those on the vertex's functions alone.
+            let mut held = Vec::new();
+            for (tag, normal) in bend.tags.iter().zip([na, nb]) {
+                for c in self.basis.dirichlet(tag, &normal)? {
+                    if c.terms.iter().all(|(i, _)| functions.contains(i)) {
+                        held.push((c, normal));
+                    }
+                }
+            }
+            // A function held in every component (a no-slip wall there): leave it.
+            if functions.iter().any(|&i| (0..D).all(|k| self.fixed[k][i])) {
+                continue;
+            }
+            for (c, normal) in &held {
+                match (single_axis(normal), c.is_single()) {
+                    (Some(k), true) => {
+                        self.fixed[k][c.terms[0].0] = false;
+                        unfixed = true;
+                    }
+                    (axis, _) => {
+                        // An axis wall's rows were made along the positive axis
+                        // ([`Driver::new`]), an oblique wall's along its normal.
+                        let along = axis.map_or(*normal, |k| {
+                            let mut e = SVector::<T, D>::zeros();
+                            e[k] = T::one();
+                            e
+                        });
+                        let row = expand_row(&c.terms, &along);
+                        rows.retain(|r| *r != row);
+                    }
+                }
+            }
+            // The value along the mean normal; the derivative along each wall, along
+            // its own normal (PS: a C¹ basis holds the tangential derivative too).
+            let value: Vec<(usize, T)> = of_vertex
+                .iter()
+                .map(|&q| (at.index[q], at.phi[q]))
+                .collect();
+            rows.push(expand_row(&value, &mean));
+            if self.basis.degree() > 1 && D == 2 {
+                for normal in [na, nb] {
+                    let mut tangent = SVector::<T, D>::zeros();
+                    tangent[0] = -normal[1];
+                    tangent[1] = normal[0];
+                    let derivative: Vec<(usize, T)> = of_vertex
+                        .iter()
+                        .map(|&q| (at.index[q], at.grad_phi[q].dot(&tangent)))
+                        .collect();
+                    rows.push(expand_row(&derivative, &normal));
+                }
+            }
+            self.slip_bends.push((functions, to_f64(&bend.vertex)));
+            treated += 1;
+        }
+        if !self.inputs.on_wall.is_empty() {
+            mark_terms(&mut self.inputs.on_wall, &rows);
+        }
+        mark_terms(&mut self.walled, &rows);
+        self.constraints = Constraints::new(rows, n);
+        if unfixed {
+            self.mass.prepare(&MassSetup {
+                pattern: &self.pattern,
+                fixed: &self.fixed,
+                support: self.inputs.support.as_ref(),
+            });
+        }
+        Ok(treated)
     }
 
     /// Tells the driver which particles make up each body: `sizes[b]` particles of
@@ -759,6 +880,16 @@ where
                 }
                 format!(
                     "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                )
+            } else if let Some((_, vertex)) = self.slip_bends.iter().find(|(functions, _)| {
+                self.basis
+                    .element_functions(from)
+                    .iter()
+                    .any(|i| functions.contains(i))
+            }) {
+                format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out at the bend where two slip walls meet at {}: there the walls hold the velocity along their mean normal (else the vertex would hold still and stop a body sliding over it), which lets a body sliding into a valley cross each wall near the vertex by sin(θ/2) of its speed, θ the bend; for a floor that bends, make its sides contact walls (`[[effect]]` with `kind = \"contact-wall\"` and each side's `tag`, in place of their `[[boundary]]`), which hold a body from outside without holding the vertex",
+                    point(vertex)
                 )
             } else if self
                 .basis
@@ -1089,6 +1220,38 @@ fn on_wall<T>(n: usize, fixed: &[Vec<bool>], general: &[Vec<(usize, usize, T)>])
 }
 
 /// Marks every function a term of the general constraints `rows` acts on.
+/// Two slip walls meeting at a bend ([`Driver::average_slip_bends`]): their tags,
+/// their unit (outward) normals, and the vertex they share.
+#[derive(Debug, Clone)]
+pub struct SlipBend<T: Scalar, const D: usize> {
+    pub tags: [String; 2],
+    pub normals: [SVector<T, D>; 2],
+    pub vertex: SVector<T, D>,
+}
+
+/// The row a wall of unit normal `normal` holds for the combination `terms` of
+/// coefficients: `Σ w c_i · normal`, as `(component, function, weight)`.
+fn expand_row<T: Scalar, const D: usize>(
+    terms: &[(usize, T)],
+    normal: &SVector<T, D>,
+) -> Vec<(usize, usize, T)> {
+    let mut row = Vec::new();
+    for &(i, w) in terms {
+        for k in 0..D {
+            if normal[k] != T::zero() {
+                row.push((k, i, w * normal[k]));
+            }
+        }
+    }
+    row
+}
+
+/// The axis a unit normal lies along, if any.
+fn single_axis<T: Scalar, const D: usize>(normal: &SVector<T, D>) -> Option<usize> {
+    let along: Vec<usize> = (0..D).filter(|&k| normal[k] != T::zero()).collect();
+    (along.len() == 1).then(|| along[0])
+}
+
 fn mark_terms<T>(on_wall: &mut [bool], rows: &[Vec<(usize, usize, T)>]) {
     for &(_, i, _) in rows.iter().flatten() {
         on_wall[i] = true;

@@ -53,7 +53,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let h = smallest_edge(&mesh);
     check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
-    let warnings = slip_bend_warning(&mesh, &walls).into_iter().collect();
+    let bends = slip_bends(&mesh, &walls);
     let contacts = contact_walls(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
@@ -69,8 +69,9 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
         basis,
         h,
         walls,
+        bends,
         contacts,
-        warnings,
+        warnings: Vec::new(),
     })
 }
 
@@ -102,6 +103,7 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
         basis,
         h,
         walls,
+        bends: Vec::new(),
         contacts: Vec::new(),
         warnings: Vec::new(),
     })
@@ -232,13 +234,12 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
 /// body is meant to slide over, not at a corner ([`slip_bend_warning`]).
 pub const SLIP_BEND: f64 = std::f64::consts::FRAC_PI_4;
 
-/// The warning for two slip walls that meet at a vertex at a bend (their normals
-/// differ by more than round-off and at most [`SLIP_BEND`]): each holds the
-/// velocity along its own normal there, so the vertex holds still and a body
-/// sliding over the bend stops on it (a user's block slid down a 21.8° slope onto
-/// one of 16.7°, stopped at the bend and slid back). Names the first such vertex
-/// and how many there are.
-fn slip_bend_warning(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> Option<String> {
+/// Every vertex where two slip walls meet at a bend (their normals differ by more
+/// than round-off and at most [`SLIP_BEND`]), for the driver to share through the
+/// walls' mean normal ([`crate::driver::Driver::average_slip_bends`]): otherwise
+/// each holds the velocity along its own normal there, the vertex holds still and
+/// a body sliding over the bend strikes it.
+fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> Vec<Bend> {
     let mut bends = Vec::new();
     for (a, (tag_a, na)) in walls.iter().enumerate() {
         for (tag_b, nb) in &walls[a + 1..] {
@@ -248,31 +249,40 @@ fn slip_bend_warning(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> Option<Str
             if angle <= STRAIGHT_WALL || angle > SLIP_BEND {
                 continue;
             }
-            let (ia, ib) = (mesh.tag_id(tag_a).ok()?, mesh.tag_id(tag_b).ok()?);
-            let at = |id: usize| {
-                mesh.edges()
-                    .iter()
-                    .filter(move |e| e.tag == Some(id))
-                    .flat_map(|e| e.vertices)
+            let (Ok(ia), Ok(ib)) = (mesh.tag_id(tag_a), mesh.tag_id(tag_b)) else {
+                continue;
             };
-            let shared: Vec<usize> = at(ia).filter(|v| at(ib).any(|w| w == *v)).collect();
-            if let Some(&v) = shared.first() {
-                bends.push((tag_a.clone(), tag_b.clone(), v, angle));
+            let at = |id: usize| -> Vec<usize> {
+                let mut v: Vec<usize> = mesh
+                    .edges()
+                    .iter()
+                    .filter(|e| e.tag == Some(id))
+                    .flat_map(|e| e.vertices)
+                    .collect();
+                v.sort_unstable();
+                v.dedup();
+                v
+            };
+            let on_b = at(ib);
+            for v in at(ia).into_iter().filter(|v| on_b.binary_search(v).is_ok()) {
+                let p = mesh.vertices()[v];
+                bends.push(Bend {
+                    tags: [tag_a.clone(), tag_b.clone()],
+                    normals: [*na, *nb],
+                    vertex: [p[0], p[1]],
+                });
             }
         }
     }
-    let (tag_a, tag_b, v, angle) = bends.first()?;
-    let p = mesh.vertices()[*v];
-    let more = match bends.len() {
-        1 => String::new(),
-        n => format!(" (and {} more such bends)", n - 1),
-    };
-    Some(format!(
-        "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend stops on it; for a floor that bends, make its sides contact walls (`[[effect]]` with `kind = \"contact-wall\"` and each side's `tag`, in place of their `[[boundary]]`), which take bends",
-        crate::scene::limits::echo_significant(p[0], 6),
-        crate::scene::limits::echo_significant(p[1], 6),
-        angle.to_degrees(),
-    ))
+    bends
+}
+
+/// Two slip walls meeting at a bend at `vertex` ([`slip_bends`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Bend {
+    pub tags: [String; 2],
+    pub normals: [[f64; 2]; 2],
+    pub vertex: [f64; 2],
 }
 
 /// The geometry of every contact wall, in the order of the scene's effects: the

@@ -21,7 +21,7 @@ pub use particles::{particle_lattice, Lattice};
 pub(crate) use mesh::{domain_1d, domain_2d, Basis1d, Basis2d};
 pub(crate) use solution::Solution;
 
-use crate::driver::{Driver, Fix, SetupError};
+use crate::driver::{Driver, Fix, SetupError, SlipBend};
 use crate::effect::Effect;
 use crate::mass::MassStrategy;
 use crate::material::MaterialError;
@@ -48,10 +48,11 @@ pub(crate) struct Domain<B> {
     pub h: f64,
     /// Tag and unit normal of every slip wall.
     pub walls: Vec<(String, [f64; 2])>,
+    /// The vertices where two slip walls meet at a bend.
+    pub bends: Vec<mesh::Bend>,
     /// The geometry of each contact wall, in the order of the scene's effects.
     pub contacts: Vec<crate::contact::WallGeometry>,
-    /// What the mesh and walls make the run warn about (slip walls meeting at a
-    /// bend).
+    /// What the mesh and walls make the run warn about.
     pub warnings: Vec<String>,
 }
 
@@ -64,6 +65,7 @@ impl<B> Domain<B> {
             basis,
             h,
             walls,
+            bends,
             contacts,
             warnings,
         } = self;
@@ -73,6 +75,7 @@ impl<B> Domain<B> {
                 basis: (),
                 h,
                 walls,
+                bends,
                 contacts,
                 warnings,
             },
@@ -87,6 +90,7 @@ impl Domain<()> {
             basis,
             h: self.h,
             walls: self.walls,
+            bends: self.bends,
             contacts: self.contacts,
             warnings: self.warnings,
         }
@@ -168,6 +172,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         basis,
         h,
         walls,
+        bends,
         warnings: domain_warnings,
         ..
     } = domain;
@@ -198,6 +203,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         effects,
         dt,
         &walls,
+        &bends,
         &body_sizes,
     )?;
     if scene.body_contact() {
@@ -360,6 +366,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
     effects: Vec<Box<dyn Effect<f64, D>>>,
     dt: f64,
     walls: &[(String, [f64; 2])],
+    bends: &[mesh::Bend],
     body_sizes: &[usize],
 ) -> Result<SceneDriver<D, B>, RunError> {
     let mut fixes: Vec<Fix> = scene
@@ -452,6 +459,23 @@ fn driver<const D: usize, B: Basis<f64, D>>(
             )
         })?;
     }
+    // Slip walls meeting at a bend share the vertex's value through their mean
+    // normal (else the vertex holds still and a body sliding over it strikes it).
+    let bends: Vec<SlipBend<f64, D>> = bends
+        .iter()
+        .map(|b| SlipBend {
+            tags: b.tags.clone(),
+            normals: b.normals.map(|n| SVector::<f64, D>::from_fn(|k, _| n[k])),
+            vertex: SVector::<f64, D>::from_fn(|k, _| b.vertex[k]),
+        })
+        .collect();
+    driver.average_slip_bends(&bends).map_err(|e| {
+        SceneError::new(
+            boundary_field(scene, &bends[0].tags[0]),
+            ErrorKind::Conflict,
+            e.to_string(),
+        )
+    })?;
     Ok(driver)
 }
 

@@ -1448,3 +1448,119 @@ per_block = [3, 4]
         "{stdout}"
     );
 }
+
+/// A block sliding down a frictionless slope onto a less steep one (two slip
+/// walls, each its own tag, meeting at a bend of 5.1°), and down a ramp onto a flat
+/// floor (an oblique slip wall and an axis one, 21.8°), slides over the bend: the
+/// walls share the bend's vertex through their mean normal. Holding the vertex
+/// along both normals stopped the block there: it struck the vertex (strain
+/// energy 400 and 328 of 1.56e3) and slid back (the potential energy rose from
+/// 1.06e3 to 1.19e3 and 1.20e3).
+#[test]
+fn a_block_slides_over_a_bend_between_two_slip_walls() {
+    let scene = |outline: &str| {
+        format!(
+            r#"name = "bend"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "polygon"
+outline = {outline}
+tags = ["upper", "lower", "right", "top", "left"]
+edge_length = 0.15
+[material]
+model = "neo-hookean"
+young = 5e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+shape = "polygon"
+outline = [[0.86444, 1.66498], [1.14299, 1.55357], [1.2544, 1.83212], [0.97585, 1.94353]]
+spacing = [0.025, 0.025]
+[[boundary]]
+tag = "upper"
+fix = ["normal"]
+[[boundary]]
+tag = "lower"
+fix = ["normal"]
+[[boundary]]
+tag = "right"
+fix = ["x"]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.5
+t_end = 1.2
+"#
+        )
+    };
+    // (outline, whether the floor past the bend descends, the most strain energy
+    // as a share of the initial potential: the 21.8° turn onto the flat floor
+    // takes the block's normal velocity, about 14 % of its kinetic energy, in an
+    // elastic impact)
+    for (name, outline, descends, most_strain) in [
+        (
+            "bend-slopes",
+            "[[0.0, 2.0], [2.5, 1.0], [5.0, 0.25], [5.0, 3.0], [0.0, 3.0]]",
+            true,
+            0.01,
+        ),
+        (
+            "bend-ramp",
+            "[[0.0, 2.0], [2.5, 1.0], [5.0, 1.0], [5.0, 3.0], [0.0, 3.0]]",
+            false,
+            0.1,
+        ),
+    ] {
+        let file = SceneFile::new(name, &scene(outline));
+        let out = cli()
+            .args(["run", file.arg(), "--diag-every", "20", "--format", "json"])
+            .output()
+            .unwrap();
+        assert_success(&out);
+        let text = String::from_utf8(out.stdout).unwrap();
+        let lines: Vec<Value> = text
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        let (steps, summary) = lines.split_at(lines.len() - 1);
+        assert_eq!(
+            summary[0]["stable"],
+            Value::Bool(true),
+            "{name}: {}",
+            summary[0]
+        );
+        let potential: Vec<f64> = steps
+            .iter()
+            .map(|s| s["potential"].as_f64().unwrap())
+            .collect();
+        let strain = steps
+            .iter()
+            .map(|s| s["strain"].as_f64().unwrap())
+            .fold(0.0, f64::max);
+        // The block reaches the bend at about t = 0.9 (potential 1.09e3).
+        assert!(
+            strain < most_strain * potential[0],
+            "{name}: strain energy {strain}"
+        );
+        let lowest_before_end = potential[..potential.len() - 1]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let last = potential[potential.len() - 1];
+        if descends {
+            assert!(last < lowest_before_end, "{name}: {potential:?}");
+        } else {
+            // On the flat floor the potential energy stays (the block's elastic
+            // wobble after the 21.8° turn moves it by a little).
+            assert!(
+                last < lowest_before_end + 0.01 * potential[0],
+                "{name}: {potential:?}"
+            );
+        }
+    }
+}
