@@ -405,6 +405,9 @@ struct Tally {
     sampling: f64,
     /// The worst-sampled body at the start.
     sampled: Sampled,
+    /// The body with the largest share of thin filled elements at the start
+    /// ([`Thin::of`]).
+    thin: Option<Thin>,
     /// PL's particles on element edges at the start ([`pl_edge_particles_warning`]).
     on_edges: Option<String>,
     /// [`stray_particles`] at the start.
@@ -666,6 +669,8 @@ impl Sampled {
         let sampling = bodies.get(worst).copied().unwrap_or(BodySampling {
             per_occupied: 0.0,
             volume_over_elements: 1.0,
+            filled: 0,
+            thin: 0,
         });
         let value = sampling.per_element();
         let alike = bodies
@@ -684,6 +689,8 @@ impl Sampled {
         Self::of(&[BodySampling {
             per_occupied: value,
             volume_over_elements: 1.0,
+            filled: 0,
+            thin: 0,
         }])
     }
 
@@ -935,6 +942,57 @@ pub fn ps_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
     })
 }
 
+/// Filled elements holding fewer than [`THIN_ELEMENT`] particles, at or above
+/// this share of a body's filled elements, make a PS run warn ([`Thin`]).
+pub const THIN_SHARE: f64 = 0.25;
+
+/// A body whose filled elements are thin in part although its average per
+/// element is enough ([`ps_sampling_warning`] is silent): a lattice of 3 × 4 per
+/// block of four triangles, 3 per triangle on average, puts 2 in the left and
+/// right triangles of every block. Measured (`docs/examples/p-wave-block.toml`,
+/// PS, default mass): E_u 3.17e-5 at 3 × 4 per block against 6.20e-7 at 4 × 4 (4
+/// in every triangle, counting those on the diagonals in both), 2.25e-6 at 4 × 3
+/// (2 in the top and bottom triangles) and 1.56e-6 at 5 × 4 (none thin); a
+/// user's P-wave block ran with its period 8.7 % long at 3 × 4.
+#[derive(Debug, Clone, Copy)]
+pub struct Thin {
+    /// `(body, bodies)`.
+    body: (usize, usize),
+    thin: usize,
+    filled: usize,
+}
+
+impl Thin {
+    /// The body with the largest share of thin filled elements, if that share is
+    /// [`THIN_SHARE`] or more.
+    pub fn of(bodies: &[BodySampling]) -> Option<Self> {
+        let share = |b: &BodySampling| b.thin as f64 / b.filled.max(1) as f64;
+        let (b, worst) = bodies
+            .iter()
+            .enumerate()
+            .max_by(|(_, a), (_, b)| share(a).total_cmp(&share(b)))?;
+        (share(worst) >= THIN_SHARE && worst.thin > 0).then_some(Thin {
+            body: (b, bodies.len()),
+            thin: worst.thin,
+            filled: worst.filled,
+        })
+    }
+
+    /// The warning, `keys` from [`particle_keys`].
+    pub fn warning(&self, keys: &str) -> String {
+        let who = match self.body {
+            (_, 1) => "the body".to_string(),
+            (b, n) => format!("body {} of {n}", b + 1),
+        };
+        format!(
+            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %), although it has 3 or more per triangle on average: a lattice of 3 × 4 per block of four triangles puts 2 in the left and right triangles of every block; each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes `per_block` [4, 4], or [5, 4], whose rows also miss the diagonals for a comparison with `pl`)",
+            self.thin,
+            self.filled,
+            100.0 * self.thin as f64 / self.filled.max(1) as f64
+        )
+    }
+}
+
 /// The tracked particles: the particle nearest each of the scene's tracked points.
 fn tracked<const D: usize, B: Basis<f64, D>>(scene: &Scene, run: &Prepared<D, B>) -> Vec<Tracked> {
     // The initial positions: the particles' reference positions.
@@ -1030,7 +1088,9 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
-    let sampled = Sampled::of(&driver.sampling_by_body(&run.body_sizes));
+    let bodies = driver.sampling_by_body(&run.body_sizes);
+    let sampled = Sampled::of(&bodies);
+    let thin = Thin::of(&bodies);
     let on_edges = (scene.basis == crate::bases::BasisKind::Pl)
         .then(|| pl_edge_particles_warning(&driver.particles_on_element_edges(&run.body_sizes)))
         .flatten();
@@ -1123,6 +1183,7 @@ where
         max_rotation_non_objective,
         sampling,
         sampled,
+        thin,
         on_edges,
         spin_at_start,
         stray_at_start,
@@ -1537,6 +1598,12 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .chain(
                     (scene.basis == crate::bases::BasisKind::Ps)
                         .then(|| ps_sampling_warning(&tally.sampled, keys))
+                        .flatten(),
+                )
+                .chain(
+                    (scene.basis == crate::bases::BasisKind::Ps
+                        && tally.sampled.value >= PS_SAMPLING)
+                        .then(|| tally.thin.as_ref().map(|t| t.warning(keys)))
                         .flatten(),
                 )
                 .chain(body_contact_warning(scene))

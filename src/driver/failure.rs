@@ -117,26 +117,70 @@ where
     /// empty or not adding up: one body).
     pub fn sampling_by_body(&self, body_sizes: &[usize]) -> Vec<BodySampling> {
         let sizes = bodies_or_one(body_sizes, self.particles.len());
-        let mut seen = vec![usize::MAX; self.basis.num_elements()];
+        let ne = self.basis.num_elements();
+        // Per element, the body's particles in it (`own`), and in its closure
+        // (`touching`: a particle on an edge or a vertex counts in every element
+        // around it, the same on both sides for a C¹ basis, where which one point
+        // location picks is a tie).
+        let (mut own, mut touching) = (vec![0usize; ne], vec![0usize; ne]);
+        let (mut elements, mut touched) = (Vec::new(), Vec::new());
         let mut pieces = Vec::new();
         let mut first = 0;
         sizes
             .iter()
-            .enumerate()
-            .map(|(b, &size)| {
-                let (mut occupied, mut size_of_elements, mut volume) = (0usize, 0.0, 0.0);
+            .map(|&size| {
+                let (mut size_of_elements, mut volume) = (0.0, 0.0);
                 for p in first..first + size {
                     volume += self.particles.volume0[p].to_f64();
                     let e = self.particles.element[p];
-                    if seen[e] != b {
-                        seen[e] = b;
-                        occupied += 1;
-                        pieces.clear();
-                        self.basis.polynomial_pieces(e, &mut pieces);
-                        size_of_elements += pieces.chunks(D + 1).map(simplex_measure).sum::<f64>();
+                    if own[e] == 0 {
+                        elements.push(e);
                     }
+                    own[e] += 1;
+                    let mut add = |o: usize| {
+                        if touching[o] == 0 {
+                            touched.push(o);
+                        }
+                        touching[o] += 1;
+                    };
+                    add(e);
+                    self.basis
+                        .other_elements_at(e, &self.particles.x[p], &mut add);
                 }
                 first += size;
+                for &e in &elements {
+                    pieces.clear();
+                    self.basis.polynomial_pieces(e, &mut pieces);
+                    size_of_elements += pieces.chunks(D + 1).map(simplex_measure).sum::<f64>();
+                }
+                let (mut filled, mut thin) = (0usize, 0usize);
+                for &e in &touched {
+                    // Inside the body: every element touching this one (at its
+                    // vertices and edges) holds some of the body's particles.
+                    pieces.clear();
+                    self.basis.polynomial_pieces(e, &mut pieces);
+                    let mut inside = true;
+                    for corner in &pieces {
+                        let x = SVector::<T, D>::from_fn(|k, _| T::of(corner[k]));
+                        self.basis
+                            .other_elements_at(e, &x, &mut |o| inside &= touching[o] > 0);
+                    }
+                    if inside {
+                        filled += 1;
+                        if (touching[e] as f64) < THIN_ELEMENT {
+                            thin += 1;
+                        }
+                    }
+                }
+                let occupied = elements.len();
+                for &e in &elements {
+                    own[e] = 0;
+                }
+                for &e in &touched {
+                    touching[e] = 0;
+                }
+                elements.clear();
+                touched.clear();
                 BodySampling {
                     per_occupied: size as f64 / occupied.max(1) as f64,
                     volume_over_elements: if size_of_elements > 0.0 {
@@ -144,6 +188,8 @@ where
                     } else {
                         1.0
                     },
+                    filled,
+                    thin,
                 }
             })
             .collect()
@@ -626,7 +672,20 @@ pub struct BodySampling {
     /// hold none (a lattice coarser than the mesh: 4 for one particle per block of
     /// four triangles).
     pub volume_over_elements: f64,
+    /// Its elements inside it (every element touching one holds some of its
+    /// particles), and of those the ones holding fewer than [`THIN_ELEMENT`]
+    /// particles (a particle on an edge or a vertex counting in every element
+    /// around it): a lattice whose average per element is enough may still leave
+    /// some elements thin (`per_block = [3, 4]` on blocks of four triangles puts 2
+    /// in the left and right triangles, 4 in the others).
+    pub filled: usize,
+    pub thin: usize,
 }
+
+/// Particles per element below which a PS element inside a body is thin
+/// ([`BodySampling::thin`]): its nine functions are quadratic on six
+/// sub-triangles, and fewer sums over particles integrate them poorly.
+pub const THIN_ELEMENT: f64 = 3.0;
 
 /// A body's particles whose volume exceeds the size of the elements holding them
 /// by more than this factor leave elements between them empty (jittered lattices
