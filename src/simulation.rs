@@ -459,16 +459,20 @@ pub fn unseen_velocity_warning(unseen: (f64, f64, f64), scale: f64, walls: bool)
 /// often a unit slip (`young` in MPa or kPa instead of Pa).
 pub const SELF_WEIGHT_STRAIN: f64 = 0.5;
 
-/// The warning for particles whose weight would strain the bodies by more than
-/// [`SELF_WEIGHT_STRAIN`]: the largest `ρ_p |g| H / E_p` over the particles, `ρ_p`
-/// and `E_p` each particle's, `H` the height of all the bodies along `g`: the
-/// extent of the particles' centres plus the mean spacing (`√V⁰_p`, `V⁰_p` in 1D)
-/// of the lowest and the highest particle, so that a lattice filling a box of
-/// height 1 measures 1, not the 1 less a spacing between its outer centres.
-/// `law_of(p)` names the particle's law, which the message speaks of.
+/// The warning for a body whose own weight would strain it by more than
+/// [`SELF_WEIGHT_STRAIN`]: per body (`body_sizes`, the numbers of particles of the
+/// bodies in order; empty: one body), the largest `ρ_p |g| H / E_p` over its
+/// particles, `ρ_p` and `E_p` each particle's, `H` the body's height along `g`:
+/// the extent of its particles' centres plus the mean spacing (`√V⁰_p`, `V⁰_p` in
+/// 1D) of its lowest and highest particle, so that a lattice filling a box of
+/// height 1 measures 1, not the 1 less a spacing between its outer centres. The
+/// worst body is named where there are several (bodies side by side, or one
+/// above another, each measured by its own height). `law_of(p)` names the
+/// particle's law, which the message speaks of.
 pub fn self_weight_warning<const D: usize>(
     gravity: Option<&[f64]>,
     particles: &Particles<f64, D>,
+    body_sizes: &[usize],
     material: &impl crate::materials::ParticleMaterials<f64, D>,
     law_of: impl Fn(usize) -> crate::scene::MaterialModel,
 ) -> Option<String> {
@@ -481,18 +485,41 @@ pub fn self_weight_warning<const D: usize>(
     }
     let along = |p: usize| (0..D).map(|k| particles.x0[p][k] * g[k]).sum::<f64>() / g_norm;
     let spacing = |p: usize| particles.volume0[p].powf(1.0 / D as f64);
-    let ((low, p_low), (high, p_high)) = (0..particles.len())
-        .map(|p| (along(p), p))
-        .fold(((f64::INFINITY, 0), (f64::NEG_INFINITY, 0)), |(l, h), s| {
-            (if s.0 < l.0 { s } else { l }, if s.0 > h.0 { s } else { h })
-        });
-    let height = high - low + 0.5 * (spacing(p_low) + spacing(p_high));
-    let (strain, p) = (0..particles.len())
-        .map(|p| {
-            let e = material.elastic(p);
-            (e.density * g_norm * height / e.young, p)
-        })
-        .max_by(|a, b| a.0.total_cmp(&b.0))?;
+    let sizes = if !body_sizes.is_empty() && body_sizes.iter().sum::<usize>() == particles.len() {
+        body_sizes.to_vec()
+    } else {
+        vec![particles.len()]
+    };
+    // (strain, particle, height, body) of the worst body.
+    let mut worst: Option<(f64, usize, f64, usize)> = None;
+    let mut first = 0;
+    for (b, &size) in sizes.iter().enumerate() {
+        let range = first..first + size;
+        first += size;
+        if size == 0 {
+            continue;
+        }
+        let ((low, p_low), (high, p_high)) = range
+            .clone()
+            .map(|p| (along(p), p))
+            .fold(((f64::INFINITY, 0), (f64::NEG_INFINITY, 0)), |(l, h), s| {
+                (if s.0 < l.0 { s } else { l }, if s.0 > h.0 { s } else { h })
+            });
+        let height = high - low + 0.5 * (spacing(p_low) + spacing(p_high));
+        let Some((strain, p)) = range
+            .map(|p| {
+                let e = material.elastic(p);
+                (e.density * g_norm * height / e.young, p)
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+        else {
+            continue;
+        };
+        if worst.is_none_or(|w| strain > w.0) {
+            worst = Some((strain, p, height, b));
+        }
+    }
+    let (strain, p, height, body) = worst?;
     (strain > SELF_WEIGHT_STRAIN).then(|| {
         let e = material.elastic(p);
         let law = match law_of(p) {
@@ -504,8 +531,13 @@ pub fn self_weight_warning<const D: usize>(
             }
             MaterialModel::NeoHookean => "the `neo-hookean` law takes them, but a body crushed to a fraction of its height by its own weight is seldom what was meant".to_string(),
         };
+        let who = if sizes.len() > 1 {
+            format!("body {} of {}'s own weight would strain it", body + 1, sizes.len())
+        } else {
+            "the body's own weight would strain it".to_string()
+        };
         format!(
-            "the bodies' own weight would strain them by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {}, H = {} along g, E = {}), far beyond small strains ({law}): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
+            "{who} by about ρ |g| H / E = {strain:.1e} (ρ = {}, |g| = {}, H = {} along g, E = {}), far beyond small strains ({law}): check the units of `young` (Pa), `density` (kg/m³) and `g` (m/s²)",
             echo_number(e.density),
             echo_number(g_norm),
             echo_fixed(height, 4),
@@ -1499,6 +1531,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
+        &run.body_sizes,
         driver.material(),
         |p| {
             let mut first = 0;
@@ -1830,7 +1863,7 @@ mod tests {
         let particles = Particles::<f64, 2>::new(x, vec![0.01; 100], 1.0);
         let soft = NeoHookean::new(Elastic::new(10.0, 0.3, 1.0).unwrap(), 2);
         let warn = |law: MaterialModel| {
-            self_weight_warning(Some(&[0.0, -10.0]), &particles, &soft, |_| law).unwrap()
+            self_weight_warning(Some(&[0.0, -10.0]), &particles, &[], &soft, |_| law).unwrap()
         };
         let neo = warn(MaterialModel::NeoHookean);
         assert!(neo.contains("ρ |g| H / E = 1.0e0"), "{neo}");
@@ -1842,10 +1875,24 @@ mod tests {
             linear.contains("beyond what the `linear-elastic` law models"),
             "{linear}"
         );
+        // Two bodies, one above the other: each measured by its own height and
+        // named (as one body the pair would be 1 tall).
+        let softer = NeoHookean::new(Elastic::new(8.0, 0.3, 1.0).unwrap(), 2);
+        let two = self_weight_warning(Some(&[0.0, -10.0]), &particles, &[50, 50], &softer, |_| {
+            MaterialModel::NeoHookean
+        })
+        .unwrap();
+        assert!(
+            two.starts_with(
+                "body 1 of 2's own weight would strain it by about ρ |g| H / E = 6.2e-1"
+            ),
+            "{two}"
+        );
+        assert!(two.contains("H = 0.5000 along g"), "{two}");
         // Stiff enough (strain 0.4): no warning.
         let stiff = NeoHookean::new(Elastic::new(25.0, 0.3, 1.0).unwrap(), 2);
         assert!(
-            self_weight_warning(Some(&[0.0, -10.0]), &particles, &stiff, |_| {
+            self_weight_warning(Some(&[0.0, -10.0]), &particles, &[], &stiff, |_| {
                 MaterialModel::NeoHookean
             })
             .is_none()

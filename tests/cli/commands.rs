@@ -927,7 +927,7 @@ fn a_body_far_too_soft_for_its_weight_is_named_as_the_cause() {
     assert!(
         // H is the column's height, 10 (the particles' centres span 10 less a
         // spacing: 1.9e4 with that, found by a user).
-        stderr.contains("own weight would strain them by about ρ |g| H / E = 2.0e4")
+        stderr.contains("the body's own weight would strain it by about ρ |g| H / E = 2.0e4")
             && stderr.contains("H = 10.0000 along g"),
         "{stderr}"
     );
