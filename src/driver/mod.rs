@@ -506,8 +506,9 @@ where
     /// normal `n̄ = (n_a + n_b) / |n_a + n_b|`, and each wall keeps its own
     /// derivative row: the vertex moves along the mean tangent, and near it each
     /// wall lets through `sin(θ/2)` of that velocity across itself (4.4 % at a 5°
-    /// bend). Call after [`Driver::add_slip_wall`] for the oblique walls, with every
-    /// bend between two slip walls (those along an axis included: the component
+    /// bend). Call after [`Driver::add_slip_wall`] for the oblique walls, with the
+    /// bends to share (the scene set-up passes those up to 22.5°,
+    /// `setup::mesh::SLIP_BEND_SHARED`) between two slip walls (those along an axis included: the component
     /// their [`Fix`] held at the vertex is released). Returns the number of bends
     /// treated; a bend at a vertex a no-slip wall also holds is left as it is.
     pub fn average_slip_bends(&mut self, bends: &[SlipBend<T, D>]) -> Result<usize, SetupError> {

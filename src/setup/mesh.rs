@@ -53,7 +53,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let h = smallest_edge(&mesh);
     check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
-    let bends = slip_bends(&mesh, &walls);
+    let (bends, bend_warning) = slip_bends(&mesh, &walls);
     let contacts = contact_walls(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
@@ -71,7 +71,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
         walls,
         bends,
         contacts,
-        warnings: Vec::new(),
+        warnings: bend_warning.into_iter().collect(),
     })
 }
 
@@ -231,16 +231,28 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
 }
 
 /// Slip walls whose normals differ by at most this angle (radians) meet at a bend a
-/// body is meant to slide over, not at a corner ([`slip_bend_warning`]).
+/// body is meant to slide over, not at a corner ([`slip_bends`]).
 pub const SLIP_BEND: f64 = std::f64::consts::FRAC_PI_4;
 
+/// Bends up to this angle (radians) are shared through the walls' mean normal
+/// ([`slip_bends`]); sharper ones, up to [`SLIP_BEND`], keep their vertex still and
+/// are warned about. The mean normal lets each wall through by `sin(θ/2)` of the
+/// vertex's velocity (38 % at 45°): measured with a PS block sliding from a slope
+/// onto a flat floor (`polygon` mesh of edge 0.15), at 21.8° it slides over the
+/// bend and stays stable (drift 3.0e-2); at 25° it slid over but ended UNSTABLE
+/// (6.4e-2), at 40° UNSTABLE (8.3e-2) where holding the vertex was stable, and PL
+/// left the mesh through the bend.
+pub const SLIP_BEND_SHARED: f64 = std::f64::consts::FRAC_PI_8;
+
 /// Every vertex where two slip walls meet at a bend (their normals differ by more
-/// than round-off and at most [`SLIP_BEND`]), for the driver to share through the
-/// walls' mean normal ([`crate::driver::Driver::average_slip_bends`]): otherwise
-/// each holds the velocity along its own normal there, the vertex holds still and
-/// a body sliding over the bend strikes it.
-fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> Vec<Bend> {
+/// than round-off and at most [`SLIP_BEND_SHARED`]), for the driver to share
+/// through the walls' mean normal ([`crate::driver::Driver::average_slip_bends`]):
+/// otherwise each holds the velocity along its own normal there, the vertex holds
+/// still and a body sliding over the bend strikes it. With the warning for the
+/// sharper bends up to [`SLIP_BEND`], whose vertex is held (the first named).
+fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> (Vec<Bend>, Option<String>) {
     let mut bends = Vec::new();
+    let mut sharp: Vec<(String, String, [f64; 2], f64)> = Vec::new();
     for (a, (tag_a, na)) in walls.iter().enumerate() {
         for (tag_b, nb) in &walls[a + 1..] {
             let angle = (na[0] * nb[1] - na[1] * nb[0])
@@ -266,15 +278,32 @@ fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> Vec<Bend> {
             let on_b = at(ib);
             for v in at(ia).into_iter().filter(|v| on_b.binary_search(v).is_ok()) {
                 let p = mesh.vertices()[v];
-                bends.push(Bend {
-                    tags: [tag_a.clone(), tag_b.clone()],
-                    normals: [*na, *nb],
-                    vertex: [p[0], p[1]],
-                });
+                if angle <= SLIP_BEND_SHARED {
+                    bends.push(Bend {
+                        tags: [tag_a.clone(), tag_b.clone()],
+                        normals: [*na, *nb],
+                        vertex: [p[0], p[1]],
+                    });
+                } else {
+                    sharp.push((tag_a.clone(), tag_b.clone(), [p[0], p[1]], angle));
+                }
             }
         }
     }
-    bends
+    let warning = sharp.first().map(|(tag_a, tag_b, p, angle)| {
+        let more = match sharp.len() {
+            1 => String::new(),
+            n => format!(" (and {} more such bends)", n - 1),
+        };
+        format!(
+            "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend strikes it (bends up to {:.1}° share the vertex through the walls' mean normal; a sharper one would let a body through the walls near it); for a floor that bends this sharply, make its sides contact walls (`[[effect]]` with `kind = \"contact-wall\"` and each side's `tag`, in place of their `[[boundary]]`), which take bends",
+            crate::scene::limits::echo_significant(p[0], 6),
+            crate::scene::limits::echo_significant(p[1], 6),
+            angle.to_degrees(),
+            SLIP_BEND_SHARED.to_degrees(),
+        )
+    });
+    (bends, warning)
 }
 
 /// Two slip walls meeting at a bend at `vertex` ([`slip_bends`]).

@@ -1562,7 +1562,28 @@ t_end = 1.2
                 "{name}: {potential:?}"
             );
         }
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert!(!stderr.contains("meet at"), "{name}: {stderr}");
     }
+    // A sharper bend (30°) keeps its vertex still, and the run says so.
+    let sharp = SceneFile::new(
+        "bend-sharp",
+        &scene("[[0.0, 2.44338], [2.5, 1.0], [5.0, 1.0], [5.0, 3.5], [0.0, 3.5]]")
+            .replace(
+                "[[0.86444, 1.66498], [1.14299, 1.55357], [1.2544, 1.83212], [0.97585, 1.94353]]",
+                "[[1.0, 2.6], [1.3, 2.6], [1.3, 2.9], [1.0, 2.9]]",
+            )
+            .replace("t_end = 1.2", "t_end = 0.01"),
+    );
+    let out = cli()
+        .args(["run", sharp.arg(), "--diag-every", "0"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("slip walls `upper` and `lower` meet at [2.5, 1] at a bend of 30.0°"),
+        "{stderr}"
+    );
 }
 
 /// A PS lattice with enough particles per triangle on average but 2 in half of
