@@ -847,7 +847,7 @@ pub fn pl_edge_particles_warning(bodies: &[(usize, usize)]) -> Option<String> {
         ),
     };
     Some(format!(
-        "{who} ({:.0} %) lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4], or `jitter`), or the smooth basis `ps`",
+        "{who} ({:.0} %) lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4]; `jitter` moves the particles off the edges but measured no better), or the smooth basis `ps`",
         100.0 * on as f64 / n as f64
     ))
 }
@@ -1017,7 +1017,7 @@ impl Thin {
             (b, n) => format!("body {} of {n}", b + 1),
         };
         format!(
-            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %), although it has 3 or more per triangle on average: a lattice of 3 × 4 per block of four triangles puts 2 in the left and right triangles of every block; each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes `per_block` [4, 4], or [5, 4], whose rows also miss the diagonals for a comparison with `pl`)",
+            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %), although it has 3 or more per triangle on average: a lattice of 3 × 4 per block of four triangles puts 2 in the left and right triangles of every block (4 × 3 in the top and bottom ones); each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes a square `per_block` such as [4, 4] or [6, 6]: non-square ones such as [5, 4] leave PS 2–8 times less accurate than [4, 4] on the same block; PL wants one odd and one even count, so compare the two bases each on its own lattice)",
             self.thin,
             self.filled,
             100.0 * self.thin as f64 / self.filled.max(1) as f64

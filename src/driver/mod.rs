@@ -889,7 +889,7 @@ where
                     .any(|i| functions.contains(i))
             }) {
                 format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out at the bend where two slip walls meet at {}: there the walls hold the velocity along their mean normal (else the vertex would hold still and stop a body sliding over it), which lets a body sliding into a valley cross each wall near the vertex by sin(θ/2) of its speed, θ the bend; for a floor that bends, make its sides contact walls (`[[effect]]` with `kind = \"contact-wall\"` and each side's `tag`, in place of their `[[boundary]]`), which hold a body from outside without holding the vertex",
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out at the bend where two slip walls meet at {}: there the walls hold the velocity along their mean normal (else the vertex would hold still and stop a body sliding over it), which lets a body sliding into a valley cross each wall near the vertex by sin(θ/2) of its speed, θ the bend; for a floor a body slides over, give the whole floor one tag and make it a contact wall (`[[effect]]` with `kind = \"contact-wall\"` and that `tag`, in place of the `[[boundary]]`s), which holds a body from outside without holding the vertex (two contact walls meeting at a corner leave a gap there)",
                     point(vertex)
                 )
             } else if self

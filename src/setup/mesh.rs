@@ -53,7 +53,7 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     let h = smallest_edge(&mesh);
     check_tags(scene, mesh.tags())?;
     let walls = wall_normals(scene, &mesh)?;
-    let (bends, bend_warning) = slip_bends(&mesh, &walls);
+    let (bends, bend_warning) = slip_bends(&mesh, &walls, scene.basis == BasisKind::Ps);
     let contacts = contact_walls(scene, &mesh)?;
     let basis = match scene.basis {
         BasisKind::Ps => Basis2d::Ps(
@@ -232,7 +232,7 @@ fn wall_normals(scene: &Scene, mesh: &TriMesh) -> Result<Vec<(String, [f64; 2])>
 
 /// Slip walls whose normals differ by at most this angle (radians) meet at a bend a
 /// body is meant to slide over, not at a corner ([`slip_bends`]).
-pub const SLIP_BEND: f64 = std::f64::consts::FRAC_PI_4;
+pub const SLIP_BEND: f64 = 80.0 * std::f64::consts::PI / 180.0;
 
 /// Bends up to this angle (radians) are shared through the walls' mean normal
 /// ([`slip_bends`]); sharper ones, up to [`SLIP_BEND`], keep their vertex still and
@@ -250,7 +250,11 @@ pub const SLIP_BEND_SHARED: f64 = std::f64::consts::FRAC_PI_8;
 /// otherwise each holds the velocity along its own normal there, the vertex holds
 /// still and a body sliding over the bend strikes it. With the warning for the
 /// sharper bends up to [`SLIP_BEND`], whose vertex is held (the first named).
-fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> (Vec<Bend>, Option<String>) {
+fn slip_bends(
+    mesh: &TriMesh,
+    walls: &[(String, [f64; 2])],
+    smooth: bool,
+) -> (Vec<Bend>, Option<String>) {
     let mut bends = Vec::new();
     let mut sharp: Vec<(String, String, [f64; 2], f64)> = Vec::new();
     for (a, (tag_a, na)) in walls.iter().enumerate() {
@@ -278,7 +282,22 @@ fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> (Vec<Bend>, Optio
             let on_b = at(ib);
             for v in at(ia).into_iter().filter(|v| on_b.binary_search(v).is_ok()) {
                 let p = mesh.vertices()[v];
-                if angle <= SLIP_BEND_SHARED {
+                // A valley (the domain convex at the vertex): the other end of a
+                // wall-b edge at the vertex lies on the domain's side of wall a.
+                let valley = mesh
+                    .edges()
+                    .iter()
+                    .filter(|e| e.tag == Some(ib) && e.vertices.contains(&v))
+                    .any(|e| {
+                        let w = if e.vertices[0] == v {
+                            e.vertices[1]
+                        } else {
+                            e.vertices[0]
+                        };
+                        let d = mesh.vertices()[w] - p;
+                        d[0] * na[0] + d[1] * na[1] < 0.0
+                    });
+                if angle <= SLIP_BEND_SHARED && valley && smooth {
                     bends.push(Bend {
                         tags: [tag_a.clone(), tag_b.clone()],
                         normals: [*na, *nb],
@@ -296,7 +315,7 @@ fn slip_bends(mesh: &TriMesh, walls: &[(String, [f64; 2])]) -> (Vec<Bend>, Optio
             n => format!(" (and {} more such bends)", n - 1),
         };
         format!(
-            "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend strikes it (bends up to {:.1}° share the vertex through the walls' mean normal; a sharper one would let a body through the walls near it); for a floor that bends this sharply, make its sides contact walls (`[[effect]]` with `kind = \"contact-wall\"` and each side's `tag`, in place of their `[[boundary]]`), which take bends",
+            "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend strikes it (with PS, valleys up to {:.1}° share the vertex through the walls' mean normal; a crest, a sharper valley or PL's particles would go through the walls near it); for a floor a body slides over, give the whole floor one tag and make it a contact wall (`[[effect]]` with `kind = \"contact-wall\"` and that `tag`, in place of the `[[boundary]]`s), which takes bends (two contact walls meeting at a corner leave a gap there)",
             crate::scene::limits::echo_significant(p[0], 6),
             crate::scene::limits::echo_significant(p[1], 6),
             angle.to_degrees(),
