@@ -974,7 +974,7 @@ pub fn ps_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
     })
 }
 
-/// Filled elements holding fewer than [`THIN_ELEMENT`] particles, at or above
+/// Filled elements holding fewer than 3 (`driver::failure::THIN_ELEMENT`) particles, at or above
 /// this share of a body's filled elements, make a PS run warn ([`Thin`]).
 pub const THIN_SHARE: f64 = 0.25;
 

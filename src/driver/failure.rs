@@ -673,7 +673,7 @@ pub struct BodySampling {
     /// four triangles).
     pub volume_over_elements: f64,
     /// Its elements inside it (every element touching one holds some of its
-    /// particles), and of those the ones holding fewer than [`THIN_ELEMENT`]
+    /// particles), and of those the ones holding fewer than 3 (`THIN_ELEMENT`)
     /// particles (a particle on an edge or a vertex counting in every element
     /// around it): a lattice whose average per element is enough may still leave
     /// some elements thin (`per_block = [3, 4]` on blocks of four triangles puts 2
