@@ -6,9 +6,27 @@
 use crate::particles::Particles;
 use nalgebra::SVector;
 
-/// How far, in its own spacing `√V⁰_p` (`V⁰_p` in 1D), a particle's nearest
-/// neighbour must be for it to count as stray ([`stray_particles`]).
+/// How far, in its own spacing `√V⁰_p` (`V⁰_p` in 1D; times its body's stretch,
+/// [`body_stretch`]), a particle's nearest neighbour must be for it to count as
+/// stray ([`stray_particles`]).
 pub const STRAY_DISTANCE: f64 = 2.0;
+
+/// The largest spacing of a lattice of spacings `h` (one per axis) over its mean
+/// spacing `(Π h_k)^(1/D)`, the `√V⁰_p` the arrangement measures by: 1 for a
+/// square lattice, 2 for `per_block = [2, 8]` on square blocks. A particle's
+/// spacing is `√V⁰_p` times its body's stretch, so that the neighbours along the
+/// coarse axis count: without it a block at `[2, 8]`, whose columns lie exactly
+/// `2 √V⁰_p` apart, was reported in 8 pieces 0.002 s into a standing wave of
+/// amplitude 1e-5.
+pub fn body_stretch(h: &[f64]) -> f64 {
+    let mean = h.iter().product::<f64>().powf(1.0 / h.len().max(1) as f64);
+    let largest = h.iter().copied().fold(0.0, f64::max);
+    if mean > 0.0 && largest.is_finite() {
+        (largest / mean).max(1.0)
+    } else {
+        1.0
+    }
+}
 
 /// The particles near each particle: a hash grid of cells of the largest reach
 /// (`distance` times the largest particle's spacing `√V⁰_p`, `V⁰_p` in 1D) over
@@ -18,6 +36,10 @@ pub const STRAY_DISTANCE: f64 = 2.0;
 struct NeighbourGrid<'a, const D: usize> {
     positions: &'a [SVector<f64, D>],
     volume0: &'a [f64],
+    /// The body of each particle (empty: one body) and each body's stretch
+    /// ([`body_stretch`]; empty: 1).
+    body: &'a [u32],
+    stretch: &'a [f64],
     distance: f64,
     reach: f64,
     grid: std::collections::HashMap<[i64; D], Vec<usize>>,
@@ -27,11 +49,17 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
     /// The grid of `positions` (particles of reference volumes `volume0`) for the
     /// neighbours within `distance` of their spacing; `None` when the particles
     /// have no size to measure by.
-    fn new(positions: &'a [SVector<f64, D>], volume0: &'a [f64], distance: f64) -> Option<Self> {
+    fn new(
+        positions: &'a [SVector<f64, D>],
+        volume0: &'a [f64],
+        (body, stretch): (&'a [u32], &'a [f64]),
+        distance: f64,
+    ) -> Option<Self> {
         let reach = volume0
             .iter()
             .map(|v| v.powf(1.0 / D as f64))
             .fold(0.0, f64::max)
+            * stretch.iter().copied().fold(1.0, f64::max)
             * distance;
         if !(reach > 0.0 && reach.is_finite()) {
             return None;
@@ -39,6 +67,8 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
         let mut grid = Self {
             positions,
             volume0,
+            body,
+            stretch,
             distance,
             reach,
             grid: Default::default(),
@@ -53,9 +83,15 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
         std::array::from_fn(|k| (self.positions[p][k] / self.reach).floor() as i64)
     }
 
-    /// Particle `p`'s spacing `√V⁰_p` (`V⁰_p` in 1D).
+    /// Particle `p`'s spacing `√V⁰_p` (`V⁰_p` in 1D), times its body's stretch.
     fn spacing(&self, p: usize) -> f64 {
-        self.volume0[p].powf(1.0 / D as f64)
+        let stretch = match (self.stretch, self.body.get(p)) {
+            ([], _) => 1.0,
+            ([one], _) => *one,
+            (all, Some(&b)) => all.get(b as usize).copied().unwrap_or(1.0),
+            (all, None) => all.iter().copied().fold(1.0, f64::max),
+        };
+        self.volume0[p].powf(1.0 / D as f64) * stretch.max(1.0)
     }
 
     /// Calls `near(q)` for each particle `q ≠ p` within `distance` times the
@@ -79,9 +115,11 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
 /// measure by.
 fn neighbours<const D: usize>(
     particles: &Particles<f64, D>,
+    bodies: (&[u32], &[f64]),
     mut pair: impl FnMut(usize, usize),
 ) -> bool {
-    let Some(grid) = NeighbourGrid::new(&particles.x, &particles.volume0, STRAY_DISTANCE) else {
+    let Some(grid) = NeighbourGrid::new(&particles.x, &particles.volume0, bodies, STRAY_DISTANCE)
+    else {
         return false;
     };
     for p in 0..particles.len() {
@@ -126,8 +164,13 @@ pub struct Fragments {
 /// are those of each body: `body_sizes` are the numbers of particles of the bodies,
 /// whose particles follow each other in that order (empty: one body), and
 /// neighbours of different bodies are not joined, so bodies that start in contact
-/// and part stay one piece each, while a body torn in two is two.
-pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[usize]) -> Fragments {
+/// and part stay one piece each, while a body torn in two is two. `stretch` is
+/// each body's [`body_stretch`] (empty: 1).
+pub fn fragments<const D: usize>(
+    particles: &Particles<f64, D>,
+    body_sizes: &[usize],
+    stretch: &[f64],
+) -> Fragments {
     fn root(parent: &mut [usize], mut a: usize) -> usize {
         while parent[a] != a {
             parent[a] = parent[parent[a]];
@@ -139,7 +182,7 @@ pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[us
     let body = bodies(body_sizes, n);
     let mut near = vec![false; n];
     let mut parent: Vec<usize> = (0..n).collect();
-    let measured = neighbours(particles, |p, q| {
+    let measured = neighbours(particles, (&body, stretch), |p, q| {
         near[p] = true;
         if !body.is_empty() && body[p] != body[q] {
             return;
@@ -170,12 +213,12 @@ pub fn fragments<const D: usize>(particles: &Particles<f64, D>, body_sizes: &[us
 
 /// [`Fragments::stray`] of `particles`.
 pub fn stray_particles<const D: usize>(particles: &Particles<f64, D>) -> usize {
-    fragments(particles, &[]).stray
+    fragments(particles, &[], &[]).stray
 }
 
 /// [`Fragments::pieces`] of `particles`, taken as one body.
 pub fn pieces<const D: usize>(particles: &Particles<f64, D>) -> Vec<usize> {
-    fragments(particles, &[]).pieces
+    fragments(particles, &[], &[]).pieces
 }
 
 /// The warning for a run whose particles form more [`pieces`] at the end (`end`,
@@ -270,16 +313,24 @@ pub struct Irregularity {
 /// of the order of the strain's variation over a spacing; particles that pair up,
 /// open voids or cross their neighbours' rows raise it to a fair fraction of a
 /// spacing. Counts, over the particles, those above [`IRREGULAR_RESIDUAL`]. In 1D
-/// no neighbourhood spans the plane and nothing is measured.
+/// no neighbourhood spans the plane and nothing is measured. The neighbourhood
+/// reaches along the coarse axis of a stretched lattice (`stretch`, each body's
+/// [`body_stretch`]; empty: 1), and the residual is measured in `√V⁰_p`.
 pub fn irregularity<const D: usize>(
     particles: &Particles<f64, D>,
     body_sizes: &[usize],
+    stretch: &[f64],
 ) -> Irregularity {
     let mut out = Irregularity::default();
-    let Some(grid) = NeighbourGrid::new(&particles.x0, &particles.volume0, NEIGHBOURHOOD) else {
+    let body = bodies(body_sizes, particles.len());
+    let Some(grid) = NeighbourGrid::new(
+        &particles.x0,
+        &particles.volume0,
+        (&body, stretch),
+        NEIGHBOURHOOD,
+    ) else {
         return out;
     };
-    let body = bodies(body_sizes, particles.len());
     for p in 0..particles.len() {
         // Σ ΔX ΔXᵀ, Σ Δx ΔXᵀ, Σ |Δx|² and the count.
         let (mut a, mut b) = (nalgebra::Matrix2::zeros(), nalgebra::Matrix2::zeros());
@@ -295,7 +346,7 @@ pub fn irregularity<const D: usize>(
             c += dx.norm_squared();
             count += 1;
         });
-        let h = grid.spacing(p);
+        let h = particles.volume0[p].powf(1.0 / D as f64);
         // A neighbourhood that spans the plane: det(Σ ΔX ΔXᵀ) well away from zero
         // on the scale of the spacing (a row of particles does not).
         if count < 2 || a.determinant().abs() <= 1e-6 * h.powi(4) {
@@ -406,6 +457,41 @@ mod tests {
         assert!(stray_warning(3, 5, 100).is_none());
     }
 
+    /// A lattice whose columns lie 4 times as far apart as its rows (`per_block =
+    /// [2, 8]`: `√V⁰` is half the column spacing, so the columns are exactly at
+    /// `STRAY_DISTANCE √V⁰`), its columns 1 % farther apart: one piece with the
+    /// lattice's stretch, as many as columns without; torn in two, two with it.
+    /// Its neighbourhoods span the plane for the irregularity with the stretch
+    /// (without it a particle's neighbours within 1.5 `√V⁰` are its column's).
+    #[test]
+    fn a_stretched_lattice_is_one_piece() {
+        let (dx, dy) = (0.4, 0.1);
+        let lattice = |widen: f64, gap: f64| {
+            let x: Vec<Vector2<f64>> = (0..100)
+                .map(|i| {
+                    let (a, b) = ((i % 5) as f64, (i / 5) as f64);
+                    Vector2::new(dx * widen * a, dy * b + if b >= 10.0 { gap } else { 0.0 })
+                })
+                .collect();
+            Particles::<f64, 2>::new(x, vec![dx * dy; 100], 1.0)
+        };
+        let stretch = [body_stretch(&[dx, dy])];
+        assert!((stretch[0] - 2.0).abs() < 1e-12);
+        let one = lattice(1.01, 0.0);
+        assert_eq!(fragments(&one, &[], &stretch).pieces, vec![100]);
+        assert_eq!(fragments(&one, &[], &[]).pieces, vec![20; 5]);
+        assert_eq!(fragments(&one, &[], &stretch).stray, 0);
+        let torn = lattice(1.0, 1.0);
+        assert_eq!(fragments(&torn, &[], &stretch).pieces, vec![50, 50]);
+        let mut moved = lattice(1.0, 0.0);
+        moved.x.iter_mut().for_each(|x| x.x *= 1.01);
+        assert_eq!(irregularity(&moved, &[], &stretch).measured, 100);
+        assert_eq!(irregularity(&moved, &[], &stretch).irregular, 0);
+        assert_eq!(irregularity(&moved, &[], &[]).measured, 0);
+        assert_eq!(body_stretch(&[0.1, 0.1]), 1.0);
+        assert_eq!(body_stretch(&[0.05, 0.0125]), 2.0);
+    }
+
     /// A lattice is one piece, stretched by half its spacing too; torn in two it is
     /// two, and the warning gives their shares; a few particles flung off are not a
     /// piece (they are stray).
@@ -435,13 +521,13 @@ mod tests {
         // The rows from 7 on as a body of their own (30 particles after the 70 of
         // the first): two pieces touching at the start, and still two once they
         // part, since pieces are counted per body; a body torn is one more.
-        let two_bodies = |gap: f64| fragments(&lattice(1.0, gap, 0), &[70, 30]).pieces;
+        let two_bodies = |gap: f64| fragments(&lattice(1.0, gap, 0), &[70, 30], &[]).pieces;
         assert_eq!(two_bodies(0.0), vec![70, 30]);
         assert_eq!(two_bodies(0.5), vec![70, 30]);
         let mut torn = lattice(1.0, 0.0, 0);
         (0..20).for_each(|p| torn.x[p].y -= 0.5);
-        assert_eq!(fragments(&torn, &[70, 30]).pieces, vec![50, 30, 20]);
-        assert_eq!(fragments(&torn, &[]).pieces, vec![80, 20]);
+        assert_eq!(fragments(&torn, &[70, 30], &[]).pieces, vec![50, 30, 20]);
+        assert_eq!(fragments(&torn, &[], &[]).pieces, vec![80, 20]);
         let warning = pieces_warning(1, &[70, 30], 100).unwrap();
         assert!(
             warning.contains("2 pieces at the end (1 at the start), holding 70 %, 30 %"),
@@ -473,7 +559,7 @@ mod tests {
         };
         let bent = |x: Vector2<f64>| Vector2::new(x.x, x.y + 0.3 * x.x * x.x);
         for (name, p) in [("affine", moved(&affine)), ("bent", moved(&bent))] {
-            let r = irregularity(&p, &[]);
+            let r = irregularity(&p, &[], &[]);
             assert_eq!((r.measured, r.irregular), (100, 0), "{name}: {r:?}");
             assert!(r.largest < 0.05, "{name}: {r:?}");
         }
@@ -481,7 +567,7 @@ mod tests {
             let column = (x.x / 0.1).round() as i64;
             x + Vector2::new(0.0, if column % 2 == 0 { 0.02 } else { -0.02 })
         });
-        let r = irregularity(&zigzag, &[]);
+        let r = irregularity(&zigzag, &[], &[]);
         assert!(r.irregular >= 64, "{r:?}");
         assert!(irregularity_warning(&r, true, 4.0, false)
             .unwrap()
@@ -505,7 +591,7 @@ mod tests {
         // The top three rows (30 particles) slide by a spacing along the rest.
         let slid =
             moved(&|x: Vector2<f64>| x + Vector2::new(if x.y > 0.65 { 0.1 } else { 0.0 }, 0.0));
-        assert_eq!(irregularity(&slid, &[70, 30]).irregular, 0);
-        assert!(irregularity(&slid, &[]).irregular >= 20);
+        assert_eq!(irregularity(&slid, &[70, 30], &[]).irregular, 0);
+        assert!(irregularity(&slid, &[], &[]).irregular >= 20);
     }
 }

@@ -46,7 +46,10 @@
 //! that slides along a slanted wall without turning, a slip wall is the better
 //! model; for one that rolls or spins, this. The wall is the tagged boundary's
 //! edges, and the boundary's reflex corners (a domain angle above π, the corners
-//! of an obstacle) push radially, so a body can wrap around them.
+//! of an obstacle) push radially, so a body can wrap around them. The contact
+//! walls of all tags are one geometry and one effect, so that walls of different
+//! tags that meet act as one wall ([`WallGeometry::new`]); each wall's `κ` scales
+//! its part of a particle's spring.
 
 use crate::effect::Effect;
 use crate::particles::Particles;
@@ -75,6 +78,9 @@ pub struct WallGeometry {
     free: Vec<[bool; 2]>,
     /// Reflex corners: the vertex and its two wall edges.
     corners: Vec<(Vec2, [usize; 2])>,
+    /// Per item (the segments, then the corners), `κ²` of its wall (of the
+    /// stiffer of a corner's two).
+    stiffness: Vec<f64>,
     /// Per element, the segments (`i`) and corners (`segments.len() + j`) within
     /// `reach` of it (CSR).
     element_start: Vec<usize>,
@@ -84,19 +90,31 @@ pub struct WallGeometry {
 }
 
 impl WallGeometry {
-    /// The edges tagged `tag` of `mesh` (a tag id), with the items within `reach`
-    /// of each element. `None` when no edge has the tag.
-    pub fn new(mesh: &TriMesh, tag: usize, reach: f64) -> Option<Self> {
+    /// The boundary edges of `mesh` tagged with the tags of `walls` (tag id and
+    /// `κ`), with the items within `reach` of each element. `None` when no edge has
+    /// any of the tags.
+    ///
+    /// The walls of all tags are one geometry: where two meet, neither end is free
+    /// and their corner pushes radially, as within one tag, and a particle touching
+    /// both has one spring ([`ContactWall`]). As two geometries, each bevelled at
+    /// the common vertex, they left a gap there, and a particle touching both
+    /// pressed on two springs, each sized as if the other were not there.
+    pub fn new(mesh: &TriMesh, walls: &[(usize, f64)], reach: f64) -> Option<Self> {
         let v = mesh.vertices();
         let mut segments = Vec::new();
         let mut edge_of_segment = Vec::new();
+        let mut stiffness = Vec::new();
         for (k, e) in mesh.edges().iter().enumerate() {
-            if e.tag == Some(tag) && e.is_boundary() {
+            let Some(&(_, kappa)) = walls.iter().find(|(tag, _)| e.tag == Some(*tag)) else {
+                continue;
+            };
+            if e.is_boundary() {
                 let (a, b) = (v[e.vertices[0]], v[e.vertices[1]]);
                 // Counter-clockwise in its triangle: the mesh lies to the left.
                 let d = (b - a).normalize();
                 segments.push((a, b, Vec2::new(-d.y, d.x)));
                 edge_of_segment.push(k);
+                stiffness.push(kappa * kappa);
             }
         }
         if segments.is_empty() {
@@ -134,6 +152,11 @@ impl WallGeometry {
                 corners.push((v[end], [s, next]));
             }
         }
+        let corner_stiffness: Vec<f64> = corners
+            .iter()
+            .map(|(_, [s0, s1])| stiffness[*s0].max(stiffness[*s1]))
+            .collect();
+        stiffness.extend(corner_stiffness);
         // Items near each element: a walk outwards from the triangles on each item
         // while their bounding boxes stay within `reach`.
         let ne = mesh.num_triangles();
@@ -173,6 +196,7 @@ impl WallGeometry {
             segments,
             free,
             corners,
+            stiffness,
             element_start,
             element_items,
             reach,
@@ -193,12 +217,12 @@ impl WallGeometry {
             .is_some_and(|(a, b)| b > a)
     }
 
-    /// Calls `contact(g, n)` for each wall item within `d` of `x` (in `element`):
-    /// `g` how far inside the distance, `n = −∇g` the direction from the wall to
-    /// `x` (a unit vector, but for the bevels).
+    /// Calls `contact(g, n, κ²)` for each wall item within `d` of `x` (in
+    /// `element`): `g` how far inside the distance, `n = −∇g` the direction from
+    /// the wall to `x` (a unit vector, but for the bevels), `κ` the item's wall's.
     ///
-    /// A free end of the wall (where the tagged boundary goes on untagged, or turns
-    /// into another tag) is bevelled over the contact distance: within `d` of the
+    /// A free end of the walls (where the tagged boundary goes on untagged, or with a
+    /// tag that is no contact wall) is bevelled over the contact distance: within `d` of the
     /// end `c` along the edge, `g = d − (x − c)·n − (d − σ)`, `σ = (x − c)·u` the
     /// distance from the end along the edge (`u` pointing into it), so that `g`
     /// is `−(x − c)·n ≤ 0` at the end itself and the potential `½ k g²` is
@@ -211,7 +235,7 @@ impl WallGeometry {
     /// but stopped the block on the ramp: its particles sit slightly closer than
     /// `d` to the ramp, and the end pushed them back.
     #[inline]
-    fn contacts(&self, element: usize, x: Vec2, d: f64, mut contact: impl FnMut(f64, Vec2)) {
+    fn contacts(&self, element: usize, x: Vec2, d: f64, mut contact: impl FnMut(f64, Vec2, f64)) {
         // An element of a body's copy of the basis (`body_contact::PerBody`) is that
         // element of the mesh.
         let element = element % (self.element_start.len() - 1).max(1);
@@ -232,8 +256,15 @@ impl WallGeometry {
             if item < self.segments.len() {
                 let (a, b, n) = self.segments[item];
                 let t = along(item);
-                if (0.0..=1.0).contains(&t) {
-                    let mut g = d - (x - a).dot(&n);
+                let height = (x - a).dot(&n);
+                // Behind the edge by more than the contact distance: the far side
+                // of an obstacle, listed because the element is within `reach` of
+                // it (an obstacle thinner than the mesh's longest edge), and out of
+                // reach through the mesh. Counted, it pushed a particle beside the
+                // near side towards the obstacle with `k_p (d + w)`, `w` its width,
+                // or, at the start, took its contact distance below zero.
+                if (0.0..=1.0).contains(&t) && height >= -d.max(0.0) {
+                    let mut g = d - height;
                     let mut direction = n;
                     let [free_a, free_b] = self.free[item];
                     if free_a || free_b {
@@ -249,7 +280,7 @@ impl WallGeometry {
                         }
                     }
                     if g > 0.0 {
-                        contact(g, direction);
+                        contact(g, direction, self.stiffness[item]);
                     }
                 }
             } else {
@@ -259,12 +290,37 @@ impl WallGeometry {
                     let r = x - c;
                     let dist = r.norm();
                     if dist < d && dist > 0.0 {
-                        contact(d - dist, r / dist);
+                        contact(d - dist, r / dist, self.stiffness[item]);
                     }
                 }
             }
         }
     }
+}
+
+/// The particles (index and distance) that start closer to the walls than
+/// [`crate::driver::STARTED_CLOSE`] of their contact distance: placed in the walls'
+/// contact layer, their springs have that little room. The particles are located
+/// (`element`).
+pub fn started_close<T: Scalar, const D: usize>(
+    geometry: &WallGeometry,
+    particles: &Particles<T, D>,
+) -> Vec<(usize, f64)> {
+    let mut close = Vec::new();
+    for p in 0..particles.len() {
+        let d = contact_distance::<D>(particles.volume0[p].to_f64());
+        let mut deepest = 0.0f64;
+        geometry.contacts(
+            particles.element[p],
+            ContactWall::position(&particles.x[p]),
+            d,
+            |g, _, _| deepest = deepest.max(g),
+        );
+        if d - deepest < crate::driver::STARTED_CLOSE * d {
+            close.push((p, d - deepest));
+        }
+    }
+    close
 }
 
 /// The angle of triangle `t` at vertex `v`.
@@ -285,9 +341,10 @@ fn box_distance(mesh: &TriMesh, t: usize, lo: Vec2, hi: Vec2) -> f64 {
     Vec2::new(gap(tlo.x, thi.x, lo.x, hi.x), gap(tlo.y, thi.y, lo.y, hi.y)).norm()
 }
 
-/// A frictionless contact wall (see the module doc): per particle, the contact
-/// distance `d_p`, and the spring `k_p` of the last step (for the potential
-/// energy); `κ` and the run's `Δt` give the stiffness.
+/// The frictionless contact walls of a run (see the module doc), all tags in one
+/// geometry: per particle, the contact distance `d_p`, and the spring `k_p` of the
+/// last step (for the potential energy); each wall's `κ` and the run's `Δt` give
+/// the stiffness.
 #[derive(Debug)]
 pub struct ContactWall {
     /// The wall.
@@ -296,9 +353,7 @@ pub struct ContactWall {
     /// (the body starts at rest where it was placed, without a spring already
     /// compressed).
     distance: Mutex<Vec<f64>>,
-    /// `κ`.
-    stiffness: f64,
-    /// `ω_c² = (κ / Δt)²`, set by [`Effect::set_time_step`].
+    /// `1 / Δt²`, set by [`Effect::set_time_step`] (`ω_c² = κ² / Δt²` per wall).
     rate: f64,
     /// Scratch and state of [`Effect::add_forces`].
     state: Mutex<State>,
@@ -311,9 +366,9 @@ struct State {
     grid_mass: Vec<f64>,
     /// The part of `m_i` carried by particles in contact (scratch).
     contact_mass: Vec<f64>,
-    /// The particles in contact and their summed `g n` (scratch).
+    /// The particles in contact and their summed `κ² g n` (scratch).
     touching: Vec<(usize, Vec2)>,
-    /// `k_p` of each particle (`m_p (κ / Δt)²` until the first step).
+    /// `k_p / κ²` of each particle (`m_p / Δt²` until the first step).
     springs: Vec<f64>,
     /// The particle was in contact at the last step (its spring may then only
     /// soften: see [`ContactWall`]'s `add_forces`).
@@ -330,13 +385,12 @@ pub fn contact_distance<const D: usize>(volume0: f64) -> f64 {
 }
 
 impl ContactWall {
-    /// The wall `geometry` for `particles`, with spring frequency `stiffness / Δt`.
-    /// `Err` with the largest contact distance when it exceeds the geometry's
-    /// reach (particles much coarser than the elements).
+    /// The walls' `geometry` for `particles` (a wall's spring frequency `κ / Δt`,
+    /// its `κ` in the geometry). `Err` with the largest contact distance when it
+    /// exceeds the geometry's reach (particles much coarser than the elements).
     pub fn new<T: Scalar, const D: usize>(
         geometry: WallGeometry,
         particles: &Particles<T, D>,
-        stiffness: f64,
     ) -> Result<Self, f64> {
         let distance: Vec<f64> = particles
             .volume0
@@ -351,7 +405,6 @@ impl ContactWall {
         let was_touching = vec![false; mass.len()];
         Ok(ContactWall {
             geometry,
-            stiffness,
             rate: 0.0,
             distance: Mutex::new(distance),
             state: Mutex::new(State {
@@ -379,7 +432,7 @@ impl ContactWall {
                 particles.element[p],
                 Self::position(&particles.x[p]),
                 *d,
-                |g, _| deepest = deepest.max(g),
+                |g, _, _| deepest = deepest.max(g),
             );
             *d -= deepest;
         }
@@ -395,7 +448,7 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
         "contact-wall"
     }
     fn set_time_step(&mut self, dt: f64) {
-        let rate = (self.stiffness / dt).powi(2);
+        let rate = (1.0 / dt).powi(2);
         // Before the first step the springs are `m_p (κ / Δt)²`; after, those of
         // the last step follow the new rate.
         let scale = if self.rate > 0.0 {
@@ -444,9 +497,9 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
             let mut touches = false;
             let x = Self::position(&particles.x[p]);
             self.geometry
-                .contacts(particles.element[p], x, distance[p], |g, n| {
+                .contacts(particles.element[p], x, distance[p], |g, n, kappa2| {
                     touches = true;
-                    f += n * g;
+                    f += n * (kappa2 * g);
                 });
             if touches {
                 touching.push((p, f));
@@ -498,6 +551,10 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
     fn walls_element(&self, element: usize) -> bool {
         self.geometry.near(element)
     }
+    fn contact_distance(&self, particle: usize) -> Option<f64> {
+        let distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());
+        distance.get(particle).copied()
+    }
     fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
         let mut guard = self.state.lock().unwrap_or_else(|e| e.into_inner());
         self.start(&mut guard, particles);
@@ -511,7 +568,7 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
                     particles.element[p],
                     Self::position(&particles.x[p]),
                     distance[p],
-                    |g, _| energy += 0.5 * k * g * g,
+                    |g, _, kappa2| energy += 0.5 * k * kappa2 * g * g,
                 );
                 energy
             })

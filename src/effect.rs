@@ -133,6 +133,12 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     fn walls_element(&self, _element: usize) -> bool {
         false
     }
+    /// For a wall at the particles, the distance from it at which it starts to
+    /// push `particle` (a contact wall's `d_p`, smaller for a particle placed
+    /// closer); `None` for other effects.
+    fn contact_distance(&self, _particle: usize) -> Option<f64> {
+        None
+    }
 }
 
 /// Uniform gravity `g`: `F^body_{k,i} = Σ_p m_p phi_i(x_p) g_k` (paper eq. (16)),

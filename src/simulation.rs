@@ -754,7 +754,7 @@ impl Sampled {
 pub fn sparse_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
     (sampled.value < SPARSE_SAMPLING).then(|| {
         format!(
-            "{}: with about one particle per element or fewer, the elements between particles hold none, the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element ({keys})",
+            "{}: with about one particle per element or fewer, an element holds none as soon as its particle moves out of it (or already, between particles), the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element ({keys})",
             sampled.phrase("element", 2)
         )
     })
@@ -813,6 +813,24 @@ pub fn reference_poisson_warning(scene: &Scene) -> Option<String> {
             ((1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))).sqrt()
         )
     })
+}
+
+/// Each body's lattice stretch ([`crate::arrangement::body_stretch`]): its largest
+/// lattice spacing over the mean; 1 for a body sampled from a Gmsh surface.
+fn lattice_stretch(scene: &Scene) -> Vec<f64> {
+    scene
+        .bodies
+        .iter()
+        .map(|body| {
+            if body.shape == crate::scene::BodyShape::Gmsh {
+                return 1.0;
+            }
+            let h: Option<Vec<f64>> = (0..scene.dim)
+                .map(|k| scene.lattice_spacing(body, k))
+                .collect();
+            h.map_or(1.0, |h| crate::arrangement::body_stretch(&h))
+        })
+        .collect()
 }
 
 /// The share of the particles on element edges at the start from which a PL run
@@ -1126,7 +1144,8 @@ where
     let on_edges = (scene.basis == crate::bases::BasisKind::Pl)
         .then(|| pl_edge_particles_warning(&driver.particles_on_element_edges(&run.body_sizes)))
         .flatten();
-    let at_start = fragments(&driver.particles, &run.body_sizes);
+    let stretch = lattice_stretch(scene);
+    let at_start = fragments(&driver.particles, &run.body_sizes, &stretch);
     let (stray_at_start, pieces_at_start) = (at_start.stray, at_start.pieces.len());
     let spin_at_start = Spin::of(&driver.particles);
     let mut max_rotation = crate::material::max_rotation(&driver.particles.f);
@@ -1525,8 +1544,10 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .max_rotation_of_non_objective(&driver.particles.f, now),
         ),
     );
-    let at_end = fragments(&driver.particles, &run.body_sizes);
-    let irregularity = crate::arrangement::irregularity(&driver.particles, &run.body_sizes);
+    let stretch = lattice_stretch(scene);
+    let at_end = fragments(&driver.particles, &run.body_sizes, &stretch);
+    let irregularity =
+        crate::arrangement::irregularity(&driver.particles, &run.body_sizes, &stretch);
     let keys = particle_keys(scene);
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),

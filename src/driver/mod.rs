@@ -57,6 +57,14 @@ use std::time::Instant;
 /// Coverage below which a function counts as under-supported in failure messages.
 pub const UNDER_SUPPORTED_COVERAGE: f64 = 0.1;
 
+/// A particle that starts closer to a contact wall than this share of its contact
+/// distance (half its spacing) was placed in the wall's contact layer: its spring
+/// has that little room (`contact::ContactWall`). A block placed with a corner
+/// on a 40° contact slope (its nearest particle 1e-5 from it, the contact
+/// distance 0.0125) went through the slope at step 53; moved off by 0.002 (0.16 of
+/// the distance) it slid down, as it did at every larger offset.
+pub const STARTED_CLOSE: f64 = 0.1;
+
 /// A homogeneous Dirichlet condition: velocity component `component` vanishes on `tag`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Fix {
@@ -832,9 +840,20 @@ where
             // The element it was in before this step (location failed, so the
             // particle's element is still the last one found).
             let from = self.particles.element[p];
-            let hint = if self.effects.iter().any(|e| e.walls_element(from)) {
-                let distance =
-                    crate::contact::contact_distance::<D>(self.particles.volume0[p].to_f64());
+            // The contact distance a particle placed closer to a contact wall keeps.
+            let started = self.effects.iter().find_map(|e| e.contact_distance(p));
+            let nominal =
+                crate::contact::contact_distance::<D>(self.particles.volume0[p].to_f64());
+            let hint = if let Some(room) = started.filter(|&d| d < STARTED_CLOSE * nominal) {
+                format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went through a contact wall it started {} from, where the wall starts to push at half a particle spacing ({}): the body was placed overlapping the wall's contact layer, so its springs there had {} of room, and a step's small motion took it through; move the body off the wall so that its particles start at least {} from it (a `box` body whose side lies on an axis wall has them there; a lattice not aligned with a slanted wall puts some closer: move such a body off by half a spacing); a smaller step lets the springs hold with less room, but leaves the room as small",
+                    crate::scene::limits::echo_significant(room.max(0.0), 3),
+                    crate::scene::limits::echo_significant(nominal, 3),
+                    crate::scene::limits::echo_significant(room.max(0.0), 3),
+                    crate::scene::limits::echo_significant(nominal, 3),
+                )
+            } else if self.effects.iter().any(|e| e.walls_element(from)) {
+                let distance = nominal;
                 let how = if moved < 0.25 * distance {
                     format!(
                         "a small part of its contact distance ({}): it was pressed through over several steps, the springs too soft for the load",
@@ -872,7 +891,7 @@ where
                             particle: p,
                             position: to_f64(&self.particles.x[p]),
                             hint: format!(
-                                "it moved {moved:.3e} in the last sub-step at speed {speed:.3e}, {how}, and went through a contact wall, although the step was split {speeds} ways for the particles' speeds, each sub-step at a Courant number of {}: a `courant` above that changes nothing; take {} (a wall's springs are `m (κ/Δt)²` stiff, so half the sub-step makes them four times stiffer) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); an impact much faster than the body's wave speed √(E/ρ) crushes the body whatever the step; if the speed is unphysical, the run became unstable earlier (see the energy column)",
+                                "it moved {moved:.3e} in the last sub-step at speed {speed:.3e}, {how}, and went through a contact wall, although the step was split {speeds} ways for the particles' speeds, each sub-step at a Courant number of {}: the springs' stiffness follows the sub-step; take {} (a wall's springs are `m (κ/Δt)²` stiff, so half the sub-step makes them four times stiffer) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); an impact much faster than the body's wave speed √(E/ρ) crushes the body whatever the step; if the speed is unphysical, the run became unstable earlier (see the energy column)",
                                 crate::scene::limits::echo_significant(sub, 2),
                                 crate::scene::limits::echo_significant(0.5 * sub, 2)
                             ),
@@ -889,7 +908,7 @@ where
                     .any(|i| functions.contains(i))
             }) {
                 format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out at the bend where two slip walls meet at {}: there the walls hold the velocity along their mean normal (else the vertex would hold still and stop a body sliding over it), which lets a body sliding into a valley cross each wall near the vertex by sin(θ/2) of its speed, θ the bend; for a floor a body slides over, give the whole floor one tag and make it a contact wall (`[[effect]]` with `kind = \"contact-wall\"` and that `tag`, in place of the `[[boundary]]`s), which holds a body from outside without holding the vertex (two contact walls meeting at a corner leave a gap there)",
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out at the bend where two slip walls meet at {}: there the walls hold the velocity along their mean normal (else the vertex would hold still and stop a body sliding over it), which lets a body sliding into a valley cross each wall near the vertex by sin(θ/2) of its speed, θ the bend; for a floor a body slides over, make its walls contact walls (an `[[effect]]` with `kind = \"contact-wall\"` per `tag`, in place of the `[[boundary]]`s), which hold a body from outside without holding the vertex",
                     point(vertex)
                 )
             } else if self
@@ -899,7 +918,7 @@ where
                 .any(|&i| self.walled[i])
             {
                 format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went through a wall (`fix`) on that side: a wall holds the velocity of the functions on it, not of each particle, and a particle that moves a large part of an element in one step can cross it: lower `time.courant` (or `time.dt`); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out of an element that a wall (`fix`) holds functions of: if it crossed the wall, a wall holds the velocity of the functions on it, not of each particle, and a particle that moves a large part of an element in one step can cross it: lower `time.courant` (or `time.dt`); if it left through a free side beside the wall, add a wall there or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
             } else {
                 format!(

@@ -425,9 +425,10 @@ impl Scene {
                 return Err(bad(
                     "time.dt",
                     format!(
-                        "t_end / dt = {:?} / {dt:?} = {} steps is above the limit of {MAX_STEPS}",
-                        self.time.t_end,
-                        if steps < 1e12 {
+                        "t_end / dt = {} / {} = {} steps is above the limit of {MAX_STEPS}",
+                        crate::scene::limits::echo_number(self.time.t_end),
+                        crate::scene::limits::echo_number(dt),
+                        if steps < 1e9 {
                             format!("{}", steps.round())
                         } else {
                             format!("{steps:.3e}")

@@ -15,11 +15,12 @@ use psmpm_basis::basis::Basis;
 pub fn build_effects<const D: usize>(
     scene: &Scene,
     particles: &Particles<f64, D>,
-    contacts: &[WallGeometry],
+    contacts: Option<&WallGeometry>,
     basis: &dyn Basis<f64, D>,
 ) -> Result<Vec<Box<dyn Effect<f64, D>>>, RunError> {
     let solution = Solution::new(scene);
-    let mut contacts = contacts.iter();
+    // The contact walls are one effect, built at the first.
+    let mut contacts = contacts;
     let mut effects: Vec<Box<dyn Effect<f64, D>>> = Vec::new();
     for (i, spec) in scene.effects.iter().enumerate() {
         match spec {
@@ -64,21 +65,35 @@ pub fn build_effects<const D: usize>(
                 };
                 effects.push(Box::new(BodyForce::Manufactured(a)));
             }
-            EffectSpec::ContactWall { tag, stiffness } => {
-                let geometry = contacts.next().cloned().ok_or_else(|| {
-                    SceneError::new(
+            EffectSpec::ContactWall { .. } => {
+                let Some(geometry) = contacts.take().cloned() else {
+                    if scene.dim == 2 {
+                        // Built with the first contact wall.
+                        continue;
+                    }
+                    return Err(SceneError::new(
                         format!("effect[{i}].kind"),
                         ErrorKind::Conflict,
                         "a contact wall needs a 2D mesh",
                     )
-                })?;
+                    .into());
+                };
                 let reach = geometry.reach();
-                let wall = ContactWall::new(geometry, particles, *stiffness).map_err(|d| {
+                let wall = ContactWall::new(geometry, particles).map_err(|d| {
+                    let tags: Vec<String> = scene
+                        .effects
+                        .iter()
+                        .filter_map(|e| match e {
+                            EffectSpec::ContactWall { tag, .. } => Some(format!("`{tag}`")),
+                            _ => None,
+                        })
+                        .collect();
                     SceneError::new(
                         format!("effect[{i}].tag"),
                         ErrorKind::Conflict,
                         format!(
-                            "the particles near `{tag}` are coarser than the mesh: a contact distance of {d:.4e} (half a particle spacing) exceeds the longest edge {reach:.4e}; use more particles (`per_block`, `count` or `spacing`)"
+                            "the particles near {} are coarser than the mesh: a contact distance of {d:.4e} (half a particle spacing) exceeds the longest edge {reach:.4e}; use more particles (`per_block`, `count` or `spacing`)",
+                            tags.join(", ")
                         ),
                     )
                 })?;

@@ -104,7 +104,7 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
         h,
         walls,
         bends: Vec::new(),
-        contacts: Vec::new(),
+        contacts: None,
         warnings: Vec::new(),
     })
 }
@@ -315,7 +315,7 @@ fn slip_bends(
             n => format!(" (and {} more such bends)", n - 1),
         };
         format!(
-            "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend strikes it (with PS, valleys up to {:.1}° share the vertex through the walls' mean normal; a crest, a sharper valley or PL's particles would go through the walls near it); for a floor a body slides over, give the whole floor one tag and make it a contact wall (`[[effect]]` with `kind = \"contact-wall\"` and that `tag`, in place of the `[[boundary]]`s), which takes bends (two contact walls meeting at a corner leave a gap there)",
+            "slip walls `{tag_a}` and `{tag_b}` meet at [{}, {}] at a bend of {:.1}°{more}: each holds the velocity along its own normal there, so the vertex between them holds still and a body sliding over the bend strikes it (with PS, valleys up to {:.1}° share the vertex through the walls' mean normal; a crest, a sharper valley or PL's particles would go through the walls near it); for a floor a body slides over, make its walls contact walls (an `[[effect]]` with `kind = \"contact-wall\"` per `tag`, in place of the `[[boundary]]`s), which take bends",
             crate::scene::limits::echo_significant(p[0], 6),
             crate::scene::limits::echo_significant(p[1], 6),
             angle.to_degrees(),
@@ -333,9 +333,10 @@ pub(crate) struct Bend {
     pub vertex: [f64; 2],
 }
 
-/// The geometry of every contact wall, in the order of the scene's effects: the
-/// wall items are listed for the elements within the mesh's longest edge of them.
-fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Vec<WallGeometry>, RunError> {
+/// The geometry of the scene's contact walls, all tags in one (`None` without a
+/// contact wall): the wall items are listed for the elements within the mesh's
+/// longest edge of them.
+fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Option<WallGeometry>, RunError> {
     let longest = mesh
         .edges()
         .iter()
@@ -343,7 +344,7 @@ fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Vec<WallGeometry>, Run
         .fold(0.0, f64::max);
     let mut walls = Vec::new();
     for (i, effect) in scene.effects.iter().enumerate() {
-        let EffectSpec::ContactWall { tag, .. } = effect else {
+        let EffectSpec::ContactWall { tag, stiffness } = effect else {
             continue;
         };
         let field = format!("effect[{i}].tag");
@@ -358,12 +359,16 @@ fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Vec<WallGeometry>, Run
                 )),
             )
         })?;
-        walls.push(
-            WallGeometry::new(mesh, id, longest)
-                .ok_or_else(|| conflict(field, format!("`{tag}` has no boundary edge")))?,
-        );
+        if !mesh
+            .edges()
+            .iter()
+            .any(|e| e.tag == Some(id) && e.is_boundary())
+        {
+            return Err(conflict(field, format!("`{tag}` has no boundary edge")).into());
+        }
+        walls.push((id, *stiffness));
     }
-    Ok(walls)
+    Ok(WallGeometry::new(mesh, &walls, longest))
 }
 
 fn smallest_edge(mesh: &TriMesh) -> f64 {

@@ -28,7 +28,7 @@ use crate::material::MaterialError;
 use crate::material::{AnyMaterial, Corotational, Elastic, LinearElastic, NeoHookean};
 use crate::materials::MaterialTable;
 use crate::particles::Particles;
-use crate::scene::limits::{echo_fixed, echo_number};
+use crate::scene::limits::{echo_fixed, echo_number, echo_significant};
 use crate::scene::{ErrorKind, MaterialModel, MaterialSpec, Scene, SceneError};
 use crate::simulation::RunError;
 use nalgebra::SVector;
@@ -50,8 +50,8 @@ pub(crate) struct Domain<B> {
     pub walls: Vec<(String, [f64; 2])>,
     /// The vertices where two slip walls meet at a bend.
     pub bends: Vec<mesh::Bend>,
-    /// The geometry of each contact wall, in the order of the scene's effects.
-    pub contacts: Vec<crate::contact::WallGeometry>,
+    /// The geometry of the contact walls, all tags in one.
+    pub contacts: Option<crate::contact::WallGeometry>,
     /// What the mesh and walls make the run warn about.
     pub warnings: Vec<String>,
 }
@@ -163,7 +163,7 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
     let mut particles = particles::place::<D>(scene, &lattice);
     particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles)?;
-    let effects = build_effects(scene, &particles, &domain.contacts, &domain.basis)?;
+    let effects = build_effects(scene, &particles, domain.contacts.as_ref(), &domain.basis)?;
     // The lattice's positions and volumes are in `particles` now: free them before
     // the driver allocates (they would otherwise count in the run's peak memory).
     let body_sizes = std::mem::take(&mut lattice.body_sizes);
@@ -173,8 +173,8 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         h,
         walls,
         bends,
+        contacts,
         warnings: domain_warnings,
-        ..
     } = domain;
     let functions = basis.num_functions();
     // With `courant` the step is fixed by `time_steps`, from the critical step; this
@@ -221,6 +221,13 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     driver.set_body_sizes(&body_sizes);
     let mut warnings = domain_warnings;
     warnings.extend(held_traction_warnings(scene, &driver));
+    if let Some(walls) = &contacts {
+        warnings.extend(started_close_warnings(
+            walls,
+            &driver.particles,
+            &body_sizes,
+        ));
+    }
     let (dt, steps, dt_critical, failed) = time_steps(scene, &mut driver, dt)?;
     warnings.extend(failed);
     if let (Some(critical), None, false) = (
@@ -255,6 +262,45 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         body_sizes,
         warnings,
     })
+}
+
+/// A warning for each body with particles that start in a contact wall's contact
+/// layer ([`crate::contact::started_close`]).
+fn started_close_warnings<const D: usize>(
+    walls: &crate::contact::WallGeometry,
+    particles: &crate::particles::Particles<f64, D>,
+    body_sizes: &[usize],
+) -> Vec<String> {
+    let close = crate::contact::started_close(walls, particles);
+    let mut warnings = Vec::new();
+    let mut first = 0;
+    for (b, &n) in body_sizes.iter().enumerate() {
+        let body: Vec<&(usize, f64)> = close
+            .iter()
+            .filter(|(p, _)| (first..first + n).contains(p))
+            .collect();
+        first += n;
+        let Some(&&(p, distance)) = body.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
+            continue;
+        };
+        let nominal = crate::contact::contact_distance::<D>(particles.volume0[p]);
+        let x = &particles.x[p];
+        warnings.push(format!(
+            "body[{b}]: {} particle{} start{} closer to a contact wall than {} of the distance at which it pushes (half a particle spacing, {}), the nearest (particle {p}) {} from it at [{}]: the body overlaps the wall's contact layer, so these particles' springs have that little room, and a step's small motion can take them through the wall; move the body off so that its particles start at least {} from the wall (a lattice not aligned with a slanted wall puts some particles closer than its outline: move such a body off by half a spacing)",
+            body.len(),
+            if body.len() == 1 { "" } else { "s" },
+            if body.len() == 1 { "s" } else { "" },
+            crate::driver::STARTED_CLOSE,
+            echo_significant(nominal, 3),
+            echo_significant(distance.max(0.0), 3),
+            x.iter()
+                .map(|c| echo_significant(*c, 5))
+                .collect::<Vec<_>>()
+                .join(", "),
+            echo_significant(nominal, 3),
+        ));
+    }
+    warnings
 }
 
 /// A warning for each traction whose load the walls take for the most part: the
