@@ -35,6 +35,13 @@ pub struct ConvergeArgs {
     /// Number of levels (1 to 7).
     #[arg(long, default_value_t = 3, allow_hyphen_values = true, value_parser = crate::whole::<u32>("from 1 to 7"))]
     levels: u32,
+    /// The factor (1 to 4) by which each level also multiplies the particles per
+    /// element along each refined axis (replaces the scene's
+    /// `study.particle_growth`; default: the scene's, else 1, particles per element
+    /// stay). At fixed particles per element PS's error is set by the particle
+    /// quadrature and stops falling with h; 2 shows its order.
+    #[arg(long, value_name = "N", allow_hyphen_values = true, value_parser = crate::whole::<u32>("from 1 to 4"))]
+    particle_growth: Option<u32>,
     #[command(flatten)]
     overrides: Overrides,
     /// Write the table as CSV and JSON and the log-log error-vs-h and
@@ -337,6 +344,11 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
         )));
     }
     crate::run::check_threads(args.threads)?;
+    if let Some(growth) = args.particle_growth.filter(|g| !(1..=4).contains(g)) {
+        return Err(CliError::Input(format!(
+            "--particle-growth must be between 1 and 4, got {growth}"
+        )));
+    }
     if let Some(e) = args.target_error {
         if !(e.is_finite() && e > 0.0) {
             return Err(CliError::Input(format!(
@@ -359,7 +371,12 @@ fn levels(args: &ConvergeArgs) -> Result<(Scene, Against, Vec<Vec<Scene>>), CliE
         Against::FinestLevel
     };
     let masses: Vec<String> = args.mass.iter().cloned().collect();
-    let bases = variants(&base, &args.basis, &masses, &args.overrides, &args.scene)?;
+    let mut bases = variants(&base, &args.basis, &masses, &args.overrides, &args.scene)?;
+    if let Some(growth) = args.particle_growth {
+        for scene in &mut bases {
+            scene.study.particle_growth = Some(growth);
+        }
+    }
     let levels = bases
         .iter()
         .map(|scene| {
@@ -647,8 +664,9 @@ fn verdict(
     } else {
         "a smaller `dt` (--dt), or `courant` (--courant) so that the step shrinks with h"
     };
-    let particles = "more particles per element as h shrinks (`per_block` or `count`, \
-                     --particles)";
+    let particles = "more particles per element as h shrinks (`--particle-growth 2`, or \
+                     `particle_growth = 2` in `[study]`, doubles them along each refined \
+                     axis per level)";
     let step_limits = falls_with_the_step(half_dt, quarter_dt);
     // Half the step lowered the error far more than the scheme's order allows and
     // the next halving raised it again: the time integration's error and the

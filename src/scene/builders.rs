@@ -141,18 +141,35 @@ impl Scene {
                 ))
             }
         }
+        // `particle_growth^level` more particles per element along those axes.
+        let growth = (self.study.particle_growth.unwrap_or(1) as usize)
+            .checked_pow(level)
+            .filter(|g| *g <= 1 << 16)
+            .ok_or_else(|| {
+                bad(
+                    "study.particle_growth",
+                    format!("level {level} grows the particles too far"),
+                )
+            })?;
         for (i, body) in s.bodies.iter_mut().enumerate() {
             if let Some(c) = &mut body.count {
                 for (axis, n) in c.iter_mut().enumerate() {
                     if axes[axis] {
-                        *n = refine_count(&format!("body[{i}].count"), *n, factor)?;
+                        *n = refine_count(&format!("body[{i}].count"), *n, factor * growth)?;
                     }
                 }
             }
             if let Some(h) = &mut body.spacing {
                 for (axis, h) in h.iter_mut().enumerate() {
                     if axes[axis] {
-                        *h /= factor as f64;
+                        *h /= (factor * growth) as f64;
+                    }
+                }
+            }
+            if let Some(per) = &mut body.per_block {
+                for (axis, n) in per.iter_mut().enumerate() {
+                    if axes[axis] {
+                        *n = refine_count(&format!("body[{i}].per_block"), *n, growth)?;
                     }
                 }
             }

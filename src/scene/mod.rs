@@ -183,6 +183,12 @@ pub struct StudySpec {
     /// error, so is an axis listed twice).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refine: Option<Vec<Axis>>,
+    /// The factor (1 to 4) by which each level also multiplies the particles per
+    /// element along the axes whose element size shrinks (absent: 1, particles per
+    /// element stay). PS's error at fixed particles per element is set by the
+    /// particle quadrature and stops falling with `h`; with 2 its orders appear.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub particle_growth: Option<u32>,
 }
 
 /// A coordinate axis (`study.refine`).

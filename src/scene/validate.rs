@@ -13,6 +13,9 @@ use super::{
 /// Largest lateral coefficient `k0` of a geostatic stress.
 pub const MAX_K0: f64 = 10.0;
 
+/// Largest `study.particle_growth`.
+pub const MAX_PARTICLE_GROWTH: u32 = 4;
+
 impl Scene {
     /// Checks that the scene is consistent; the error names the field.
     pub fn validate(&self) -> Result<(), SceneError> {
@@ -433,6 +436,16 @@ impl Scene {
                         } else {
                             format!("{steps:.3e}")
                         }
+                    ),
+                ));
+            }
+        }
+        if let Some(growth) = self.study.particle_growth {
+            if !(1..=MAX_PARTICLE_GROWTH).contains(&growth) {
+                return Err(bad(
+                    "study.particle_growth",
+                    format!(
+                        "must be a whole number from 1 to {MAX_PARTICLE_GROWTH} (the factor on the particles per element along each refined axis per level), got {growth}"
                     ),
                 ));
             }

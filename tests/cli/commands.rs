@@ -8,7 +8,7 @@ mod common;
 mod common_cli;
 
 use common::temp_dir;
-use common_cli::{assert_success, cli, DAMPED_COLUMN_1D};
+use common_cli::{assert_success, cli, SceneFile, DAMPED_COLUMN_1D};
 use serde_json::Value;
 
 fn stdout(args: &[&str]) -> String {
@@ -379,9 +379,101 @@ fn converge_explains_a_falling_order_with_two_probes() {
     let table = stdout(&["converge", "vibrating-bar-1d", "--levels", "4"]);
     assert!(
         table.contains("pl1d level 3: the order falls to -2.46")
-            && table.contains("--particles")
+            && table.contains("`--particle-growth 2`")
             && table.contains("crossing element edges"),
         "{table}"
+    );
+}
+
+/// A teacher's 2D bar (1 × 0.125, E = 100, ρ = 1, ν = 0, the vibrating-bar
+/// reference): at fixed particles per element PS's error stops falling with h (the
+/// particle quadrature: 3.66e-7, 2.54e-7, order 0.5), and `--particle-growth 2`,
+/// doubling the particles per element along each axis per level, shows its order
+/// (3.66e-7, 3.25e-8: 3.5) and PL's (2.1). Out of range, the flag and the scene key
+/// are refused by name.
+#[test]
+fn converge_grows_the_particles_per_element_when_asked() {
+    let bar = SceneFile::new(
+        "bar-2d",
+        r#"name = "bar-2d"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 1.0]
+y = [0.0, 0.125]
+blocks = [8, 1]
+[material]
+young = 100.0
+poisson = 0.0
+density = 1.0
+[[body]]
+min = [0.0, 0.0]
+max = [1.0, 0.125]
+per_block = [4, 4]
+[initial_velocity]
+kind = "exact"
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[boundary]]
+tag = "right"
+fix = ["x"]
+[time]
+dt = 1e-4
+t_end = 0.1
+[reference]
+kind = "vibrating-bar"
+v0 = 0.01
+"#,
+    );
+    let orders = |extra: &[&str]| {
+        let mut args = vec!["converge", bar.arg(), "--levels", "2", "--format", "json"];
+        args.extend_from_slice(extra);
+        let study: Value = serde_json::from_str(&stdout(&args)).unwrap();
+        let levels = study["levels"].as_array().unwrap().clone();
+        let order = |basis: &str| {
+            levels
+                .iter()
+                .find(|l| l["basis"] == basis && l["level"] == 1)
+                .and_then(|l| l["order"].as_f64())
+                .unwrap()
+        };
+        let particles: Vec<u64> = levels
+            .iter()
+            .filter(|l| l["basis"] == "ps")
+            .map(|l| l["particles"].as_u64().unwrap())
+            .collect();
+        (order("ps"), order("pl"), particles)
+    };
+    let (ps, _, particles) = orders(&[]);
+    assert!(ps < 1.0, "{ps}");
+    assert_eq!(particles, [128, 512]);
+    let (ps, pl, particles) = orders(&["--particle-growth", "2"]);
+    assert!(ps > 3.0, "{ps}");
+    assert!(pl > 1.8, "{pl}");
+    assert_eq!(particles, [128, 2048]);
+    let out = cli()
+        .args(["converge", bar.arg(), "--particle-growth", "9"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    assert!(String::from_utf8(out.stderr)
+        .unwrap()
+        .contains("--particle-growth must be between 1 and 4, got 9"));
+    let keyed = SceneFile::new(
+        "bar-2d-keyed",
+        &format!(
+            "{}[study]\nparticle_growth = 5\n",
+            std::fs::read_to_string(&bar.path).unwrap()
+        ),
+    );
+    let out = cli().args(["converge", keyed.arg()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("study.particle_growth: must be a whole number from 1 to 4"),
+        "{stderr}"
     );
 }
 
