@@ -71,8 +71,9 @@ pub(crate) struct Filled {
 }
 
 /// The particles of a polygon or disk body `b`: the cells of the lattice of spacing
-/// `h` over the region's bounding box (anchored at its lower corner) whose centres
-/// lie in `region`, each with the cell's area; `jitter(k)` gives the offset of each
+/// `h` over the region's bounding box (centred on it, so that a disk's or a
+/// symmetric polygon's particles are as symmetric as the region) whose centres lie
+/// in `region`, each with the cell's area; `jitter(k)` gives the offset of each
 /// kept particle along axis `k` in cells (drawn in the order particles are made).
 /// `room` is how many particles the scene has left under [`MAX_PARTICLES`].
 pub(crate) fn fill_lattice(
@@ -96,17 +97,45 @@ pub(crate) fn fill_lattice(
         ));
     }
     let (nx, ny) = (nx as usize, ny as usize);
+    // A cell wider than the body along an axis: centred, its one particle would
+    // stand for a volume larger than the body's box.
+    if let Some(k) = (0..2).find(|&k| h[k] > (hi[k] - lo[k]) * (1.0 + WHOLE_CELLS)) {
+        return Err(SceneError::new(
+            lattice_field(b, body),
+            ErrorKind::Conflict,
+            format!(
+                "a lattice cell of size {} along axis {k} is wider than the body's {} ({}): the lattice is too coarse for it",
+                crate::scene::limits::echo_number(h[k]),
+                body.shape.name(),
+                crate::scene::limits::echo_number(hi[k] - lo[k])
+            ),
+        ));
+    }
     let mut filled = Filled {
         positions: Vec::new(),
         volumes: Vec::new(),
         bounds: (lo, hi),
     };
     let volume = h[0] * h[1];
+    // The lattice's overhang past the box, split between its two sides (none where
+    // the box holds whole cells). Anchored at the lower corner, a disk of diameter
+    // 0.6 sampled at 0.03125 (19.2 cells) had its particles 0.0125 off its centre
+    // along both axes, and two such disks striking head-on parted 5.4° off their
+    // line of centres.
+    let start = |k: usize, n: usize| {
+        let overhang = n as f64 * h[k] - (hi[k] - lo[k]);
+        if overhang.abs() <= WHOLE_CELLS * h[k] * n as f64 {
+            lo[k]
+        } else {
+            lo[k] - 0.5 * overhang
+        }
+    };
+    let origin = [start(0, nx), start(1, ny)];
     for j in 0..ny {
         for i in 0..nx {
             let centre = [
-                lo[0] + (i as f64 + 0.5) * h[0],
-                lo[1] + (j as f64 + 0.5) * h[1],
+                origin[0] + (i as f64 + 0.5) * h[0],
+                origin[1] + (j as f64 + 0.5) * h[1],
             ];
             if !region.contains(centre) {
                 continue;

@@ -430,7 +430,7 @@ fn unknown_field_cases() -> Vec<Case> {
             .expect("resolution[0].colour: unknown field `colour`, expected one of `basis`, `blocks`, `edge_length`, `per_block`"),
         case("unknown-field-in-study", BAR)
             .edit("refine = [\"x\"]", "refine = [\"x\"]\n@@levels = 3")
-            .expect("study.levels: unknown field `levels`, expected `refine`"),
+            .expect("study.levels: unknown field `levels`, expected `refine` or `particle_growth`"),
         case("unknown-field-in-initial-velocity", BAR)
             .edit("[initial_velocity]", "@@[initial_velocity]")
             .edit("kind = \"exact\"", "kind = \"sine-mode\"\nv0 = 1.0\nv1 = 2.0")

@@ -1690,10 +1690,10 @@ fn two_contact_walls_that_meet_act_as_one() {
 }
 
 /// A block placed with a corner on a contact slope has a particle in the wall's
-/// contact layer (5.4e-4 from the wall, where it pushes at 0.0125): the run warns,
-/// and when the particle goes through (at step 53, at `courant = 0.5`; at 0.25 it
-/// held), the error names that cause and the fix that removes it (to move the
-/// body off), not only a smaller step.
+/// contact layer (6.9e-5 from the wall, where it pushes at 0.0125; its outline
+/// 9.5e-4 into the slope): the run warns, and when the particle goes through (at
+/// step 15, at `courant = 0.5`), the error names that cause and the fix that
+/// removes it (to move the body off), not only a smaller step.
 #[test]
 fn a_body_placed_in_a_contact_walls_layer_is_told_to_move_off() {
     let file = SceneFile::new(
@@ -1701,7 +1701,7 @@ fn a_body_placed_in_a_contact_walls_layer_is_told_to_move_off() {
         &valley_scene(
             r#""floor", "floor""#,
             &contact_wall("floor"),
-            "[[0.4, 2.6644], [0.7064, 2.4073], [0.9635, 2.7137], [0.6571, 2.9708]]",
+            "[[0.39939, 2.66367], [0.70579, 2.40657], [0.96289, 2.71297], [0.65649, 2.97007]]",
             0.1,
         )
         .replace("spacing = [0.04, 0.04]", "spacing = [0.025, 0.025]")
