@@ -217,6 +217,33 @@ impl WallGeometry {
             .is_some_and(|(a, b)| b > a)
     }
 
+    /// `true` if `x` (a point outside the mesh that left it from `element`) lies
+    /// behind one of the wall's edges listed for `element` (between the edge's
+    /// ends, on the far side of its line), or within [`Self::reach`] of one of its
+    /// reflex corners: it went out through the wall. A particle that left through
+    /// an open side beside a wall is neither.
+    pub fn behind(&self, element: usize, x: Vec2) -> bool {
+        let element = element % (self.element_start.len() - 1).max(1);
+        let Some(range) = self
+            .element_start
+            .get(element)
+            .zip(self.element_start.get(element + 1))
+        else {
+            return false;
+        };
+        self.element_items[*range.0..*range.1].iter().any(|&item| {
+            let item = item as usize;
+            if let Some(&(a, b, n)) = self.segments.get(item) {
+                let ab = b - a;
+                let t = (x - a).dot(&ab) / ab.norm_squared();
+                (0.0..=1.0).contains(&t) && (x - a).dot(&n) <= 0.0
+            } else {
+                let (c, _) = self.corners[item - self.segments.len()];
+                (x - c).norm() <= self.reach
+            }
+        })
+    }
+
     /// Calls `contact(g, n, κ²)` for each wall item within `d` of `x` (in
     /// `element`): `g` how far inside the distance, `n = −∇g` the direction from
     /// the wall to `x` (a unit vector, but for the bevels), `κ` the item's wall's.
@@ -550,6 +577,9 @@ impl<T: Scalar, const D: usize> Effect<T, D> for ContactWall {
     }
     fn walls_element(&self, element: usize) -> bool {
         self.geometry.near(element)
+    }
+    fn went_through(&self, element: usize, x: [f64; 2]) -> bool {
+        self.geometry.behind(element, Vec2::new(x[0], x[1]))
     }
     fn contact_distance(&self, particle: usize) -> Option<f64> {
         let distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());

@@ -133,6 +133,12 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     fn walls_element(&self, _element: usize) -> bool {
         false
     }
+    /// `true` if the effect is a wall at the particles that a particle now at `x`,
+    /// outside the mesh, went through from `element`: `x` lies behind one of its
+    /// edges listed for `element`, or within reach of one of its reflex corners.
+    fn went_through(&self, _element: usize, _x: [f64; 2]) -> bool {
+        false
+    }
     /// For a wall at the particles, the distance from it at which it starts to
     /// push `particle` (a contact wall's `d_p`, smaller for a particle placed
     /// closer); `None` for other effects.

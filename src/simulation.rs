@@ -152,8 +152,7 @@ pub struct Summary {
     pub irregularity: crate::arrangement::Irregularity,
     /// Warnings about the run, each once: the paper's non-objective law
     /// (`linear-elastic`) under a rotation above [`crate::material::ROTATION_WARNING`].
-    /// In the JSON summary only when there is one.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    /// Always in the JSON summary (`[]` without any), so that a script can read it.
     pub warnings: Vec<String>,
     /// The run was stopped from outside (the stop flag of [`observe_2d_until`])
     /// before its end time; the rest of the summary covers the steps taken. Not
@@ -703,6 +702,7 @@ impl Sampled {
             volume_over_elements: 1.0,
             filled: 0,
             thin: 0,
+            empty: 0,
         });
         let value = sampling.per_element();
         let alike = bodies
@@ -723,6 +723,7 @@ impl Sampled {
             volume_over_elements: 1.0,
             filled: 0,
             thin: 0,
+            empty: 0,
         }])
     }
 
@@ -996,6 +997,11 @@ pub fn ps_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
 /// this share of a body's filled elements, make a PS run warn ([`Thin`]).
 pub const THIN_SHARE: f64 = 0.25;
 
+/// Filled elements a body needs for its share of thin ones to count ([`Thin`]): a
+/// beam one element thick (`docs/examples/cantilever.toml`) has 3, one of them a
+/// small triangle of the `polygon` mesh that no lattice point falls in.
+pub const THIN_LEAST_FILLED: usize = 10;
+
 /// A body whose filled elements are thin in part although its average per
 /// element is enough ([`ps_sampling_warning`] is silent): a lattice of 3 × 4 per
 /// block of four triangles, 3 per triangle on average, puts 2 in the left and
@@ -1010,21 +1016,25 @@ pub struct Thin {
     body: (usize, usize),
     thin: usize,
     filled: usize,
+    empty: usize,
 }
 
 impl Thin {
     /// The body with the largest share of thin filled elements, if that share is
-    /// [`THIN_SHARE`] or more.
+    /// [`THIN_SHARE`] or more (of the bodies with [`THIN_LEAST_FILLED`] filled
+    /// elements or more).
     pub fn of(bodies: &[BodySampling]) -> Option<Self> {
         let share = |b: &BodySampling| b.thin as f64 / b.filled.max(1) as f64;
         let (b, worst) = bodies
             .iter()
             .enumerate()
+            .filter(|(_, b)| b.filled >= THIN_LEAST_FILLED)
             .max_by(|(_, a), (_, b)| share(a).total_cmp(&share(b)))?;
         (share(worst) >= THIN_SHARE && worst.thin > 0).then_some(Thin {
             body: (b, bodies.len()),
             thin: worst.thin,
             filled: worst.filled,
+            empty: worst.empty,
         })
     }
 
@@ -1035,10 +1045,18 @@ impl Thin {
             (b, n) => format!("body {} of {n}", b + 1),
         };
         format!(
-            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %), although it has 3 or more per triangle on average: a lattice of 3 × 4 per block of four triangles puts 2 in the left and right triangles of every block (4 × 3 in the top and bottom ones); each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes a square `per_block` such as [4, 4] or [6, 6]: non-square ones such as [5, 4] leave PS 2–8 times less accurate than [4, 4] on the same block; PL wants one odd and one even count, so compare the two bases each on its own lattice)",
+            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %{}), although it has 3 or more per triangle on average: a lattice of 3 × 4 per block of four triangles puts 2 in the left and right triangles of every block (4 × 3 in the top and bottom ones); each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes a square `per_block` such as [4, 4] or [6, 6]: non-square ones such as [5, 4] leave PS 2–8 times less accurate than [4, 4] on the same block; PL wants one odd and one even count, so compare the two bases each on its own lattice)",
             self.thin,
             self.filled,
-            100.0 * self.thin as f64 / self.filled.max(1) as f64
+            100.0 * self.thin as f64 / self.filled.max(1) as f64,
+            if self.empty > 0 {
+                format!(
+                    "; {} of them none, a lattice with one particle per block along an axis leaving the triangles beside its rows empty",
+                    self.empty
+                )
+            } else {
+                String::new()
+            }
         )
     }
 }

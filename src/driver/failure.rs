@@ -125,6 +125,10 @@ where
         let (mut own, mut touching) = (vec![0usize; ne], vec![0usize; ne]);
         let (mut elements, mut touched) = (Vec::new(), Vec::new());
         let mut pieces = Vec::new();
+        // The empty elements around a body's (`seen_empty`: listed in `around`),
+        // and which of them are holes in its particles (`hole_here`).
+        let (mut seen_empty, mut hole_here) = (vec![false; ne], vec![false; ne]);
+        let mut around = Vec::new();
         let mut first = 0;
         sizes
             .iter()
@@ -153,17 +157,64 @@ where
                     self.basis.polynomial_pieces(e, &mut pieces);
                     size_of_elements += pieces.chunks(D + 1).map(simplex_measure).sum::<f64>();
                 }
-                let (mut filled, mut thin) = (0usize, 0usize);
+                let (mut filled, mut thin, mut empty) = (0usize, 0usize, 0usize);
+                // The empty elements around the body's: holes where each of
+                // their corners touches an element of the body.
+                around.clear();
+                for &e in &touched {
+                    pieces.clear();
+                    self.basis.polynomial_pieces(e, &mut pieces);
+                    for corner in &pieces {
+                        let x = SVector::<T, D>::from_fn(|k, _| T::of(corner[k]));
+                        self.basis.other_elements_at(e, &x, &mut |o| {
+                            if touching[o] == 0 && !seen_empty[o] {
+                                seen_empty[o] = true;
+                                around.push(o);
+                            }
+                        });
+                    }
+                }
+                for &e in &around {
+                    pieces.clear();
+                    self.basis.polynomial_pieces(e, &mut pieces);
+                    let mut hole = true;
+                    // Every vertex (a point shared with two or more other
+                    // elements) touches the body's elements, and two of its edges
+                    // (a point shared with one: the PS pieces' points on the
+                    // edges; a point inside has none) border them. With the
+                    // vertices alone, an element beside a beam one element thick,
+                    // outside it, counted.
+                    let mut edges = 0;
+                    for corner in &pieces {
+                        let x = SVector::<T, D>::from_fn(|k, _| T::of(corner[k]));
+                        let (mut others, mut held) = (0usize, false);
+                        self.basis.other_elements_at(e, &x, &mut |o| {
+                            others += 1;
+                            held |= touching[o] > 0;
+                        });
+                        hole &= others < 2 || held;
+                        edges += usize::from(others == 1 && held);
+                    }
+                    hole &= edges >= 2;
+                    hole_here[e] = hole;
+                    if hole {
+                        filled += 1;
+                        thin += 1;
+                        empty += 1;
+                    }
+                }
                 for &e in &touched {
                     // Inside the body: every element touching this one (at its
-                    // vertices and edges) holds some of the body's particles.
+                    // vertices and edges) holds some of the body's particles, or is
+                    // a hole in them.
                     pieces.clear();
                     self.basis.polynomial_pieces(e, &mut pieces);
                     let mut inside = true;
                     for corner in &pieces {
                         let x = SVector::<T, D>::from_fn(|k, _| T::of(corner[k]));
-                        self.basis
-                            .other_elements_at(e, &x, &mut |o| inside &= touching[o] > 0);
+                        self.basis.other_elements_at(e, &x, &mut |o| {
+                            inside &= touching[o] > 0 || hole_here[o]
+                        });
                     }
                     if inside {
                         filled += 1;
@@ -179,6 +230,10 @@ where
                 for &e in &touched {
                     touching[e] = 0;
                 }
+                for &e in &around {
+                    seen_empty[e] = false;
+                    hole_here[e] = false;
+                }
                 elements.clear();
                 touched.clear();
                 BodySampling {
@@ -190,6 +245,7 @@ where
                     },
                     filled,
                     thin,
+                    empty,
                 }
             })
             .collect()
@@ -680,6 +736,11 @@ pub struct BodySampling {
     /// in the left and right triangles, 4 in the others).
     pub filled: usize,
     pub thin: usize,
+    /// Of the thin ones, those holding none: an element every corner of which
+    /// touches an element holding some of the body's particles (a hole in the
+    /// sampling: `per_block = [1, 16]` on blocks of four triangles leaves the left
+    /// and right triangles of every block empty).
+    pub empty: usize,
 }
 
 /// Particles per element below which a PS element inside a body is thin

@@ -853,7 +853,10 @@ where
                     crate::scene::limits::echo_significant(room.max(0.0), 3),
                     crate::scene::limits::echo_significant(nominal, 3),
                 )
-            } else if self.effects.iter().any(|e| e.walls_element(from)) {
+            } else if self.effects.iter().any(|e| {
+                let x = to_f64(&self.particles.x[p]);
+                e.went_through(from, [x[0], if D > 1 { x[1] } else { 0.0 }])
+            }) {
                 let distance = nominal;
                 let how = if moved < 0.25 * distance {
                     format!(

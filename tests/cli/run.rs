@@ -1732,7 +1732,8 @@ fn a_body_placed_in_a_contact_walls_layer_is_told_to_move_off() {
 /// them (3 × 4 per block of four triangles: 2 in the left and right triangles of
 /// every block) is warned about; 4 × 4 (its particles on the diagonals counting
 /// in both triangles) and 5 × 4 are not. Measured on the example: E_u 3.17e-5 at
-/// 3 × 4 against 6.20e-7 at 4 × 4.
+/// 3 × 4 against 6.20e-7 at 4 × 4. A lattice of 1 × 16 leaves half the
+/// triangles empty, and is warned about too.
 #[test]
 fn a_ps_lattice_with_thin_triangles_is_warned_about() {
     // The documented example the warning cites, cut short.
@@ -1764,4 +1765,12 @@ fn a_ps_lattice_with_thin_triangles_is_warned_about() {
         let out = warnings(fine);
         assert!(!out.contains("hold fewer than 3"), "{fine}: {out}");
     }
+    // One particle per block along an axis (16 along the other) leaves the left
+    // and right triangles of every block empty: holes the count did not see (a
+    // user counted 64 of 128 empty, unwarned).
+    let holes = warnings("1x16");
+    assert!(
+        holes.contains("64 of the 128 triangles inside the body hold fewer than 3 particles (50 %; 64 of them none"),
+        "{holes}"
+    );
 }
