@@ -1774,3 +1774,60 @@ fn a_ps_lattice_with_thin_triangles_is_warned_about() {
         "{holes}"
     );
 }
+
+/// A contact wall closing around an obstacle narrower than 1.5 times the triangles
+/// along it is warned about (a user's disk went through a post of 0.2 at an edge
+/// length of 0.25, and held at 0.1, which is not warned about).
+#[test]
+fn a_contact_obstacle_smaller_than_the_mesh_is_warned_about() {
+    let scene = |edge: f64| {
+        format!(
+            r#"name = "post"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "polygon"
+outline = [[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]]
+edge_length = {edge}
+[[mesh.holes]]
+outline = [[1.9, 0.9], [2.1, 0.9], [2.1, 1.1], [1.9, 1.1]]
+tag = "post"
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+shape = "disk"
+centre = [0.8, 1.0]
+radius = 0.25
+spacing = [0.025, 0.025]
+[[effect]]
+kind = "contact-wall"
+tag = "post"
+[time]
+courant = 0.25
+t_end = 0.01
+"#
+        )
+    };
+    for (edge, warned) in [(0.25, true), (0.1, false)] {
+        let file = SceneFile::new(&format!("post-{edge}"), &scene(edge));
+        let out = cli()
+            .args(["run", file.arg(), "--diag-every", "0"])
+            .output()
+            .unwrap();
+        assert_success(&out);
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(
+            stderr.contains("the contact wall `post` closes around an obstacle 0.2 across"),
+            warned,
+            "{edge}: {stderr}"
+        );
+        if warned {
+            assert!(
+                stderr.contains("refine the mesh to an `edge_length` of 0.1 or less"),
+                "{stderr}"
+            );
+        }
+    }
+}
