@@ -208,13 +208,31 @@ impl WallGeometry {
         self.reach
     }
 
+    /// The wall items listed for `element` (those within [`Self::reach`]). An
+    /// element of a body's copy of the basis (`body_contact::PerBody`) is that
+    /// element of the mesh.
+    fn items(&self, element: usize) -> &[u32] {
+        let element = element % (self.element_start.len() - 1).max(1);
+        match (
+            self.element_start.get(element),
+            self.element_start.get(element + 1),
+        ) {
+            (Some(&a), Some(&b)) => &self.element_items[a..b],
+            _ => &[],
+        }
+    }
+
     /// `true` if a wall item is listed for `element` (within [`Self::reach`]).
     pub fn near(&self, element: usize) -> bool {
-        let element = element % (self.element_start.len() - 1).max(1);
-        self.element_start
-            .get(element)
-            .zip(self.element_start.get(element + 1))
-            .is_some_and(|(a, b)| b > a)
+        !self.items(element).is_empty()
+    }
+
+    /// How far inside the contact distance `d` of the walls `x` (in `element`)
+    /// lies, at the deepest of them (0 outside it).
+    fn depth(&self, element: usize, x: Vec2, d: f64) -> f64 {
+        let mut deepest = 0.0f64;
+        self.contacts(element, x, d, |g, _, _| deepest = deepest.max(g));
+        deepest
     }
 
     /// `true` if `x` (a point outside the mesh that left it from `element`) lies
@@ -223,15 +241,7 @@ impl WallGeometry {
     /// reflex corners: it went out through the wall. A particle that left through
     /// an open side beside a wall is neither.
     pub fn behind(&self, element: usize, x: Vec2) -> bool {
-        let element = element % (self.element_start.len() - 1).max(1);
-        let Some(range) = self
-            .element_start
-            .get(element)
-            .zip(self.element_start.get(element + 1))
-        else {
-            return false;
-        };
-        self.element_items[*range.0..*range.1].iter().any(|&item| {
+        self.items(element).iter().any(|&item| {
             let item = item as usize;
             if let Some(&(a, b, n)) = self.segments.get(item) {
                 let ab = b - a;
@@ -263,22 +273,12 @@ impl WallGeometry {
     /// `d` to the ramp, and the end pushed them back.
     #[inline]
     fn contacts(&self, element: usize, x: Vec2, d: f64, mut contact: impl FnMut(f64, Vec2, f64)) {
-        // An element of a body's copy of the basis (`body_contact::PerBody`) is that
-        // element of the mesh.
-        let element = element % (self.element_start.len() - 1).max(1);
-        let Some(range) = self
-            .element_start
-            .get(element)
-            .zip(self.element_start.get(element + 1))
-        else {
-            return;
-        };
         let along = |s: usize| {
             let (a, b, _) = self.segments[s];
             let ab = b - a;
             (x - a).dot(&ab) / ab.norm_squared()
         };
-        for &item in &self.element_items[*range.0..*range.1] {
+        for &item in self.items(element) {
             let item = item as usize;
             if item < self.segments.len() {
                 let (a, b, n) = self.segments[item];
@@ -336,15 +336,13 @@ pub fn started_close<T: Scalar, const D: usize>(
     let mut close = Vec::new();
     for p in 0..particles.len() {
         let d = contact_distance::<D>(particles.volume0[p].to_f64());
-        let mut deepest = 0.0f64;
-        geometry.contacts(
+        let room = d - geometry.depth(
             particles.element[p],
             ContactWall::position(&particles.x[p]),
             d,
-            |g, _, _| deepest = deepest.max(g),
         );
-        if d - deepest < crate::driver::STARTED_CLOSE * d {
-            close.push((p, d - deepest));
+        if room < crate::driver::STARTED_CLOSE * d {
+            close.push((p, room));
         }
     }
     close
@@ -454,14 +452,9 @@ impl ContactWall {
         state.started = true;
         let mut distance = self.distance.lock().unwrap_or_else(|e| e.into_inner());
         for (p, d) in distance.iter_mut().enumerate() {
-            let mut deepest = 0.0f64;
-            self.geometry.contacts(
-                particles.element[p],
-                Self::position(&particles.x[p]),
-                *d,
-                |g, _, _| deepest = deepest.max(g),
-            );
-            *d -= deepest;
+            *d -= self
+                .geometry
+                .depth(particles.element[p], Self::position(&particles.x[p]), *d);
         }
     }
 

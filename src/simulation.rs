@@ -415,6 +415,9 @@ struct Tally {
     pieces_at_start: usize,
     /// [`Spin`] of the particles at the start.
     spin_at_start: Spin,
+    /// Each body's lattice stretch ([`lattice_stretch`]), for the arrangement's
+    /// checks at the start and at the end.
+    stretch: Vec<f64>,
     /// The total energy after the last completed step (the initial one before any).
     last_energy: f64,
     /// The largest `kinetic − kinetic_motion` of a step, with its time and
@@ -1255,6 +1258,7 @@ where
         thin,
         on_edges,
         spin_at_start,
+        stretch,
         stray_at_start,
         pieces_at_start,
         last_energy,
@@ -1562,10 +1566,9 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 .max_rotation_of_non_objective(&driver.particles.f, now),
         ),
     );
-    let stretch = lattice_stretch(scene);
-    let at_end = fragments(&driver.particles, &run.body_sizes, &stretch);
+    let at_end = fragments(&driver.particles, &run.body_sizes, &tally.stretch);
     let irregularity =
-        crate::arrangement::irregularity(&driver.particles, &run.body_sizes, &stretch);
+        crate::arrangement::irregularity(&driver.particles, &run.body_sizes, &tally.stretch);
     let keys = particle_keys(scene);
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
