@@ -103,6 +103,55 @@ where
         })
     }
 
+    /// The particles' changes of element since the driver placed them: one per
+    /// particle and location (each step and sub-step) that found it in another
+    /// element than the last.
+    pub fn element_changes(&self) -> u64 {
+        self.element_changes
+    }
+
+    /// The width (smallest altitude; length in 1D) of the widest element that
+    /// holds a particle, at the last location.
+    pub fn widest_occupied_element(&self) -> f64 {
+        self.particles
+            .element
+            .iter()
+            .map(|&e| self.element_width[e])
+            .fold(0.0, f64::max)
+    }
+
+    /// Per body (`body_sizes` as [`Driver::sampling_by_body`]): its extent, the
+    /// smallest over the axes of its particles' spread plus their mean spacing
+    /// (`(V⁰_p)^(1/D)`, so that a lattice filling a box of side 1 measures 1), and
+    /// the width of the widest element holding one of its particles.
+    pub fn body_extents(&self, body_sizes: &[usize]) -> Vec<(f64, f64)> {
+        let sizes = bodies_or_one(body_sizes, self.particles.len());
+        let mut first = 0;
+        sizes
+            .iter()
+            .map(|&size| {
+                let range = first..first + size;
+                first += size;
+                let (mut low, mut high) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
+                let (mut spacing, mut widest) = (0.0, 0.0f64);
+                for p in range {
+                    for k in 0..D {
+                        let x = self.particles.x[p][k].to_f64();
+                        low[k] = low[k].min(x);
+                        high[k] = high[k].max(x);
+                    }
+                    spacing += self.particles.volume0[p].to_f64().powf(1.0 / D as f64);
+                    widest = widest.max(self.element_width[self.particles.element[p]]);
+                }
+                let spacing = spacing / size.max(1) as f64;
+                let extent = (0..D)
+                    .map(|k| high[k] - low[k] + spacing)
+                    .fold(f64::INFINITY, f64::min);
+                (extent, widest)
+            })
+            .collect()
+    }
+
     /// Particles per element that holds at least one, at the last location.
     pub fn particles_per_occupied_element(&self) -> f64 {
         let occupied = (0..self.basis.num_elements())

@@ -244,6 +244,9 @@ where
     /// The end (one past the last particle) of each body's particles, the bodies
     /// stored one after another ([`Driver::set_body_sizes`]); empty for one body.
     body_ends: Vec<usize>,
+    /// The particles' changes of element over the run (one per particle and
+    /// location that found another element than the last; phase 1).
+    element_changes: u64,
     /// Per-chunk sums `Σ_p m_p v_pⁿ · Δv_p` of the velocity update (phase 4), for
     /// the time-centred kinetic energy.
     centred_terms: Vec<f64>,
@@ -436,6 +439,7 @@ where
             energy_terms: vec![[0.0; TERMS]; phases::chunks(np)],
             body_ends: Vec::new(),
             centred_terms: vec![0.0; phases::chunks(np)],
+            element_changes: 0,
             previous_energy: None,
             affine_gradient: vec![SMatrix::zeros(); if momentum_corrects { np } else { 0 }],
             function_points,
@@ -685,6 +689,12 @@ where
     pub fn dt(&self) -> f64 {
         self.dt_outer
     }
+    /// Replaces the critical step of [`Driver::critical_time_step`] (by a bound
+    /// the estimate exceeded, `setup::time_steps`): what the messages and the
+    /// watch measure the step against.
+    pub fn set_critical_step(&mut self, critical: f64) {
+        self.dt_critical = Some(critical);
+    }
     /// Changes the time step (e.g. to a fraction of [`Driver::critical_time_step`]).
     pub fn set_dt(&mut self, dt: f64) {
         self.dt_outer = dt;
@@ -829,7 +839,8 @@ where
             &mut self.scratch,
             &mut self.evals,
         )
-        .inspect(|_| {
+        .map(|crossed| {
+            self.element_changes += crossed as u64;
             self.gather.mark_live(&self.basis, &self.bins);
             self.inputs
                 .mark_touching(&self.basis, &self.particles, &self.bins, &self.gather);

@@ -144,8 +144,9 @@ pub struct Outside {
 /// Phase 1: locate every particle (walking from its previous element), bin the
 /// particles by element ([`Bins`]), and evaluate the basis at each particle in bin
 /// order, into its slot ([`Evaluations`]); [`CHUNK`] particles per task with one
-/// scratch buffer each (`scratch` holds [`chunks`]`(x.len())` of them). On
-/// failure, the first particle outside.
+/// scratch buffer each (`scratch` holds [`chunks`]`(x.len())` of them). The
+/// number of particles now in another element than before; on failure, the first
+/// particle outside.
 pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
     basis: &B,
     x: &[SVector<T, D>],
@@ -153,23 +154,32 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
     bins: &mut Bins,
     scratch: &mut [BasisEval<T, D>],
     out: &mut Evaluations<T, D>,
-) -> Result<(), Outside> {
-    let failure = (x.par_chunks(CHUNK), element.par_chunks_mut(CHUNK))
+) -> Result<usize, Outside> {
+    // The particles that changed element, or the first one outside (integer sums
+    // and a minimum: the same for any thread count).
+    let located = (x.par_chunks(CHUNK), element.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
-        .filter_map(|(c, (x, element))| {
+        .map(|(c, (x, element))| {
+            let mut crossed = 0usize;
             for q in 0..x.len() {
                 let Some(e) = basis.locate(&x[q], Some(element[q])) else {
-                    return Some(c * CHUNK + q);
+                    return Err(c * CHUNK + q);
                 };
+                crossed += usize::from(e != element[q]);
                 element[q] = e;
             }
-            None
+            Ok(crossed)
         })
-        .min();
-    if let Some(particle) = failure {
-        return Err(Outside { particle });
-    }
+        .reduce(
+            || Ok(0),
+            |a, b| match (a, b) {
+                (Err(p), Err(q)) => Err(p.min(q)),
+                (Err(p), Ok(_)) | (Ok(_), Err(p)) => Err(p),
+                (Ok(a), Ok(b)) => Ok(a + b),
+            },
+        );
+    let crossed = located.map_err(|particle| Outside { particle })?;
     bins.fill_with_slots(element, &mut out.slot);
     let stride = out.stride;
     let (order, element) = (&bins.order, &*element);
@@ -202,7 +212,7 @@ pub fn locate_and_evaluate<T: Scalar, const D: usize, B: Basis<T, D>>(
                 copy_entries(&scratch.grad_phi, &mut grad_phi[base..base + m]);
             }
         });
-    Ok(())
+    Ok(crossed)
 }
 
 /// `out.copy_from_slice(&source[..out.len()])`, with the PS and PL lengths (9 and

@@ -1831,3 +1831,69 @@ t_end = 0.01
         }
     }
 }
+
+/// A body far smaller than its elements (a disk of radius 0.05 in blocks of 1):
+/// the default's system holds almost no stiffness, and its critical step came out
+/// at 2.1e12, so that `courant = 0.25` asked for a `t_end` of 5e11 (a user's
+/// finding; at a fixed step the disk moved rigidly, its strain energy 1e-27, with
+/// no warning). The run now steps at `courant` times the P-wave's crossing time of
+/// the widest element holding particles, warns that the body moves rigidly and
+/// asks for a mesh it spans; on that mesh nothing is warned and the estimate is
+/// the critical step.
+#[test]
+fn a_body_smaller_than_its_elements_is_warned_about_and_stepped_by_the_wave_speed() {
+    let scene = |blocks: usize| {
+        format!(
+            r#"name = "tiny"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [{blocks}, {blocks}]
+[material]
+young = 5e6
+poisson = 0.3
+density = 1000.0
+[[body]]
+shape = "disk"
+centre = [1.3, 1.6]
+radius = 0.05
+spacing = [0.0125, 0.0125]
+initial_velocity = {{ kind = "uniform", value = [1.0, 0.0] }}
+[time]
+courant = 0.25
+t_end = 0.02
+"#
+        )
+    };
+    for (blocks, warned) in [(4, true), (64, false)] {
+        let file = SceneFile::new(&format!("tiny-{blocks}"), &scene(blocks));
+        let out = cli()
+            .args(["run", file.arg(), "--diag-every", "0", "--format", "json"])
+            .output()
+            .unwrap();
+        assert_success(&out);
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(
+            stderr.contains("the bodies move rigidly, without strain"),
+            warned,
+            "{blocks}: {stderr}"
+        );
+        let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let critical = summary["dt_critical"].as_f64().unwrap();
+        if warned {
+            assert!(
+                stderr.contains("the body spans 0.1 across, less than the width of the elements it lies in (0.5)")
+                    && stderr.contains("elements about 0.033 wide or less: `mesh.blocks`"),
+                "{stderr}"
+            );
+            // The P-wave speed √((λ + 2μ)/ρ) = 82.0 m/s across a width of 0.5.
+            let c = (5e6 * 0.7 / (1.3 * 0.4) / 1000.0f64).sqrt();
+            assert!((critical / (0.5 / c) - 1.0).abs() < 1e-9, "{critical}");
+        } else {
+            assert!(critical < 1e-3, "{critical}");
+        }
+    }
+}
