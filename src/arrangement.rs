@@ -164,8 +164,7 @@ fn neighbours<const D: usize>(
         &particles.f,
         bodies,
         STRAY_DISTANCE,
-    )
-    else {
+    ) else {
         return false;
     };
     for p in 0..particles.len() {
@@ -633,8 +632,14 @@ mod tests {
         // Bounded, and 1 for a compression or an `F` that is not a number.
         let huge = nalgebra::Matrix2::new(1e9, 0.0, 0.0, 1.0);
         assert_eq!(principal_stretch(&huge), MOST_STRETCH);
-        assert_eq!(principal_stretch(&(nalgebra::Matrix2::identity() * 0.5)), 1.0);
-        assert_eq!(principal_stretch(&(nalgebra::Matrix2::identity() * f64::NAN)), 1.0);
+        assert_eq!(
+            principal_stretch(&(nalgebra::Matrix2::identity() * 0.5)),
+            1.0
+        );
+        assert_eq!(
+            principal_stretch(&(nalgebra::Matrix2::identity() * f64::NAN)),
+            1.0
+        );
     }
 
     /// A 10 × 10 lattice (spacing 0.1) carried by any affine map has no particle out

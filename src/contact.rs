@@ -326,16 +326,16 @@ impl WallGeometry {
 }
 
 /// The particles (index and distance) that start closer to the walls than
-/// [`crate::driver::STARTED_CLOSE`] of their contact distance: placed in the walls'
-/// contact layer, their springs have that little room. The particles are located
-/// (`element`).
+/// [`crate::driver::STARTED_CLOSE`] of their contact distance (`distance`,
+/// [`contact_distances`]): placed in the walls' contact layer, their springs have
+/// that little room. The particles are located (`element`).
 pub fn started_close<T: Scalar, const D: usize>(
     geometry: &WallGeometry,
     particles: &Particles<T, D>,
+    distance: &[f64],
 ) -> Vec<(usize, f64)> {
     let mut close = Vec::new();
-    for p in 0..particles.len() {
-        let d = contact_distance::<D>(particles.volume0[p].to_f64());
+    for (p, &d) in distance.iter().enumerate().take(particles.len()) {
         let room = d - geometry.depth(
             particles.element[p],
             ContactWall::position(&particles.x[p]),
@@ -409,19 +409,49 @@ pub fn contact_distance<const D: usize>(volume0: f64) -> f64 {
     0.5 * volume0.powf(1.0 / D as f64)
 }
 
+/// Each particle's contact distance on a lattice stretched by `stretch` (each
+/// body's largest lattice spacing over its mean, [`crate::arrangement::body_stretch`];
+/// `body_sizes` the numbers of particles of the bodies in order; empty or sizes
+/// that do not add up: 1): half its body's largest spacing,
+/// [`contact_distance`] times the stretch, so that a body whose rows lie half a
+/// row spacing from a wall starts touching it along either axis. With `½ √V⁰`
+/// a block on `per_block = [5, 4]` (spacings 0.05 and 0.0625) placed on a
+/// contact floor had its bottom row 0.03125 above it against a contact distance
+/// of 0.028: it fell 3.3 mm, landed, and rang at 270 times its static strain
+/// energy (a user's finding). Along the finer axis a particle then starts inside
+/// the distance, which takes its start distance instead ([`ContactWall`]).
+pub fn contact_distances<T: Scalar, const D: usize>(
+    particles: &Particles<T, D>,
+    body_sizes: &[usize],
+    stretch: &[f64],
+) -> Vec<f64> {
+    let n = particles.len();
+    let mut factor = vec![1.0; n];
+    if body_sizes.len() == stretch.len() && body_sizes.iter().sum::<usize>() == n {
+        let mut first = 0;
+        for (&size, &s) in body_sizes.iter().zip(stretch) {
+            factor[first..first + size].fill(s.max(1.0));
+            first += size;
+        }
+    }
+    particles
+        .volume0
+        .iter()
+        .zip(factor)
+        .map(|(v, f)| contact_distance::<D>(v.to_f64()) * f)
+        .collect()
+}
+
 impl ContactWall {
     /// The walls' `geometry` for `particles` (a wall's spring frequency `κ / Δt`,
-    /// its `κ` in the geometry). `Err` with the largest contact distance when it
+    /// its `κ` in the geometry), whose contact distances are `distance`
+    /// ([`contact_distances`]). `Err` with the largest contact distance when it
     /// exceeds the geometry's reach (particles much coarser than the elements).
     pub fn new<T: Scalar, const D: usize>(
         geometry: WallGeometry,
         particles: &Particles<T, D>,
+        distance: Vec<f64>,
     ) -> Result<Self, f64> {
-        let distance: Vec<f64> = particles
-            .volume0
-            .iter()
-            .map(|v| contact_distance::<D>(v.to_f64()))
-            .collect();
         let largest = distance.iter().copied().fold(0.0, f64::max);
         if largest > geometry.reach {
             return Err(largest);

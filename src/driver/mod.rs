@@ -676,6 +676,48 @@ where
         held / (weight * loaded.len() as f64)
     }
 
+    /// How the walls hold the initial motion of the particles `range`, per
+    /// component `k`: the share of their momentum `Σ_p m_p |v_{p,k}|` that falls on
+    /// the functions the walls hold in `k` (single-term constraints),
+    /// `Σ_p m_p |v_{p,k}| Σ_{i held} phi_i(x_p)`, and the speed there against the
+    /// mean speed: `(Σ_p m_p |v_{p,k}| Σ_{i held} phi_i / Σ_p m_p Σ_{i held} phi_i)`
+    /// over `Σ_p m_p |v_{p,k}| / Σ_p m_p`; `(0, 0)` for a component without motion
+    /// or held functions. The walls hold those functions both ways: the particles
+    /// there take the walls' velocity, whichever way they move. A motion that
+    /// vanishes at the walls (a bar vibrating between two) has its speed there well
+    /// below the mean; a body moving as a whole, about the mean.
+    pub fn motion_held_by_walls(&self, range: std::ops::Range<usize>) -> [(f64, f64); D] {
+        let mut eval = BasisEval::for_basis(&self.basis);
+        // Per component: Σ m |v| φ_held, Σ m φ_held, Σ m |v|, Σ m.
+        let mut sums = [[0.0f64; 4]; D];
+        for p in range {
+            let m = self.particles.mass[p].to_f64();
+            let v = &self.particles.v[p];
+            self.basis
+                .eval(self.particles.element[p], &self.particles.x[p], &mut eval);
+            for (k, fixed) in self.fixed.iter().enumerate().take(D) {
+                let speed = v[k].to_f64().abs();
+                let held: f64 = eval
+                    .iter()
+                    .filter(|&(i, _, _)| fixed[i])
+                    .map(|(_, phi, _)| phi.to_f64())
+                    .sum();
+                sums[k][0] += m * speed * held;
+                sums[k][1] += m * held;
+                sums[k][2] += m * speed;
+                sums[k][3] += m;
+            }
+        }
+        std::array::from_fn(|k| {
+            let [near, held, momentum, mass] = sums[k];
+            if momentum > 0.0 && held > 0.0 && mass > 0.0 {
+                (near / momentum, (near / held) / (momentum / mass))
+            } else {
+                (0.0, 0.0)
+            }
+        })
+    }
+
     /// Current time.
     pub fn time(&self) -> f64 {
         self.time

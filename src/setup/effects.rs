@@ -15,6 +15,7 @@ use psmpm_basis::basis::Basis;
 pub fn build_effects<const D: usize>(
     scene: &Scene,
     particles: &Particles<f64, D>,
+    body_sizes: &[usize],
     contacts: Option<&WallGeometry>,
     basis: &dyn Basis<f64, D>,
 ) -> Result<Vec<Box<dyn Effect<f64, D>>>, RunError> {
@@ -79,7 +80,12 @@ pub fn build_effects<const D: usize>(
                     .into());
                 };
                 let reach = geometry.reach();
-                let wall = ContactWall::new(geometry, particles).map_err(|d| {
+                let distance = crate::contact::contact_distances(
+                    particles,
+                    body_sizes,
+                    &crate::simulation::lattice_stretch(scene),
+                );
+                let wall = ContactWall::new(geometry, particles, distance).map_err(|d| {
                     let tags: Vec<String> = scene
                         .effects
                         .iter()

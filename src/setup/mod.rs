@@ -163,7 +163,13 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     origin[..D].copy_from_slice(&lattice.bounds[0].0[..D]);
     let mut particles = particles::place::<D>(scene, &lattice);
     particles::apply_initial_states(scene, &lattice, solution, origin, &mut particles)?;
-    let effects = build_effects(scene, &particles, domain.contacts.as_ref(), &domain.basis)?;
+    let effects = build_effects(
+        scene,
+        &particles,
+        &lattice.body_sizes,
+        domain.contacts.as_ref(),
+        &domain.basis,
+    )?;
     // The lattice's positions and volumes are in `particles` now: free them before
     // the driver allocates (they would otherwise count in the run's peak memory).
     let body_sizes = std::mem::take(&mut lattice.body_sizes);
@@ -221,8 +227,10 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     driver.set_body_sizes(&body_sizes);
     let mut warnings = domain_warnings;
     warnings.extend(held_traction_warnings(scene, &driver));
+    warnings.extend(held_motion_warnings(scene, &driver, &body_sizes));
     if let Some(walls) = &contacts {
         warnings.extend(started_close_warnings(
+            scene,
             walls,
             &driver.particles,
             &body_sizes,
@@ -267,11 +275,17 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
 /// A warning for each body with particles that start in a contact wall's contact
 /// layer ([`crate::contact::started_close`]).
 fn started_close_warnings<const D: usize>(
+    scene: &Scene,
     walls: &crate::contact::WallGeometry,
     particles: &crate::particles::Particles<f64, D>,
     body_sizes: &[usize],
 ) -> Vec<String> {
-    let close = crate::contact::started_close(walls, particles);
+    let distances = crate::contact::contact_distances(
+        particles,
+        body_sizes,
+        &crate::simulation::lattice_stretch(scene),
+    );
+    let close = crate::contact::started_close(walls, particles, &distances);
     let mut warnings = Vec::new();
     let mut first = 0;
     for (b, &n) in body_sizes.iter().enumerate() {
@@ -283,7 +297,7 @@ fn started_close_warnings<const D: usize>(
         let Some(&&(p, distance)) = body.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
             continue;
         };
-        let nominal = crate::contact::contact_distance::<D>(particles.volume0[p]);
+        let nominal = distances[p];
         let x = &particles.x[p];
         warnings.push(format!(
             "body[{b}]: {} particle{} start{} closer to a contact wall than {} of the distance at which it pushes (half a particle spacing, {}), the nearest (particle {p}) {} from it at [{}]: the body overlaps the wall's contact layer, so these particles' springs have that little room, and a step's small motion can take them through the wall; move the body off so that its particles start at least {} from the wall (a lattice not aligned with a slanted wall puts some particles closer than its outline: move such a body off by half a spacing)",
@@ -334,6 +348,69 @@ fn held_traction_warnings<const D: usize, B: Basis<f64, D>>(
         })
         .collect()
 }
+
+/// A warning for each body whose initial motion the walls (`fix`) hold for
+/// [`HELD_MOMENTUM`] of it or more ([`crate::driver::Driver::momentum_held_by_walls`]):
+/// a wall holds its functions both ways, so a body started against it and moving
+/// away stays stuck to it, and one moving into it stops dead; a motion that
+/// vanishes at the walls (a bar vibrating between two) is not warned about
+/// ([`HELD_SPEED`]). A user's L-shaped
+/// body launched at (3, 3) m/s from the corner of two slip walls (`fix =
+/// ["normal"]`) stayed in the corner, its centre at (0.31, 0.41) at t = 0.6
+/// against (2.11, 0.45) in free flight, with no warning; with contact walls it
+/// flew off as expected.
+fn held_motion_warnings<const D: usize, B: Basis<f64, D>>(
+    scene: &Scene,
+    driver: &SceneDriver<D, B>,
+    body_sizes: &[usize],
+) -> Vec<String> {
+    let walls: Vec<String> = scene
+        .boundaries
+        .iter()
+        .filter(|b| !b.fix.is_empty())
+        .map(|b| format!("`{}`", b.tag))
+        .collect();
+    if walls.is_empty() {
+        return Vec::new();
+    }
+    let sizes: Vec<usize> = if body_sizes.iter().sum::<usize>() == driver.particles.len() {
+        body_sizes.to_vec()
+    } else {
+        vec![driver.particles.len()]
+    };
+    let mut first = 0;
+    let mut warnings = Vec::new();
+    for (b, &n) in sizes.iter().enumerate() {
+        let held = driver
+            .motion_held_by_walls(first..first + n)
+            .iter()
+            .filter(|&&(_, speed)| speed >= HELD_SPEED)
+            .map(|&(share, _)| share)
+            .fold(0.0, f64::max);
+        first += n;
+        if held >= HELD_MOMENTUM {
+            warnings.push(format!(
+                "body[{b}]: {:.0} % of its initial momentum falls on functions the walls (`fix`: {}) hold, which they hold both ways: the particles near such a wall take its velocity, so a body started against it and moving away stays stuck to it, and one moving into it stops dead; start the body at least an element away from the walls, or, for a wall the body should leave or strike and rebound from, make it a contact wall (`[[effect]] kind = \"contact-wall\"` with its `tag`, in place of the `[[boundary]]`), which only pushes",
+                100.0 * held,
+                walls.join(", ")
+            ));
+        }
+    }
+    warnings
+}
+
+/// The share of a body's initial momentum (in a component) held by the walls from
+/// which the run warns ([`held_motion_warnings`]), if the speed there is
+/// [`HELD_SPEED`] of the mean or more.
+pub(crate) const HELD_MOMENTUM: f64 = 0.01;
+
+/// The speed at the held functions over the body's mean speed (in a component)
+/// from which a held share counts ([`held_motion_warnings`]): a motion the walls
+/// allow vanishes at them. Measured: the vibrating bars (`vibrating-bar`,
+/// `-thesis`, `-1d`, `docs/examples/student-bar-1d.toml`, `axis-aligned`): shares
+/// 1.3–2.4 % at speeds of 0.16–0.30 of the mean; a user's L-shaped body launched
+/// from the corner of two slip walls: 8 % at 1.0.
+pub(crate) const HELD_SPEED: f64 = 0.5;
 
 /// The share of a traction's load taken by the walls above which the run warns
 /// ([`held_traction_warnings`]).
