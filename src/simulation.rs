@@ -798,6 +798,19 @@ pub const FASTEST_SOLID: f64 = 2.5e4;
 /// `density = 7.85`: 1.85e5 m/s, 483 092 steps and 99 s).
 pub fn featherweight_warning(scene: &Scene) -> Option<String> {
     let (who, m, speed) = first_material_where(scene, |_, speed| speed > FASTEST_SOLID)?;
+    // A Poisson's ratio near ½ makes the P-wave fast whatever the density: the
+    // bar speed `√(E/ρ)` then tells the two apart (a user's ν = 0.4999999 with
+    // E = 5e6 and ρ = 1000, 70.7 m/s along a bar and 9.1e4 m/s as a P-wave, was
+    // told to write the density in kg/m³).
+    let bar = (m.young / m.density).sqrt();
+    if bar <= FASTEST_SOLID {
+        return Some(format!(
+            "{who} has a P-wave speed √((λ + 2μ)/ρ) of {speed:.2e} m/s, {:.0} times its bar speed √(E/ρ) = {bar:.3e} m/s: with poisson = {} it is nearly incompressible (λ grows as 1/(1 − 2ν)), which makes the time step that small; take `poisson` of 0.49 or less unless the incompressibility is the point (the step grows as √(1 − 2ν) there; at 0.49 the P-wave is {:.1} times the bar speed)",
+            speed / bar,
+            echo_number(m.poisson),
+            ((1.0 - 0.49) / ((1.0 + 0.49) * (1.0 - 0.98f64))).sqrt()
+        ));
+    }
     Some(format!(
         "{who} has a P-wave speed of {speed:.2e} m/s (young = {:e}, density = {}), faster than any solid (steel about 5 900, diamond 18 000), which makes the time step that small: if `density` is in g/cm³, write it in kg/m³ ({} here: × 1000)",
         m.young,
@@ -1843,6 +1856,19 @@ mod tests {
         two.bodies.push(two.bodies[0].clone());
         let w = reference_bodies_warning(&two).expect("two bodies");
         assert!(w.contains("all 2 bodies"), "{w}");
+        // Nearly incompressible rubber in kg/m³: the Poisson's ratio is named, not
+        // the density (a user's finding).
+        let mut rubber = steel.clone();
+        rubber.material.young = 5e6;
+        rubber.material.density = 1000.0;
+        rubber.material.poisson = 0.4999999;
+        let w = featherweight_warning(&rubber).expect("ν near ½");
+        assert!(
+            w.contains("with poisson = 0.4999999 it is nearly incompressible")
+                && w.contains("take `poisson` of 0.49 or less")
+                && !w.contains("g/cm³"),
+            "{w}"
+        );
     }
 
     /// A 2D scene with a Poisson's ratio measured against a 1D reference is warned

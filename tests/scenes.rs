@@ -92,7 +92,9 @@ fn only_declared_effects_are_evaluated() {
     let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 1.0, 0.0, 1.0, 1, 1).unwrap();
     let basis = psmpm_basis::basis::linear::Linear::<f64>::new(mesh);
     let bar = Scene::builtin("vibrating-bar").unwrap();
-    assert!(build_effects(&bar, &none, &[], None, &basis).unwrap().is_empty());
+    assert!(build_effects(&bar, &none, &[], None, &basis)
+        .unwrap()
+        .is_empty());
     let column = Scene::builtin("column-small").unwrap();
     let effects = build_effects(&column, &none, &[], None, &basis).unwrap();
     let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();

@@ -852,21 +852,23 @@ fn print_levels(study: &Study, format: Format) {
 }
 
 fn csv(rows: &[Level]) -> String {
-    let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
+    // Every digit, in exponent form as in `diagnostics.csv` (not `0.0000000000224…`).
+    let float = |x: f64| format!("{x:e}");
+    let opt = |v: Option<f64>| v.map_or_else(String::new, float);
     let mut out = crate::out::csv_record(&COLUMNS);
     out.push('\n');
     for r in rows {
         out += &crate::out::csv_record(&[
             r.basis.to_string(),
             r.level.to_string(),
-            r.h.to_string(),
+            float(r.h),
             r.functions.to_string(),
             r.particles.to_string(),
-            r.dt.to_string(),
+            float(r.dt),
             r.steps.to_string(),
             opt(r.error),
             opt(r.order),
-            r.seconds.to_string(),
+            float(r.seconds),
             r.stable.to_string(),
         ]);
         out.push('\n');

@@ -42,10 +42,35 @@ impl Scene {
         }
         let particles = self.estimated_particle_count();
         if particles.is_nan() || particles > MAX_PARTICLES as f64 {
+            // The body with the most particles, and the key that sets its lattice.
+            let (b, most) = self
+                .bodies
+                .iter()
+                .map(|body| self.estimated_particles(body))
+                .enumerate()
+                .max_by(|a, c| a.1.total_cmp(&c.1))
+                .unwrap_or((0, particles));
+            let body = &self.bodies[b];
+            let key = if body.per_block.is_some() {
+                "per_block"
+            } else if body.count.is_some() {
+                "count"
+            } else if body.spacing.is_some() {
+                "spacing"
+            } else {
+                "per_block"
+            };
+            let fix = if key == "spacing" {
+                "a larger `spacing`"
+            } else if key == "per_block" {
+                "fewer particles per block (`per_block` counts per block of the mesh, so a finer mesh multiplies them too: coarsen `mesh.blocks` or `mesh.elements` for the same particles per element)"
+            } else {
+                "a smaller `count`"
+            };
             return Err(bad(
-                "body[0]",
+                format!("body[{b}].{key}"),
                 format!(
-                    "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES}"
+                    "the bodies would hold about {particles:.3e} particles, above the limit of {MAX_PARTICLES} (body[{b}] about {most:.3e}): give {fix}"
                 ),
             ));
         }

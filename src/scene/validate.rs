@@ -223,8 +223,13 @@ impl Scene {
                 return Err(conflict(
                     format!("boundary[{i}].fix"),
                     format!(
-                        "component `{}` does not exist in {d}D",
-                        format!("{c:?}").to_lowercase()
+                        "component `{}` does not exist in {d}D: {}",
+                        format!("{c:?}").to_lowercase(),
+                        if d == 1 {
+                            "a 1D bar moves along x only; hold its end with `fix = [\"x\"]` (or `[\"normal\"]`, the same in 1D)"
+                        } else {
+                            "use `x` and `y` (or `normal` for a slip wall)"
+                        }
                     ),
                 ));
             }

@@ -38,10 +38,27 @@ pub fn build_effects<const D: usize>(
             } => {
                 let selected = traction_particles(particles, min, max);
                 if selected.is_empty() {
+                    // A body outside the mesh is the cause to name first (a
+                    // user's body moved off the mesh was told only of its traction).
+                    let extent = super::mesh_extent(basis);
+                    if let Some(p) = (0..particles.len())
+                        .find(|&p| basis.locate(&particles.x[p], None).is_none())
+                    {
+                        let position: Vec<f64> = particles.x[p].iter().copied().collect();
+                        return Err(super::particle_outside(
+                            scene, p, &position, extent, body_sizes,
+                        )
+                        .into());
+                    }
                     return Err(SceneError::new(
                         format!("effect[{i}].min"),
                         ErrorKind::Conflict,
-                        "the traction box selects no particle",
+                        format!(
+                            "the traction box {} to {} selects no particle: the particles' centres span {}; give `min` and `max` a box around the centres of the particles to load (the outer ones lie half a spacing inside the body's outline)",
+                            crate::driver::point(min),
+                            crate::driver::point(max),
+                            particle_span(particles)
+                        ),
                     )
                     .into());
                 }
@@ -124,4 +141,24 @@ pub(crate) fn traction_particles<const D: usize>(
     (0..particles.len())
         .filter(|&p| (0..D).all(|k| (min[k]..=max[k]).contains(&particles.x0[p][k])))
         .collect()
+}
+
+/// The bounding box of the particles' centres, for messages: `[x0, x1] × [y0, y1]`.
+fn particle_span<const D: usize>(particles: &Particles<f64, D>) -> String {
+    (0..D)
+        .map(|k| {
+            let (lo, hi) = particles
+                .x
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x[k]), hi.max(x[k]))
+                });
+            format!(
+                "[{}, {}]",
+                crate::scene::limits::echo_significant(lo, 6),
+                crate::scene::limits::echo_significant(hi, 6)
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(" × ")
 }

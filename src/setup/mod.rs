@@ -444,7 +444,9 @@ fn law<const D: usize>(m: &MaterialSpec) -> Result<AnyMaterial, MaterialError> {
 }
 
 /// The bounding box of the mesh of `basis`, for messages: `[x0, x1] × [y0, y1]`.
-fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> ([f64; D], [f64; D]) {
+pub(crate) fn mesh_extent<const D: usize, B: Basis<f64, D> + ?Sized>(
+    basis: &B,
+) -> ([f64; D], [f64; D]) {
     let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
     let mut pieces = Vec::new();
     for e in 0..basis.num_elements() {
@@ -464,7 +466,15 @@ fn mesh_extent<const D: usize, B: Basis<f64, D>>(basis: &B) -> ([f64; D], [f64; 
 /// `(lo, hi)`: in a hole or notch when it lies inside the box, outside otherwise.
 fn outside_the_mesh<const D: usize>(position: &[f64], (lo, hi): ([f64; D], [f64; D])) -> String {
     let span = (0..D)
-        .map(|k| format!("[{}, {}]", echo_number(lo[k]), echo_number(hi[k])))
+        .map(|k| {
+            // Significant digits: a bound computed from the mesh's vertices carries
+            // round-off (`0.6000000000000001`).
+            format!(
+                "[{}, {}]",
+                crate::scene::limits::echo_significant(lo[k], 10),
+                crate::scene::limits::echo_significant(hi[k], 10)
+            )
+        })
         .collect::<Vec<_>>()
         .join(" × ");
     let inside_box = (0..D).all(|k| position.get(k).is_some_and(|&x| lo[k] <= x && x <= hi[k]));
@@ -475,6 +485,40 @@ fn outside_the_mesh<const D: usize>(position: &[f64], (lo, hi): ([f64; D], [f64;
         let position = crate::driver::point(position);
         format!("the particle at {position} lies outside the mesh, which spans {span}; the body must lie inside the meshed domain")
     }
+}
+
+/// The error for particle `particle` at `position` outside a mesh of bounding box
+/// `extent`, named against its body (`body_sizes`, the bodies' particle counts in
+/// order): a box past the mesh's low side is its `min`'s doing, past the high side
+/// its `max`'s; in a hole, the whole body's.
+pub(crate) fn particle_outside<const D: usize>(
+    scene: &Scene,
+    particle: usize,
+    position: &[f64],
+    extent: ([f64; D], [f64; D]),
+    body_sizes: &[usize],
+) -> SceneError {
+    let mut first = 0;
+    let body = body_sizes
+        .iter()
+        .position(|&n| {
+            first += n;
+            particle < first
+        })
+        .unwrap_or(0);
+    let (lo, hi) = extent;
+    let below = (0..D).any(|k| position.get(k).is_some_and(|&x| x < lo[k]));
+    let above = (0..D).any(|k| position.get(k).is_some_and(|&x| x > hi[k]));
+    let field = match scene.bodies.get(body) {
+        Some(b) if b.shape.is_box() && below => format!("body[{body}].min"),
+        Some(b) if b.shape.is_box() && above => format!("body[{body}].max"),
+        _ => format!("body[{body}]"),
+    };
+    SceneError::new(
+        field,
+        ErrorKind::Conflict,
+        outside_the_mesh(position, extent),
+    )
 }
 
 /// The one place a scene's driver is built: fixes from the boundary conditions,
@@ -533,30 +577,7 @@ fn driver<const D: usize, B: Basis<f64, D>>(
     )
     .map_err(|e| match e {
         SetupError::ParticleOutside { particle, position } => {
-            // Name the body the particle belongs to.
-            let mut first = 0;
-            let body = body_sizes
-                .iter()
-                .position(|&n| {
-                    first += n;
-                    particle < first
-                })
-                .unwrap_or(0);
-            // A box past the mesh's low side is its `min`'s doing, past the high
-            // side its `max`'s; in a hole, the whole body's.
-            let (lo, hi) = extent;
-            let below = (0..D).any(|k| position.get(k).is_some_and(|&x| x < lo[k]));
-            let above = (0..D).any(|k| position.get(k).is_some_and(|&x| x > hi[k]));
-            let field = match scene.bodies.get(body) {
-                Some(b) if b.shape.is_box() && below => format!("body[{body}].min"),
-                Some(b) if b.shape.is_box() && above => format!("body[{body}].max"),
-                _ => format!("body[{body}]"),
-            };
-            SceneError::new(
-                field,
-                ErrorKind::Conflict,
-                outside_the_mesh(&position, extent),
-            )
+            particle_outside(scene, particle, &position, extent, body_sizes)
         }
         SetupError::Boundary { tag, message } => SceneError::new(
             boundary_field(scene, &tag),

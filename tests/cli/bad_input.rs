@@ -803,7 +803,7 @@ fn inconsistent_cases() -> Vec<Case> {
             .expect("body[0].per_block: needs a `blocks` or `interval` mesh; use `count` or `spacing` on other meshes"),
         case("component-y-in-1d", BAR_1D)
             .edit("fix = [\"x\"]", "fix = @@[\"y\"]")
-            .expect("boundary[0].fix: component `y` does not exist in 1D"),
+            .expect("boundary[0].fix: component `y` does not exist in 1D: a 1D bar moves along x only; hold its end with `fix = [\"x\"]` (or `[\"normal\"]`, the same in 1D)"),
         case("no-component", BAR)
             .edit("fix = [\"x\", \"y\"]\n\n[[boundary]]\ntag = \"right\"", "fix = @@[]\n\n[[boundary]]\ntag = \"right\"")
             .expect("boundary[0].fix: lists no component"),
@@ -950,9 +950,14 @@ fn inconsistent_cases() -> Vec<Case> {
         case("body-not-a-whole-number-of-cells", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 0.9]")
             .at(24, 7).expect("body[0].max: the body's extent 0.9 along axis 1 is not a whole number of lattice cells of size 0.25 (the mesh's block size along that axis over `per_block`): make the extent a multiple of it, choose `blocks` (or `--blocks`) so that it is, or give `count` instead of `per_block`"),
+        // A body off the mesh is named, not its traction (a user's finding: the
+        // traction box selecting nothing was reported first).
+        case("body-off-the-mesh-with-a-traction", COLUMN)
+            .edit("min = [0.0, 0.0]\nmax = [1.0, 4.0]", "min = [10.0, 10.0]\nmax = [11.0, 14.0]")
+            .at(19, 7).expect("body[0].max: the particle at [10.25, 10.25] lies outside the mesh, which spans [0, 1] × [0, 4]; the body must lie inside the meshed domain"),
         case("traction-box-selects-nothing", COLUMN)
             .edit("min = [0.0, 3.5]\nmax = [1.0, 4.0]", "min = [5.0, 5.0]\nmax = [6.0, 6.0]")
-            .at(36, 7).expect("effect[2].min: the traction box selects no particle"),
+            .at(36, 7).expect("effect[2].min: the traction box [5, 5] to [6, 6] selects no particle: the particles' centres span [0.25, 0.75] × [0.25, 3.75]; give `min` and `max` a box around the centres of the particles to load (the outer ones lie half a spacing inside the body's outline)"),
         case("self-intersecting-polygon", SQUARE)
             .edit("outline = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]", "outline = [[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]]")
             .at(8, 11).expect("mesh.outline: invalid mesh parameter: the boundary intersects itself: segment (0, 0)–(1, 1) of the outer polygon meets segment (1, 0)–(0, 1) of the outer polygon"),
