@@ -456,9 +456,9 @@ fn bad_bodies_are_errors_naming_the_field() {
                 "[[body]]\nshape = \"disk\"\ncentre = [2.0, 2.0]\nradius = 1.0\nspacing = [1e-4, 1e-4]",
                 "",
             ),
-            "body[0]",
+            "body[0].spacing",
             ErrorKind::Value,
-            "above the limit of 10000000",
+            "above the limit of 10000000 (body[0] about 4.000e8): give a larger `spacing`",
         ),
         (
             scene_text(
