@@ -193,7 +193,8 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
             eprintln!("warning ({} {}): {warning}", s.basis, s.mass);
         }
     }
-    print_summaries(&summaries, args.format);
+    // As asked: `--jobs 1` runs them one after the other.
+    print_summaries(&summaries, args.format, args.jobs != Some(1));
     let failed = summaries.iter().filter(|s| !s.stable).count();
     crate::error::study_verdict(args.strict, failed, summaries.len())
 }
@@ -255,7 +256,9 @@ fn print_tracked(summaries: &[Summary]) {
     print!("{}", table.render());
 }
 
-pub fn print_summaries(summaries: &[Summary], format: Format) {
+/// `side_by_side`: the variants ran at the same time (not `--jobs 1`), which the
+/// table's note on the wall times says.
+pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool) {
     match format {
         Format::Json => {
             let all: Vec<_> = summaries.iter().map(summary_json).collect();
@@ -338,9 +341,14 @@ pub fn print_summaries(summaries: &[Summary], format: Format) {
                     format!(" ({})", stopped.join("; "))
                 };
                 println!(
-                    "{}: {error}, t = {}{stopped}; wall times measured side by side",
+                    "{}: {error}, t = {}{stopped}; wall times measured {}",
                     s.scene,
-                    crate::table::short(t_end)
+                    crate::table::short(t_end),
+                    if side_by_side {
+                        "side by side"
+                    } else {
+                        "one after the other (--jobs 1)"
+                    }
                 );
                 print_tracked(summaries);
                 let steps: Vec<f64> = summaries.iter().map(|s| s.dt).collect();

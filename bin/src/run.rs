@@ -748,8 +748,15 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     });
     match format {
         Format::Json => stdout.line(&summary_json(&summary).to_string()),
-        // stdout stays CSV: the summary goes to stderr as `# key=value` lines.
-        Format::Csv => eprint!("{}", summary_comments(&summary)),
+        // stdout stays CSV: the summary goes to stderr as `# key=value` lines. No
+        // row was due (`--diag-every 0`, or above the steps): the header alone, so
+        // that stdout is a CSV file a script can read (it was empty).
+        Format::Csv => {
+            if csv_header {
+                stdout.line(&out::csv_record(&out::DIAGNOSTICS_COLUMNS));
+            }
+            eprint!("{}", summary_comments(&summary))
+        }
         Format::Table => {
             if every > 0 {
                 stdout.line(&table.render());

@@ -11,7 +11,18 @@ impl Scene {
         match &mut self.mesh {
             MeshSpec::Blocks { blocks, .. } => *blocks = [nx, ny],
             MeshSpec::Interval { elements, .. } => *elements = nx,
-            _ => return Err(conflict("mesh.blocks", "the scene's mesh has no blocks")),
+            MeshSpec::Polygon { .. } => {
+                return Err(conflict(
+                    "mesh.blocks",
+                    "the scene's mesh is a `polygon` mesh, which has no blocks: refine or coarsen it with `mesh.edge_length` in the scene file (`converge` halves it per level)",
+                ))
+            }
+            MeshSpec::Gmsh { .. } => {
+                return Err(conflict(
+                    "mesh.blocks",
+                    "the scene's mesh is a Gmsh file, which has no blocks: make a finer or coarser mesh with Gmsh (its characteristic length) and give that file as `mesh.file`",
+                ))
+            }
         }
         Ok(())
     }

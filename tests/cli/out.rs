@@ -752,6 +752,30 @@ fn binary_and_ascii_runs_write_the_same_frames() {
     input_error(&["run", "vibrating-bar-1d", "--vtu", "ascii"]);
 }
 
+/// `--format csv` with no row due (`--diag-every 0`) prints the header alone, so
+/// that stdout is still a CSV file (it was empty: a user's script failed on it).
+#[test]
+fn csv_format_without_rows_prints_the_header() {
+    let out = cli()
+        .args([
+            "run",
+            "vibrating-bar-1d",
+            "--t-end",
+            "0.01",
+            "--diag-every",
+            "0",
+            "--format",
+            "csv",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let mut reader = csv::Reader::from_reader(&out.stdout[..]);
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(header[..3], ["step", "time", "kinetic"]);
+    assert_eq!(reader.records().count(), 0);
+}
+
 #[test]
 fn csv_format_keeps_the_summary_on_stderr() {
     let out = cli()

@@ -404,6 +404,7 @@ fn command_line_cases() -> Vec<Case> {
         args_case("converge-particles-with-gmsh-bodies-only", gmsh_body, &["converge", "@", "--particles", "2x2"], "--particles 2x2: every body is a Gmsh body"),
         args_case("resolution-per-block-with-gmsh-bodies-only", gmsh_resolution, &["run", "@"], "resolution[0].per_block: every body is a Gmsh body"),
         args_case("1d-blocks-second-number", rod.clone(), &["run", "@", "--blocks", "8x3"], "--blocks 8x3: a 1D scene has one count; the second number must be 1"),
+        args_case("blocks-on-a-polygon-mesh", Some(SQUARE.to_string()), &["run", "@", "--blocks", "8x8"], "--blocks 8x8: mesh.blocks: the scene's mesh is a `polygon` mesh, which has no blocks: refine or coarsen it with `mesh.edge_length` in the scene file"),
         args_case("1d-particles-second-number", rod.clone(), &["run", "@", "--particles", "4x2"], "--particles 4x2: a 1D scene has one count"),
         args_case("1d-builtin-blocks", None, &["run", "vibrating-bar-1d", "--blocks", "8x2"], "the second number must be 1"),
         args_case("compare-1d-blocks", rod.clone(), &["compare", "@", "--blocks", "8x3"], "--blocks 8x3"),
