@@ -956,7 +956,7 @@ where
                     }
                 }
                 format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or raise the wall's `stiffness` toward its default 0.5 (below about 0.25 the springs let an impact through: an L body striking a wedge at 5.9 m/s went through at 0.02 and 0.1 and held at 0.25 and 0.5; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
             } else if let Some((_, vertex)) = self.slip_bends.iter().find(|(functions, _)| {
                 self.basis

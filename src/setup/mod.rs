@@ -238,6 +238,12 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
     }
     let (dt, steps, dt_critical, failed) = time_steps(scene, &mut driver, &body_sizes, dt)?;
     warnings.extend(failed);
+    warnings.extend(soft_contact_warnings(
+        scene,
+        &driver.particles,
+        &body_sizes,
+        dt,
+    ));
     if let (Some(critical), None, false) = (
         dt_critical,
         scene.time.courant,
@@ -270,6 +276,92 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
         body_sizes,
         warnings,
     })
+}
+
+/// A warning for each contact wall whose springs, at the run's step `dt`, would let
+/// a body resting on it under gravity sink by more than half its contact distance:
+/// a particle's spring is `m_p (κ/Δt)²` stiff, the bottom particle of a body of
+/// height `H` (along `g`) and spacing `h` carries about `ρ |g| H h`, so it sinks by
+/// about `|g| H Δt² / (h κ²)` against a contact distance of `h / 2`; it holds for
+/// `κ ≥ 2 Δt √(|g| H) / h`. A user's wall at `stiffness = 1e-3` was told after the
+/// body went through to halve `courant`, and went through again: the springs were
+/// about 1e5 times too soft. The first wall and the body that sinks most are named.
+fn soft_contact_warnings<const D: usize>(
+    scene: &Scene,
+    particles: &crate::particles::Particles<f64, D>,
+    body_sizes: &[usize],
+    dt: f64,
+) -> Vec<String> {
+    use crate::scene::limits::echo_significant;
+    let Some(g) = scene.gravity() else {
+        return Vec::new();
+    };
+    let g_norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if g_norm <= 0.0 || dt.is_nan() || dt <= 0.0 {
+        return Vec::new();
+    }
+    let sizes: Vec<usize> = if body_sizes.iter().sum::<usize>() == particles.len() {
+        body_sizes.to_vec()
+    } else {
+        vec![particles.len()]
+    };
+    // Per body: its height along g and its mean spacing.
+    let mut first = 0;
+    let bodies: Vec<(f64, f64)> = sizes
+        .iter()
+        .map(|&n| {
+            let range = first..first + n;
+            first += n;
+            let (mut low, mut high, mut spacing) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+            for p in range {
+                let along: f64 = (0..D).map(|k| particles.x[p][k] * g[k] / g_norm).sum();
+                low = low.min(along);
+                high = high.max(along);
+                spacing += particles.volume0[p].powf(1.0 / D as f64);
+            }
+            let h = spacing / n.max(1) as f64;
+            (high - low + h, h)
+        })
+        .collect();
+    let mut warnings = Vec::new();
+    for effect in &scene.effects {
+        let crate::scene::EffectSpec::ContactWall { tag, stiffness } = effect else {
+            continue;
+        };
+        let sink =
+            |(height, h): (f64, f64)| g_norm * height * dt * dt / (h * stiffness * stiffness);
+        let Some((b, &(height, h))) = bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, &(_, h))| h > 0.0)
+            .max_by(|a, c| (sink(*a.1) / a.1 .1).total_cmp(&(sink(*c.1) / c.1 .1)))
+        else {
+            continue;
+        };
+        let depth = sink((height, h));
+        if depth <= 0.25 * h {
+            continue;
+        }
+        let holds = 2.0 * dt * (g_norm * height).sqrt() / h;
+        let who = if bodies.len() > 1 {
+            format!("body[{b}]")
+        } else {
+            "the body".to_string()
+        };
+        warnings.push(format!(
+            "contact wall `{tag}`: at `stiffness = {}` and the step {}, {who} resting on it under gravity would sink about {} into its springs (|g| H Δt² / (h κ²), H = {} its height, h = {} its spacing), more than half its contact distance ({}): it will be pressed through the wall. Its springs hold a resting body for `stiffness` of {} or more (at most 1), or with a step shorter by {:.1} times (`time.courant`); a body striking it needs more (an L body striking a wedge at 5.9 m/s went through at 0.02 and 0.1 and held at 0.25 and at the default 0.5)",
+            echo_significant(*stiffness, 3),
+            echo_significant(dt, 3),
+            echo_significant(depth, 3),
+            echo_significant(height, 3),
+            echo_significant(h, 3),
+            echo_significant(0.5 * h, 3),
+            echo_significant(holds, 2),
+            (depth / (0.25 * h)).sqrt(),
+        ));
+        break;
+    }
+    warnings
 }
 
 /// A warning for each body with particles that start in a contact wall's contact

@@ -2041,3 +2041,57 @@ t_end = 0.1
     // Static: ½ ∫ σ²/E' over the block, about 5e-5 (1.4e-2 when it fell).
     assert!(most < 2e-4, "{most}");
 }
+
+/// A contact wall whose springs cannot hold a resting body at the run's step is
+/// warned about at the start, with the `stiffness` that holds (a user's wall at
+/// `stiffness = 1e-3` was told, after the body went through, to halve `courant`,
+/// and it went through again); at the default stiffness nothing is warned.
+#[test]
+fn a_contact_wall_too_soft_to_hold_a_resting_body_is_warned_about() {
+    let scene = |stiffness: &str| {
+        format!(
+            r#"name = "soft-floor"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [0.0, 1.0]
+blocks = [8, 4]
+[material]
+young = 1e6
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [0.5, 0.0]
+max = [1.5, 0.5]
+per_block = [4, 4]
+[[effect]]
+kind = "contact-wall"
+tag = "bottom"
+{stiffness}
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.25
+t_end = 0.002
+"#
+        )
+    };
+    for (name, stiffness, warned) in [("soft", "stiffness = 1e-3", true), ("default", "", false)] {
+        let file = SceneFile::new(&format!("floor-{name}"), &scene(stiffness));
+        let out = cli()
+            .args(["run", file.arg(), "--diag-every", "0"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(
+            stderr.contains("contact wall `bottom`: at `stiffness = 0.001`")
+                && stderr.contains("it will be pressed through the wall")
+                && stderr.contains("Its springs hold a resting body for `stiffness` of"),
+            warned,
+            "{name}: {stderr}"
+        );
+    }
+}
