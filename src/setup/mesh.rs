@@ -171,6 +171,24 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
     Ok(mesh)
 }
 
+/// The message for a tag `tag` the mesh (of tags `tags`) does not have, with the
+/// closest tag where one is near, and for a Gmsh mesh where its tags come from (a
+/// user's missing `Physical Curve` was told only the tags the file has).
+fn unknown_tag(scene: &Scene, tag: &str, tags: &[String]) -> String {
+    let message = crate::scene::names::did_you_mean(format!(
+        "unknown boundary tag `{}`; the mesh has tags {}",
+        crate::scene::limits::echo(tag),
+        crate::scene::limits::echo_tags(tags)
+    ));
+    match &scene.mesh {
+        MeshSpec::Gmsh { file } => format!(
+            "{message}: the tags of `{file}` are its physical curves (1D physical groups) on boundary edges, a physical curve on interior edges is none; add `Physical Curve(\"{}\") = {{...}};` for the wall's boundary curves to the .geo and mesh it again",
+            crate::scene::limits::echo(tag)
+        ),
+        _ => message,
+    }
+}
+
 /// Every boundary condition names a tag of the mesh.
 fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
     for (b, bc) in scene.boundaries.iter().enumerate() {
@@ -178,11 +196,7 @@ fn check_tags(scene: &Scene, tags: &[String]) -> Result<(), RunError> {
             return Err(SceneError::new(
                 format!("boundary[{b}].tag"),
                 ErrorKind::Unknown,
-                crate::scene::names::did_you_mean(format!(
-                    "unknown boundary tag `{}`; the mesh has tags {}",
-                    crate::scene::limits::echo(&bc.tag),
-                    crate::scene::limits::echo_tags(tags)
-                )),
+                unknown_tag(scene, &bc.tag, tags),
             )
             .into());
         }
@@ -354,11 +368,7 @@ fn contact_walls(scene: &Scene, mesh: &TriMesh) -> Result<Option<WallGeometry>, 
             SceneError::new(
                 field.clone(),
                 ErrorKind::Unknown,
-                crate::scene::names::did_you_mean(format!(
-                    "unknown boundary tag `{}`; the mesh has tags {}",
-                    crate::scene::limits::echo(tag),
-                    crate::scene::limits::echo_tags(mesh.tags())
-                )),
+                unknown_tag(scene, tag, mesh.tags()),
             )
         })?;
         if !mesh

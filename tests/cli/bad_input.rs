@@ -934,7 +934,7 @@ fn inconsistent_cases() -> Vec<Case> {
             .at(35, 7).expect("boundary[1].tag: unknown boundary tag `west`; the mesh has tags `bottom`, `top`, `left`, `right`"),
         case("unknown-boundary-tag-on-a-gmsh-mesh", GMSH)
             .edit("tag = \"bottom\"", "tag = \"wall\"")
-            .at(21, 7).expect("boundary[0].tag: unknown boundary tag `wall`; the mesh has tags `bottom`, `right`, `top`, `left`"),
+            .at(21, 7).expect("boundary[0].tag: unknown boundary tag `wall`; the mesh has tags `bottom`, `right`, `top`, `left`: the tags of `{dir}/meshes/square.msh` are its physical curves (1D physical groups) on boundary edges, a physical curve on interior edges is none; add `Physical Curve(\"wall\") = {...};` for the wall's boundary curves to the .geo and mesh it again"),
         case("body-outside-the-mesh", BAR)
             .edit("max = [4.0, 1.0]", "max = [4.0, 2.0]")
             .at(22, 1).at(24, 7).expect("body[0].max: the particle at [0.125, 1.125] lies outside the mesh, which spans [0, 4] × [0, 1]; the body must lie inside the meshed domain"),
