@@ -925,7 +925,9 @@ fn unresolved_body<const D: usize, B: Basis<f64, D>>(
     ))
 }
 
-/// [`unresolved_body`]'s bound on `critical c / extent`.
+/// The bound on `critical c / extent` above which a body is warned about as
+/// unresolved by the mesh (`unresolved_body`: the critical step longer than a
+/// P-wave takes to cross the body).
 pub const UNRESOLVED_BODY: f64 = 1.0;
 
 /// What sets a critical step too small for the run: the scene's fastest P-wave
