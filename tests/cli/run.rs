@@ -1842,32 +1842,7 @@ t_end = 0.01
 /// the critical step.
 #[test]
 fn a_body_smaller_than_its_elements_is_warned_about_and_stepped_by_the_wave_speed() {
-    let scene = |blocks: usize| {
-        format!(
-            r#"name = "tiny"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 4.0]
-y = [0.0, 4.0]
-blocks = [{blocks}, {blocks}]
-[material]
-young = 5e6
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "disk"
-centre = [1.3, 1.6]
-radius = 0.05
-spacing = [0.0125, 0.0125]
-initial_velocity = {{ kind = "uniform", value = [1.0, 0.0] }}
-[time]
-courant = 0.25
-t_end = 0.02
-"#
-        )
-    };
+    let scene = |blocks: usize| small_disk(blocks, 0.05, 0.0125, 5e6, 0.25, 0.02);
     for (blocks, warned) in [(4, true), (64, false)] {
         let file = SceneFile::new(&format!("tiny-{blocks}"), &scene(blocks));
         let out = cli()
@@ -2145,32 +2120,7 @@ t_end = 0.01
 /// finding). Warned now; on blocks of 1/16 not.
 #[test]
 fn a_body_the_mesh_does_not_resolve_is_warned_about() {
-    let scene = |blocks: usize| {
-        format!(
-            r#"name = "small-disk"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 4.0]
-y = [0.0, 4.0]
-blocks = [{blocks}, {blocks}]
-[material]
-young = 1e5
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "disk"
-centre = [1.3, 1.6]
-radius = 0.075
-spacing = [0.0075, 0.0075]
-initial_velocity = {{ kind = "uniform", value = [1.0, 0.0] }}
-[time]
-courant = 0.4
-t_end = 0.1
-"#
-        )
-    };
+    let scene = |blocks: usize| small_disk(blocks, 0.075, 0.0075, 1e5, 0.4, 0.1);
     for (blocks, warned) in [(4, true), (64, false)] {
         let file = SceneFile::new(&format!("small-disk-{blocks}"), &scene(blocks));
         let out = cli()
@@ -2185,4 +2135,41 @@ t_end = 0.1
             "{blocks}: {stderr}"
         );
     }
+}
+
+/// A disk of `radius` (lattice `spacing`, `young`, ρ = 1000) moving at 1 m/s in
+/// the box [0, 4]² of `blocks` × `blocks` blocks (PS), stepped at `courant` to
+/// `t_end`: a body small against coarse elements.
+fn small_disk(
+    blocks: usize,
+    radius: f64,
+    spacing: f64,
+    young: f64,
+    courant: f64,
+    t_end: f64,
+) -> String {
+    format!(
+        r#"name = "small-disk"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [{blocks}, {blocks}]
+[material]
+young = {young:e}
+poisson = 0.3
+density = 1000.0
+[[body]]
+shape = "disk"
+centre = [1.3, 1.6]
+radius = {radius}
+spacing = [{spacing}, {spacing}]
+initial_velocity = {{ kind = "uniform", value = [1.0, 0.0] }}
+[time]
+courant = {courant}
+t_end = {t_end}
+"#
+    )
 }
