@@ -161,6 +161,37 @@ const COLUMNS: [&str; 12] = [
     "seconds",
 ];
 
+/// The columns `--format csv` adds after [`COLUMNS`]: the table's verdict, the
+/// time each run reached (a stopped one stops early), the pieces the particles
+/// form at the start and the end and the stray ones at the end (a body that came
+/// apart), the first tracked particle's start and end displacement (`output.tracked`;
+/// empty without one; `y` components 0 in 1D), and why a run stopped (empty when it
+/// completed).
+const CSV_COLUMNS: [&str; 10] = [
+    "verdict",
+    "t_end",
+    "pieces_start",
+    "pieces_end",
+    "stray_end",
+    "tracked_x0",
+    "tracked_y0",
+    "tracked_ux",
+    "tracked_uy",
+    "failure",
+];
+
+/// The table's verdict on a run: `stopped` (it failed; the line below the table
+/// says why), `yes, in pieces` (stable in energy, with a body broken up: the
+/// warnings say how), `yes` or `NO`.
+fn verdict(s: &Summary) -> &'static str {
+    match (s.stable, s.failure.is_some()) {
+        (_, true) => "stopped",
+        (true, false) if s.came_apart() => "yes, in pieces",
+        (true, false) => "yes",
+        (false, false) => "NO",
+    }
+}
+
 /// The variants of the comparison, validated, and `--jobs` and `--threads` checked
 /// ([`crate::check`]).
 pub fn prepare(args: &CompareArgs) -> Result<Vec<Scene>, CliError> {
@@ -265,9 +296,14 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
             println!("{}", serde_json::Value::Array(all));
         }
         Format::Csv => {
-            println!("{}", crate::out::csv_record(&COLUMNS));
+            let header: Vec<&str> = COLUMNS.iter().chain(&CSV_COLUMNS).copied().collect();
+            println!("{}", crate::out::csv_record(&header));
             let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
             for s in summaries {
+                let tracked = s.tracked_end.first();
+                let tracked = |f: fn(&([f64; 2], [f64; 2])) -> f64| {
+                    tracked.map_or_else(String::new, |t| f(t).to_string())
+                };
                 let record = [
                     s.basis.to_string(),
                     s.mass.clone(),
@@ -281,6 +317,16 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
                     s.energy_drift.to_string(),
                     s.stable.to_string(),
                     s.seconds.to_string(),
+                    verdict(s).to_string(),
+                    s.t_end.to_string(),
+                    s.pieces[0].to_string(),
+                    s.pieces[1].to_string(),
+                    s.stray[1].to_string(),
+                    tracked(|t| t.0[0]),
+                    tracked(|t| t.0[1]),
+                    tracked(|t| t.1[0]),
+                    tracked(|t| t.1[1]),
+                    s.failure.clone().unwrap_or_default(),
                 ];
                 println!("{}", crate::out::csv_record(&record));
             }
@@ -299,15 +345,7 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
                     s.max_condition.map_or_else(|| "-".into(), sci),
                     s.max_lumped_rows.to_string(),
                     sci(s.energy_drift),
-                    match (s.stable, s.failure.is_some()) {
-                        (_, true) => "stopped",
-                        // Stable in energy, with a body broken up (the warnings
-                        // on standard error say how).
-                        (true, false) if s.came_apart() => "yes, in pieces",
-                        (true, false) => "yes",
-                        (false, false) => "NO",
-                    }
-                    .to_string(),
+                    verdict(s).to_string(),
                     format!("{:.2}", s.seconds),
                 ]);
             }

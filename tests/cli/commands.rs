@@ -209,7 +209,43 @@ fn compare_ps_and_pl_side_by_side_identically_on_one_and_two_threads() {
         "--format",
         "csv",
     ]);
-    assert_eq!(csv.lines().count(), 3);
+    // The table's columns, then the verdict, the time reached, the pieces, the
+    // tracked particle and why a run stopped.
+    let mut reader = csv::Reader::from_reader(csv.as_bytes());
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(header.len(), 22, "{csv}");
+    assert_eq!(
+        header[12..],
+        [
+            "verdict",
+            "t_end",
+            "pieces_start",
+            "pieces_end",
+            "stray_end",
+            "tracked_x0",
+            "tracked_y0",
+            "tracked_ux",
+            "tracked_uy",
+            "failure"
+        ]
+    );
+    let records: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(records.len(), 2, "{csv}");
+    for (record, row) in records.iter().zip(&rows) {
+        assert_eq!(&record[12], "yes", "{csv}");
+        assert_eq!(record[13].parse::<f64>().unwrap(), 1.0, "{csv}");
+        assert_eq!((&record[14], &record[15]), ("1", "1"), "{csv}");
+        let x0: [f64; 2] = [record[17].parse().unwrap(), record[18].parse().unwrap()];
+        assert!(
+            (x0[0] - 12.37).abs() < 1e-2 && (x0[1] - 1.167).abs() < 1e-3,
+            "{csv}"
+        );
+        // The table's displacement, in full.
+        let u_x: f64 = record[19].parse().unwrap();
+        let shown: f64 = row[2].parse().unwrap();
+        assert!((u_x - shown).abs() <= 1e-3 * shown.abs(), "{csv}");
+        assert_eq!(&record[21], "", "{csv}");
+    }
 }
 
 #[test]
