@@ -13,7 +13,7 @@ use crate::materials::ParticleMaterials;
 use crate::sparse::Scalar;
 use nalgebra::SMatrix;
 use psmpm_basis::Basis;
-use rayon::iter::{IntoParallelIterator, ParallelIterator};
+use rayon::iter::{IntoParallelIterator, IntoParallelRefIterator, ParallelIterator};
 
 /// Power iterations of the critical-step estimate.
 pub const CRITICAL_ITERATIONS: usize = 40;
@@ -297,6 +297,9 @@ where
             since_check: 0,
             interval: WATCH_EVERY,
             counts: (self.last_report.active, self.last_report.treated()),
+            narrowest: self.narrowest_occupied_element(),
+            narrowest_start: self.narrowest_occupied_element(),
+            probed: vec![false; n],
             #[cfg(test)]
             audit: Vec::new(),
         };
@@ -320,14 +323,19 @@ where
         Ok(critical.max(advection))
     }
 
-    /// Books the sub-steps of a step taken whole ([`Driver::substeps`]): in the
-    /// watch's counts only once the step completed.
-    pub(super) fn book_substeps(&mut self) {
+    /// Books the sub-steps of a step taken whole ([`Driver::substeps`]), `taken` of
+    /// them in all: in the watch's counts only once the step completed.
+    pub(super) fn book_substeps(&mut self, taken: usize) {
         let step = self.step;
         let Some(w) = self.watch.as_mut() else {
             return;
         };
-        let (critical, advection) = w.pending;
+        // More taken than planned: the step was split again for the critical step
+        // ([`Driver::resplit_substeps`]).
+        let (mut critical, advection) = w.pending;
+        if taken > critical.max(advection) {
+            critical = taken;
+        }
         if advection > critical {
             w.advected_steps += 1;
             if w.fastest.is_none_or(|(speed, _)| w.speed > speed) {
@@ -431,6 +439,32 @@ where
         Ok(k as usize)
     }
 
+    /// The most sub-steps a step may take for the critical step:
+    /// [`MAX_SUBSTEPS`], times the factor by which the narrowest element the
+    /// particles are in is narrower than when the watch started (at most
+    /// [`NARROWER_SUBSTEPS`]): a fall of the critical step the elements explain
+    /// is not a nearly singular system (a block dropped on a floor of triangles
+    /// 43 times longer than high: its critical step fell 65 to 100 times as it
+    /// landed, at any `courant`, since the sub-steps are at `courant` times it).
+    fn critical_substep_limit(&self, watch: &Watch<T>) -> f64 {
+        let narrower = match (watch.narrowest_start, self.narrowest_occupied_element()) {
+            (Some((_, start)), Some((_, now))) if now > 0.0 => (start / now).max(1.0),
+            _ => 1.0,
+        };
+        MAX_SUBSTEPS as f64 * narrower.min(NARROWER_SUBSTEPS)
+    }
+
+    /// The narrowest element (smallest [`element_widths`]) holding a particle, and
+    /// its width (ties to the lower element: the same for any thread count).
+    pub(super) fn narrowest_occupied_element(&self) -> Option<(usize, f64)> {
+        let width = &self.element_width;
+        self.particles
+            .element
+            .par_iter()
+            .map(|&e| (e, width[e]))
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+    }
+
     /// `near[e]`: element `e` lies within a contact wall's reach
     /// ([`crate::effect::Effect::walls_element`]) or shares a function with one
     /// that does (a particle there reaches the wall's reach within a sub-step of
@@ -455,6 +489,148 @@ where
         near
     }
 
+    /// A check of the watch ([`Driver::watch_critical_step`]) at the state just
+    /// factorised, `counts` the functions active and treated in it: the estimate
+    /// of the critical step, booked in `watch` (the interval to the next check,
+    /// the latest and the lowest estimate).
+    fn watch_estimate(
+        &mut self,
+        watch: &mut Watch<T>,
+        counts: (usize, usize),
+    ) -> Result<f64, StepError> {
+        watch.since_check = 0;
+        // Warm start: the last Ritz vector, with a share of the fixed non-smooth
+        // field (for a new stiff mode elsewhere).
+        let (nv, ns) = (norm(&watch.lanczos.start), watch.seed_norm);
+        for (k, c) in watch.lanczos.start.iter_mut().enumerate() {
+            for (i, a) in c.iter_mut().enumerate() {
+                let warm = if nv > 0.0 { a.to_f64() / nv } else { 0.0 };
+                *a = T::of(warm + WATCH_SEED_SHARE * seed(i, k) / ns);
+            }
+        }
+        // A probe on the narrowest occupied element's functions: the stiffest
+        // mode lives where the elements are narrowest, and a few Lanczos steps
+        // find it only from a start that reaches it.
+        watch.narrowest = self.narrowest_occupied_element();
+        if let Some((_, narrowest)) = watch.narrowest {
+            let probed = &mut watch.probed;
+            probed.iter_mut().for_each(|p| *p = false);
+            for &e in &self.particles.element {
+                if self.element_width[e] <= WATCH_PROBE_WIDTH * narrowest {
+                    for &i in self.basis.element_functions(e) {
+                        probed[i] = true;
+                    }
+                }
+            }
+            let count = probed.iter().filter(|&&p| p).count();
+            let share = WATCH_PROBE_SHARE / ((D * count.max(1)) as f64).sqrt();
+            for (k, c) in watch.lanczos.start.iter_mut().enumerate() {
+                for (i, a) in c.iter_mut().enumerate() {
+                    if probed[i] {
+                        *a += T::of(share * seed(i, k).signum());
+                    }
+                }
+            }
+        }
+        // The watch is out of `self` while it runs, so its buffers lend directly.
+        let estimate = self.lanczos_critical(&mut watch.lanczos, WATCH_ITERATIONS)?;
+        // A steady estimate of an unchanged system: the interval doubles, up to
+        // `WATCH_EVERY_MOST`; else it is back to `WATCH_EVERY`.
+        let steady = counts == watch.counts
+            && watch
+                .latest
+                .is_some_and(|last| (estimate / last - 1.0).abs() < WATCH_STEADY);
+        watch.interval = if steady {
+            (2 * watch.interval).min(WATCH_EVERY_MOST)
+        } else {
+            WATCH_EVERY
+        };
+        watch.counts = counts;
+        #[cfg(test)]
+        {
+            let mut cold = Lanczos::new(D, self.basis.num_functions(), 0);
+            let reference = self.lanczos_critical(&mut cold, 40)?;
+            watch.audit.push((estimate, reference));
+        }
+        watch.latest = Some(estimate);
+        watch.latest_step = self.step + 1;
+        if watch.lowest.is_none_or(|(low, _, _)| estimate < low) {
+            watch.lowest = Some((estimate, self.step + 1, self.time));
+        }
+        Ok(estimate)
+    }
+
+    /// Within a split step, after sub-step `taken` of `planned` ([`Driver::step`]):
+    /// where the functions the strategy's system holds or treats changed since the
+    /// last check, the watch checks again, and where the sub-steps left are above
+    /// `trigger` times the new estimate, the rest of the step (`remaining` of
+    /// time) is split again at `courant`: the new count of its sub-steps. A body
+    /// entering elements much narrower than its own meets their stiffness within
+    /// the step (a block sliding into triangles 100 times longer than high: the
+    /// critical step fell from 1.3e-3 to 6.4e-5 between two sub-steps of 1.4e-4,
+    /// and the next inverted an element).
+    pub(super) fn resplit_substeps(
+        &mut self,
+        remaining: f64,
+        left: usize,
+        crossed: bool,
+    ) -> Result<Option<usize>, StepError> {
+        let Some(mut watch) = self.watch.take() else {
+            return Ok(None);
+        };
+        let counts = (self.last_report.active, self.last_report.treated());
+        let narrowest = self.narrowest_occupied_element();
+        let due = counts != watch.counts
+            || narrower(narrowest, watch.narrowest)
+            || (crossed && watch.pending.0 > 1);
+        if !due {
+            self.watch = Some(watch);
+            return Ok(None);
+        }
+        let estimate = match self.watch_estimate(&mut watch, counts) {
+            Ok(e) => e,
+            Err(e) => {
+                self.watch = Some(watch);
+                return Err(e);
+            }
+        };
+        if remaining / left as f64 <= watch.trigger * estimate {
+            self.watch = Some(watch);
+            return Ok(None);
+        }
+        // The whole step at this estimate: the next steps start split as far,
+        // and past `MAX_SUBSTEPS` the run stops as at a check between steps.
+        let dt = self.dt_outer;
+        let whole = (dt / (watch.courant * estimate)).ceil();
+        let limit = self.critical_substep_limit(&watch);
+        if whole > limit {
+            let start = self.dt_critical;
+            self.watch = Some(watch);
+            let cause = match self.narrower_elements_cause() {
+                Some(cause) => Some(cause),
+                None => {
+                    let lumped = self.lumped_critical_time_step().ok();
+                    self.singular_mass_cause_with(lumped.map(|l| (estimate, l)))
+                }
+            };
+            return Err(StepError::CriticalStepFell {
+                step: self.step + 1,
+                time: self.time,
+                critical: estimate,
+                start,
+                dt,
+                limit: limit as usize,
+                cause,
+            });
+        }
+        watch.substeps = watch.substeps.max(whole as usize);
+        let courant = watch.courant;
+        self.watch = Some(watch);
+        Ok(Some(
+            ((remaining / (courant * estimate)).ceil() as usize).max(left + 1),
+        ))
+    }
+
     /// The sub-steps the critical step needs (1 when the watch is not due): at the
     /// state the step has just factorised (see [`Driver::watch_critical_step`]).
     fn critical_substeps(&mut self) -> Result<usize, StepError> {
@@ -468,67 +644,40 @@ where
         watch.since_check += 1;
         let due = watch.substeps > 1
             || watch.since_check >= watch.interval
-            || (counts != watch.counts && watch.since_check >= WATCH_CHANGED);
+            || (counts != watch.counts && watch.since_check >= WATCH_CHANGED)
+            || narrower(self.narrowest_occupied_element(), watch.narrowest);
         if !due {
             let k = watch.substeps;
             self.watch = Some(watch);
             return Ok(k);
         }
-        watch.since_check = 0;
-        // Warm start: the last Ritz vector, with a share of the fixed non-smooth
-        // field (for a new stiff mode elsewhere).
-        let (nv, ns) = (norm(&watch.lanczos.start), watch.seed_norm);
-        for (k, c) in watch.lanczos.start.iter_mut().enumerate() {
-            for (i, a) in c.iter_mut().enumerate() {
-                let warm = if nv > 0.0 { a.to_f64() / nv } else { 0.0 };
-                *a = T::of(warm + WATCH_SEED_SHARE * seed(i, k) / ns);
-            }
-        }
-        // The watch is out of `self` while it runs, so its buffers lend directly.
-        let estimate = self.lanczos_critical(&mut watch.lanczos, WATCH_ITERATIONS);
-        let estimate = match estimate {
+        let estimate = match self.watch_estimate(&mut watch, counts) {
             Ok(e) => e,
             Err(e) => {
                 self.watch = Some(watch);
                 return Err(e);
             }
         };
-        // A steady estimate of an unchanged system: the interval doubles, up to
-        // `WATCH_EVERY_MOST`; else it is back to `WATCH_EVERY`.
-        let steady = counts == watch.counts
-            && watch
-                .latest
-                .is_some_and(|last| (estimate / last - 1.0).abs() < WATCH_STEADY);
-        watch.interval = if steady {
-            (2 * watch.interval).min(WATCH_EVERY_MOST)
-        } else {
-            WATCH_EVERY
-        };
-        watch.counts = counts;
         let dt = self.dt_outer;
-        #[cfg(test)]
-        {
-            let mut cold = Lanczos::new(D, self.basis.num_functions(), 0);
-            let reference = self.lanczos_critical(&mut cold, 40)?;
-            watch.audit.push((estimate, reference));
-        }
-        watch.latest = Some(estimate);
-        watch.latest_step = self.step + 1;
-        if watch.lowest.is_none_or(|(low, _, _)| estimate < low) {
-            watch.lowest = Some((estimate, self.step + 1, self.time));
-        }
         let k = substep_count(dt, estimate, watch.courant, watch.trigger, watch.substeps);
-        if k > MAX_SUBSTEPS as f64 {
+        let limit = self.critical_substep_limit(&watch);
+        if k > limit {
             let start = self.dt_critical;
             self.watch = Some(watch);
-            let lumped = self.lumped_critical_time_step().ok();
-            let cause = self.singular_mass_cause_with(lumped.map(|l| (estimate, l)));
+            let cause = match self.narrower_elements_cause() {
+                Some(cause) => Some(cause),
+                None => {
+                    let lumped = self.lumped_critical_time_step().ok();
+                    self.singular_mass_cause_with(lumped.map(|l| (estimate, l)))
+                }
+            };
             return Err(StepError::CriticalStepFell {
                 step: self.step + 1,
                 time: self.time,
                 critical: estimate,
                 start,
                 dt,
+                limit: limit as usize,
                 cause,
             });
         }
@@ -655,6 +804,12 @@ pub(super) struct Watch<T> {
     pub interval: usize,
     /// The functions active and treated in the system at the last check.
     pub counts: (usize, usize),
+    /// The narrowest element a particle was in at the last check, and its width.
+    pub narrowest: Option<(usize, f64)>,
+    /// The same when the watch started.
+    pub narrowest_start: Option<(usize, f64)>,
+    /// The functions of the probe ([`WATCH_PROBE_SHARE`]) at the last check.
+    pub probed: Vec<bool>,
     /// Each check's estimate beside a cold 40-step Lanczos estimate at the same
     /// state (tests only).
     #[cfg(test)]
@@ -694,9 +849,33 @@ pub const WATCH_STEADY: f64 = 0.02;
 pub const WATCH_ITERATIONS: usize = 4;
 /// The share (in norm) of the fixed start field added to the last Ritz vector at each check.
 pub const WATCH_SEED_SHARE: f64 = 0.3;
+/// The share (in norm) of the probe on the narrowest occupied element's
+/// functions added to the start of each check ([`Driver::watch_estimate`]).
+pub const WATCH_PROBE_SHARE: f64 = 0.3;
+/// The probe covers the functions of every occupied element at most this many
+/// times as wide as the narrowest occupied one.
+pub const WATCH_PROBE_WIDTH: f64 = 2.0;
+/// A check is due at once, between steps or within a split one, when a particle
+/// is in an element narrower than this share of the narrowest at the last check.
+pub const WATCH_NARROWER: f64 = 0.5;
+
+/// A particle is in an element narrower than [`WATCH_NARROWER`] times the
+/// narrowest at the last check (`last`).
+fn narrower(now: Option<(usize, f64)>, last: Option<(usize, f64)>) -> bool {
+    match (now, last) {
+        (Some((_, width)), Some((_, last))) => width < WATCH_NARROWER * last,
+        (Some(_), None) => true,
+        _ => false,
+    }
+}
+
 /// Most sub-steps one step may be split into before the run stops: a critical
 /// step that fell that far means a nearly singular mass system or a collapse.
 pub const MAX_SUBSTEPS: usize = 64;
+/// The largest factor [`MAX_SUBSTEPS`] grows by for the critical step where the
+/// particles are in elements narrower than at the start
+/// ([`Driver::critical_substep_limit`]).
+pub const NARROWER_SUBSTEPS: f64 = 16.0;
 
 /// The fixed non-smooth field the power iterations start from (it excites the
 /// highest modes): entry `i` of component `k`.

@@ -480,6 +480,61 @@ where
         *angles.select_nth_unstable_by(middle, f64::total_cmp).1
     }
 
+    /// Why the critical step fell, when the particles reached elements at least
+    /// `1 / WATCH_NARROWER` times narrower than the narrowest they were in when
+    /// the watch started: the element, how narrow, and the fix
+    /// ([`Driver::narrow_elements_fix`]; a block dropped on a floor of triangles
+    /// 43 times longer than high: the critical step fell 100 times as it landed).
+    pub(super) fn narrower_elements_cause(&self) -> Option<String> {
+        let watch = self.watch.as_ref()?;
+        let (start, (element, width)) =
+            (watch.narrowest_start?, self.narrowest_occupied_element()?);
+        if width >= super::critical::WATCH_NARROWER * start.1 {
+            return None;
+        }
+        let mut corners = Vec::new();
+        self.basis.polynomial_pieces(element, &mut corners);
+        let mut centre = [0.0; D];
+        for c in &corners {
+            for (k, x) in centre.iter_mut().enumerate() {
+                *x += c[k] / corners.len() as f64;
+            }
+        }
+        let sliver = self
+            .sliver_aspect(element)
+            .map_or_else(String::new, |aspect| {
+                format!(", a sliver: its pieces' longest edge is {aspect:.0} times their height")
+            });
+        Some(format!(
+            "the particles reached elements {:.0} times narrower than those they started in (element {element} near {}: width {width:.2e}{sliver}), and the critical step falls with the width of the elements the particles are in; {}",
+            start.1 / width,
+            point(&centre),
+            self.narrow_elements_fix()
+        ))
+    }
+
+    /// The fix for a run failing in elements much narrower than the rest: a
+    /// quarter of the step (a block dropped on a floor of triangles 43 times
+    /// longer than high failed at `courant` 0.1 and held at 0.05; in the watch's
+    /// sub-steps at `courant` times the critical step, a smaller `courant` keeps
+    /// them further below a critical step that falls within a step), or a mesh
+    /// without them.
+    fn narrow_elements_fix(&self) -> String {
+        let dt = self.dt_outer;
+        let lower = match self.dt_critical {
+            Some(critical) if critical.is_finite() && critical > 0.0 => format!(
+                "lower `time.courant` from {} to {} (or `time.dt` to {:.2e})",
+                crate::scene::limits::echo_significant(dt / critical, 2),
+                crate::scene::limits::echo_significant(0.25 * dt / critical, 2),
+                0.25 * dt
+            ),
+            _ => format!("lower `time.dt` to {:.2e}", 0.25 * dt),
+        };
+        format!(
+            "{lower}, or mesh without such elements (Gmsh: `Mesh.Optimize = 1`, `Mesh.OptimizeNetgen = 1`, a larger smallest edge, no graded layer where the bodies go)"
+        )
+    }
+
     /// Why the element around a failing particle inverted, when the driver sees it
     /// in the sampling or the mesh: a function with almost no particle support that
     /// the strategy solves for, a sliver, fewer particles than functions.
@@ -522,8 +577,14 @@ where
             self.basis.element_functions(element).len(),
         );
         if let Some(aspect) = self.sliver_aspect(element) {
+            let watched = if self.watch.is_some() {
+                "which stiffens the system as particles enter it, faster than the watch over the critical step follows: "
+            } else {
+                "whose stiffness the critical step estimated at the start did not see if the body was not in it yet, and nothing estimated it again: turn the watch on (`time.watch = true`, the default; `allow_above_critical` turns it off too), which splits steps as the critical step falls, or "
+            };
             return Some(format!(
-                "the element around it inverted (speed {speed:.3e}); it is a sliver (its pieces' longest edge is {aspect:.0} times their height), whose stiffness the critical step estimated at the start did not see if the body was not in it yet: lower `time.courant` or `time.dt` by about that factor, or mesh without slivers (Gmsh: `Mesh.OptimizeNetgen`, or a larger smallest edge)"
+                "the element around it inverted (speed {speed:.3e}); it is a sliver (its pieces' longest edge is {aspect:.0} times their height), {watched}{}",
+                self.narrow_elements_fix()
             ));
         }
         if inside < functions {
@@ -648,6 +709,7 @@ fn critical_fell_message(
     critical: f64,
     start: Option<f64>,
     dt: f64,
+    limit: usize,
     cause: Option<&str>,
 ) -> String {
     let from = start.map_or(String::new(), |s| {
@@ -658,8 +720,7 @@ fn critical_fell_message(
         str::to_string,
     );
     format!(
-        "at t = {time:.4e} the critical step fell to {critical:.3e}{from}: Δt = {dt:.3e} would take more than {} sub-steps; {cause}",
-        super::critical::MAX_SUBSTEPS
+        "at t = {time:.4e} the critical step fell to {critical:.3e}{from}: Δt = {dt:.3e} would take more than {limit} sub-steps; {cause}"
     )
 }
 
@@ -700,7 +761,7 @@ pub enum StepError {
     /// The critical step, estimated again as the bodies moved
     /// ([`super::Driver::watch_critical_step`]), fell so far that the step would
     /// take more than [`super::critical::MAX_SUBSTEPS`] sub-steps.
-    #[error("step {step}: {}", critical_fell_message(*time, *critical, *start, *dt, cause.as_deref()))]
+    #[error("step {step}: {}", critical_fell_message(*time, *critical, *start, *dt, *limit, cause.as_deref()))]
     CriticalStepFell {
         step: usize,
         /// The time at the start of the step.
@@ -711,6 +772,9 @@ pub enum StepError {
         start: Option<f64>,
         /// The time step.
         dt: f64,
+        /// The most sub-steps the step could take
+        /// (`Driver::critical_substep_limit`).
+        limit: usize,
         /// What makes the mass system nearly singular, with its fix, when the driver
         /// sees it.
         cause: Option<String>,

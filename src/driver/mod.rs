@@ -35,7 +35,7 @@ pub use critical::{
     WATCH_ITERATIONS, WATCH_SEED_SHARE,
 };
 pub(crate) use failure::point;
-pub use failure::{BodySampling, SetupError, StepError, NEARLY_SINGULAR};
+pub use failure::{BodySampling, SetupError, StepError, NEARLY_SINGULAR, SLIVER_ASPECT};
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};
 pub use phases::update_deformation_gradient;
@@ -785,19 +785,40 @@ where
         let mut times = PhaseTimes::default();
         self.prepare_system(&mut times)?;
         let clock = Instant::now();
-        let substeps = self.substeps()?;
+        let mut planned = self.substeps()?;
         times.solve += clock.elapsed().as_secs_f64();
-        self.set_substep_dt(self.dt_outer / substeps as f64);
-        let mut report = self.advance(0, substeps, &mut times)?;
-        for j in 1..substeps {
+        // The step's sub-steps: `planned` equal ones over the share of the step
+        // from `begin`, of which `j` are taken; split again where the watch finds
+        // the critical step fell within the step (`Driver::resplit_substeps`).
+        let (mut begin, mut j, mut taken) = (0.0, 0, 0);
+        self.set_substep_dt(self.dt_outer / planned as f64);
+        loop {
+            let end = (j + 1 < planned)
+                .then(|| begin + (1.0 - begin) * ((j + 1) as f64 / planned as f64));
+            let report = self.advance(end, &mut times)?;
+            j += 1;
+            taken += 1;
+            if j == planned {
+                self.book_substeps(taken);
+                self.phases = times;
+                return Ok(StepReport {
+                    phases: times,
+                    substeps: taken,
+                    ..report
+                });
+            }
+            let changes = self.element_changes;
             self.prepare_system(&mut times)?;
-            report = self.advance(j, substeps, &mut times)?;
+            let clock = Instant::now();
+            let done = begin + (1.0 - begin) * (j as f64 / planned as f64);
+            let remaining = self.dt_outer * (1.0 - done);
+            let crossed = self.element_changes > changes;
+            if let Some(k) = self.resplit_substeps(remaining, planned - j, crossed)? {
+                (begin, j, planned) = (done, 0, k);
+                self.set_substep_dt(remaining / k as f64);
+            }
+            times.solve += clock.elapsed().as_secs_f64();
         }
-        self.book_substeps();
-        self.phases = times;
-        report.phases = times;
-        report.substeps = substeps;
-        Ok(report)
     }
 
     /// Phases 1, 2a and the factorisation: the particles located, the basis
@@ -815,13 +836,12 @@ where
         Ok(())
     }
 
-    /// Sub-step `j` of `substeps` from a factorised system
-    /// ([`Driver::prepare_system`]): the effects' forces, both solves, the
-    /// particles' update, and the report.
+    /// A sub-step from a factorised system ([`Driver::prepare_system`]): the
+    /// effects' forces, both solves, the particles' update, and the report. `end`:
+    /// the share of the step done after it, `None` for the step's last.
     fn advance(
         &mut self,
-        j: usize,
-        substeps: usize,
+        end: Option<f64>,
         times: &mut PhaseTimes,
     ) -> Result<StepReport, StepError> {
         let clock = Instant::now();
@@ -848,11 +868,12 @@ where
         times.solve += t_solve + t_projection;
         times.update += clock.elapsed().as_secs_f64() - t_assemble - t_solve - t_projection;
         // Time from the step count, so that it does not accumulate round-off.
-        if j + 1 == substeps {
-            self.step += 1;
-            self.time = self.step as f64 * self.dt_outer;
-        } else {
-            self.time = (self.step as f64 + (j + 1) as f64 / substeps as f64) * self.dt_outer;
+        match end {
+            Some(share) => self.time = (self.step as f64 + share) * self.dt_outer,
+            None => {
+                self.step += 1;
+                self.time = self.step as f64 * self.dt_outer;
+            }
         }
         let e = self.step_energies();
         let mut report = self.report_with(e);
