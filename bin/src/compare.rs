@@ -351,7 +351,13 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
             }
             print!("{}", table.render());
             if let Some(s) = summaries.first() {
-                let t_end = summaries.iter().map(|s| s.t_end).fold(0.0, f64::max);
+                // The end time the completed variants reached (a stopped one's
+                // time is where it stopped: listed after it).
+                let t_end = summaries
+                    .iter()
+                    .filter(|v| v.failure.is_none())
+                    .map(|v| v.t_end)
+                    .fold(0.0, f64::max);
                 let error = match s.error_measure {
                     Some(measure) => {
                         format!("error {measure} at the end (or where a run stopped)")
@@ -361,7 +367,7 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
                 // Where a variant stopped early, its own time, to 3 digits.
                 let stopped: Vec<String> = summaries
                     .iter()
-                    .filter(|v| v.t_end < t_end)
+                    .filter(|v| v.failure.is_some() || v.t_end < t_end)
                     .map(|v| {
                         format!(
                             "{} {} stopped at t = {}",
@@ -373,15 +379,20 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
                         )
                     })
                     .collect();
-                let stopped = if stopped.is_empty() {
-                    String::new()
+                let reached = if stopped.len() == summaries.len() {
+                    format!("every variant stopped ({})", stopped.join("; "))
+                } else if stopped.is_empty() {
+                    format!("t = {}", crate::table::short(t_end))
                 } else {
-                    format!(" ({})", stopped.join("; "))
+                    format!(
+                        "t = {} ({})",
+                        crate::table::short(t_end),
+                        stopped.join("; ")
+                    )
                 };
                 println!(
-                    "{}: {error}, t = {}{stopped}; wall times measured {}",
+                    "{}: {error}, {reached}; wall times measured {}",
                     s.scene,
-                    crate::table::short(t_end),
                     if side_by_side {
                         "side by side"
                     } else {

@@ -840,6 +840,11 @@ pub fn watched_line(summary: &Summary) -> Option<String> {
         summary.courant?,
     );
     if summary.split_steps == 0 {
+        // Fell below the step itself, at the step that then stopped the run
+        // (too far to split it): the stop message says so.
+        if summary.failure.is_some() && lowest < summary.dt {
+            return None;
+        }
         // Fell, but not far enough to split a step: said, so that the figure in
         // summary.json is not the only trace.
         return (lowest < 0.9 * start).then(|| {

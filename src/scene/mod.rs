@@ -231,6 +231,7 @@ pub enum MeshSpec {
     /// A quality triangulation of a polygon (with holes) by the project's mesher.
     Polygon {
         /// Corners of the outer boundary.
+        #[serde(deserialize_with = "points::mesh_outline")]
         outline: Vec<[f64; 2]>,
         /// Tag of each outline segment `i → i + 1` (default: all `boundary`).
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -276,6 +277,7 @@ impl<'de> Deserialize<'de> for Hole {
         #[derive(Deserialize)]
         #[serde(deny_unknown_fields)]
         struct Table {
+            #[serde(deserialize_with = "points::mesh_hole")]
             outline: Vec<[f64; 2]>,
             tag: String,
         }
@@ -378,12 +380,15 @@ pub struct Body {
     pub max: Vec<f64>,
     /// Polygon: corners of the outline (either orientation, closed implicitly).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[serde(deserialize_with = "points::list")]
     pub outline: Vec<[f64; 2]>,
     /// Polygon: holes, each a list of corners.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[serde(deserialize_with = "points::lists")]
     pub holes: Vec<Vec<[f64; 2]>>,
     /// Disk: centre.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "points::option")]
     pub centre: Option<[f64; 2]>,
     /// Disk: radius.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -1001,3 +1006,49 @@ fn join_and(items: &[impl AsRef<str>]) -> String {
 
 #[cfg(test)]
 mod tests;
+
+/// Points of the plane read with their number of entries checked: a list of
+/// numbers read into `[f64; 2]` took the first two of `[x, y, z]` without a word
+/// in some tables (a disk's `centre = [0.8, 2.2, 0.0]`).
+mod points {
+    use serde::{de::Error, Deserialize, Deserializer};
+
+    fn point<E: Error>(p: Vec<f64>) -> Result<[f64; 2], E> {
+        match p[..] {
+            [x, y] => Ok([x, y]),
+            _ => Err(E::custom(format!(
+                "a point has 2 entries, x and y, got {}",
+                p.len()
+            ))),
+        }
+    }
+
+    pub fn option<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+        Option::<Vec<f64>>::deserialize(d)?.map(point).transpose()
+    }
+
+    pub fn list<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+        Vec::<Vec<f64>>::deserialize(d)?
+            .into_iter()
+            .map(point)
+            .collect()
+    }
+
+    /// [`list`] for `mesh.outline`, named: a polygon mesh is read through its
+    /// `kind`, and an error inside it is located at `[mesh]` without the key.
+    pub fn mesh_outline<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+        list(d).map_err(|e| D::Error::custom(format!("mesh.outline: {e}")))
+    }
+
+    /// [`list`] for the outline of a `[[mesh.holes]]` table, named.
+    pub fn mesh_hole<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+        list(d).map_err(|e| D::Error::custom(format!("mesh.holes outline: {e}")))
+    }
+
+    pub fn lists<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec<[f64; 2]>>, D::Error> {
+        Vec::<Vec<Vec<f64>>>::deserialize(d)?
+            .into_iter()
+            .map(|l| l.into_iter().map(point).collect())
+            .collect()
+    }
+}

@@ -765,6 +765,10 @@ fn inconsistent_cases() -> Vec<Case> {
         case("body-with-three-coordinates", BAR)
             .edit("max = [4.0, 1.0]", "max = @@[4.0, 1.0, 1.0]")
             .expect("body[0].max: needs 2 entries, got 3"),
+        // A point of the plane read as `[x, y]` took the first two of three.
+        case("disk-centre-with-three-coordinates", BAR)
+            .edit("min = [0.0, 0.0]", "centre = @@[2.0, 0.5, 0.0]\nmin = [0.0, 0.0]")
+            .expect("body[0].centre: a point has 2 entries, x and y, got 3"),
         // In 1D the count is one: "needs 1 entry", not "needs 1 entries".
         case("1d-body-with-two-coordinates", BAR_1D)
             .edit("max = [4.0]", "max = @@[4.0, 1.0]")
