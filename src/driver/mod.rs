@@ -969,15 +969,20 @@ where
                             particle: p,
                             position: to_f64(&self.particles.x[p]),
                             hint: format!(
-                                "it moved {moved:.3e} in the last sub-step at speed {speed:.3e}, {how}, and went through a contact wall, although the step was split {speeds} ways for the particles' speeds, each sub-step at a Courant number of {}: the springs' stiffness follows the sub-step; take {} (a wall's springs are `m (κ/Δt)²` stiff, so half the sub-step makes them four times stiffer) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); an impact much faster than the body's wave speed √(E/ρ) crushes the body whatever the step; if the speed is unphysical, the run became unstable earlier (see the energy column)",
+                                "it moved {moved:.3e} in the last sub-step at speed {speed:.3e}, {how}, and went through a contact wall, although the step was split {speeds} ways for the particles' speeds, each sub-step at a Courant number of {}: the wall's springs are sized on the step, not its sub-steps (`m (κ/Δt)²`, so that splitting a step does not stiffen and soften them, which stores and releases energy); lower `time.courant` from {} to {} (half the step makes them four times stiffer) or raise the wall's `stiffness` a little (0.5 by default; at 1 the contact itself can grow unstable); an impact much faster than the body's wave speed √(E/ρ) crushes the body whatever the step; if the speed is unphysical, the run became unstable earlier (see the energy column)",
                                 crate::scene::limits::echo_significant(sub, 2),
-                                crate::scene::limits::echo_significant(0.5 * sub, 2)
+                                crate::scene::limits::echo_significant(self.dt_outer / c, 2),
+                                // Half the number shown (0.14 → 0.07, not 0.069).
+                                crate::scene::limits::echo_significant(
+                                    0.5 * crate::scene::limits::significant(self.dt_outer / c, 2),
+                                    2
+                                )
                             ),
                         };
                     }
                 }
                 format!(
-                    "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or raise the wall's `stiffness` toward its default 0.5 (below about 0.25 the springs let an impact through: an L body striking a wedge at 5.9 m/s went through at 0.02 and 0.1 and held at 0.25 and 0.5; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}, {how}, and went through a contact wall: lower `time.courant`{courant} (a wall's springs are `m (κ/Δt)²` stiff, so half the step makes them four times stiffer; impacts on contact walls want 0.25 or less, soft or heavy bodies pressed on few particles less) or, where a wall's `stiffness` is below its default 0.5, raise it (below about 0.25 the springs let an impact through: an L body striking a wedge at 5.9 m/s went through at 0.02 and 0.1 and held at 0.25 and 0.5; at 1 the contact itself can grow unstable); if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
             } else if let Some((_, vertex)) = self.slip_bends.iter().find(|(functions, _)| {
                 self.basis
