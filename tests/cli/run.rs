@@ -2245,3 +2245,57 @@ v0 = 0.01
         ["warning: the `[reference]` (`column-self-weight`) is a column standing on its end, held there along gravity, but no wall holds x at `left`, the end gravity pulls it onto: its error measures another motion than this scene's; add what it assumes, or leave out [reference]"]
     );
 }
+
+/// Contact between bodies on PS with a mass that lumps no rows (a user's two
+/// disks with `extended`: energy 126 → 466, then an inverted element blamed on the
+/// sampling) is warned about, and a failure names it first; the default is not.
+#[test]
+fn body_contact_with_a_mass_that_lumps_no_rows_is_warned_about() {
+    let file = SceneFile::new(
+        "disks",
+        r#"name = "disks"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 2.0]
+y = [0.0, 1.0]
+blocks = [8, 4]
+[material]
+model = "neo-hookean"
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+shape = "disk"
+centre = [0.55, 0.5]
+radius = 0.2
+spacing = [0.04, 0.04]
+initial_velocity = { kind = "uniform", value = [1.0, 0.0] }
+[[body]]
+shape = "disk"
+centre = [1.45, 0.5]
+radius = 0.2
+spacing = [0.04, 0.04]
+initial_velocity = { kind = "uniform", value = [-1.0, 0.0] }
+[[effect]]
+kind = "body-contact"
+[time]
+courant = 0.3
+t_end = 0.01
+"#,
+    );
+    let warned = |mass: &str| {
+        let out = cli()
+            .args(["run", file.arg(), "--diag-every", "0", "--mass", mass])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("warning: contact between bodies with the `")
+    };
+    assert!(warned("extended"));
+    assert!(!warned("default"));
+    assert!(!warned("lumped"));
+}
