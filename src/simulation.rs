@@ -879,11 +879,37 @@ pub fn reference_poisson_warning(scene: &Scene) -> Option<String> {
         _ => return None,
     };
     let nu = scene.body_material(0).poisson;
+    // The faces along the bar's axis (x for the bar, y for the column): held
+    // across it on a block mesh when walls there fix that component (or the
+    // normal), and then the body is in uniaxial strain; free, in plane strain with
+    // the faces free (a user's bar with free faces: periods 1/1.048 of the
+    // reference's at ν = 0.3, which is 1/√(1 − ν²)).
+    use crate::scene::Component;
+    let (faces, across) = match scene.reference {
+        Some(Reference::VibratingBar { .. }) => (["bottom", "top"], Component::Y),
+        _ => (["left", "right"], Component::X),
+    };
+    let held = matches!(scene.mesh, crate::scene::MeshSpec::Blocks { .. })
+        && faces.iter().all(|face| {
+            scene.boundaries.iter().any(|b| {
+                b.tag == *face && b.fix.iter().any(|&c| c == across || c == Component::Normal)
+            })
+        });
     (scene.dim == 2 && nu != 0.0).then(|| {
+        let (how, factor) = if held {
+            (
+                "held at its faces, its P-wave speed √((λ + 2μ)/ρ) is",
+                ((1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))).sqrt(),
+            )
+        } else {
+            (
+                "with its faces free, a slender bar's wave speed √(E/((1 − ν²)ρ)) is about",
+                1.0 / (1.0 - nu * nu).sqrt(),
+            )
+        };
         format!(
-            "the `{name}` reference is the 1D bar's, with the wave speed √(E/ρ) of uniaxial stress; with poisson = {} this 2D body is stiffer (held at its faces, its P-wave speed √((λ + 2μ)/ρ) is {:.3} times that), and the error measures that difference as well: set `poisson = 0` to compare with the reference",
+            "the `{name}` reference is the 1D bar's, with the wave speed √(E/ρ) of uniaxial stress; with poisson = {} this 2D body is stiffer ({how} {factor:.3} times that), and the error measures that difference as well: set `poisson = 0` to compare with the reference",
             echo_number(nu),
-            ((1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))).sqrt()
         )
     })
 }
@@ -1861,6 +1887,22 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
 mod tests {
     use super::*;
     use nalgebra::Vector2;
+
+    /// The vibrating bar's Poisson warning names the wave speed of the faces the
+    /// scene gives: held (the built-in, top and bottom fixed in y) or free.
+    #[test]
+    fn the_poisson_warning_follows_the_bar_s_faces() {
+        let mut scene = Scene::builtin("vibrating-bar").unwrap();
+        scene.material.poisson = 0.3;
+        let held = reference_poisson_warning(&scene).unwrap();
+        assert!(
+            held.contains("held at its faces, its P-wave speed √((λ + 2μ)/ρ) is 1.160 times"),
+            "{held}"
+        );
+        scene.boundaries.retain(|b| b.tag != "top");
+        let free = reference_poisson_warning(&scene).unwrap();
+        assert!(free.contains("with its faces free, a slender bar's wave speed √(E/((1 − ν²)ρ)) is about 1.048 times"), "{free}");
+    }
 
     #[test]
     fn velocity_that_moves_no_particle_is_warned_about_above_its_share() {
