@@ -433,6 +433,8 @@ struct Tally {
     stretch: Vec<f64>,
     /// The total energy after the last completed step (the initial one before any).
     last_energy: f64,
+    /// The largest strain energy of any step (the start's included).
+    max_strain: f64,
     /// The largest `kinetic − kinetic_motion` of a step, with its time and
     /// `kinetic` then ([`unseen_velocity_warning`]).
     unseen: (f64, f64, f64),
@@ -635,6 +637,13 @@ pub fn layered_gmsh_geostatic_warning(scene: &Scene) -> Option<String> {
 /// Changes of element per particle over a run above which a piecewise-linear run
 /// warns of grid crossing ([`grid_crossing_warning`]).
 pub const PL_CROSSINGS: f64 = 0.5;
+
+/// The share of the energy scale under which the largest strain energy of a run
+/// counts as none: its particles crossed element edges without a stress whose
+/// force could jump there ([`grid_crossing_warning`] is then not given; a user's
+/// freely falling bar was warned of grid crossing with its strain 0 at every
+/// step).
+pub const STRESS_FREE: f64 = 1e-9;
 
 /// The warning for a piecewise-linear run (`pl`, `pl1d`, `two_d` for the first)
 /// whose particles changed element `changes` times in all, `particles` of them,
@@ -1249,6 +1258,7 @@ where
         crate::diagnostics::initial_stress_energy(&driver.particles, driver.material()),
     );
     let mut last_energy = start.total_energy();
+    let mut max_strain = start.strain;
     let (mut lumped, mut deactivated, mut extended) = (0usize, 0usize, 0usize);
     let mut phases = PhaseTimes::default();
     let mut rms = exact::RmsPositionError::default();
@@ -1324,6 +1334,7 @@ where
         on_step(&r, driver.particles.view());
         verdict.observe(&r);
         last_energy = r.total_energy();
+        max_strain = max_strain.max(r.strain);
         if r.kinetic - r.kinetic_motion > unseen.0 {
             unseen = (r.kinetic - r.kinetic_motion, r.time, r.kinetic);
         }
@@ -1357,6 +1368,7 @@ where
         stray_at_start,
         pieces_at_start,
         last_energy,
+        max_strain,
         unseen,
     }
 }
@@ -1808,7 +1820,10 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     (matches!(
                         scene.basis,
                         crate::bases::BasisKind::Pl | crate::bases::BasisKind::Pl1d
-                    ) && tally.on_edges.is_none())
+                    ) && tally.on_edges.is_none()
+                        // A body that never strained (a free fall) crosses
+                        // without a force to jump.
+                        && tally.max_strain > STRESS_FREE * tally.verdict.scale())
                     .then(|| {
                         grid_crossing_warning(
                             driver.element_changes(),
