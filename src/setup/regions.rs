@@ -107,7 +107,9 @@ pub(crate) fn fill_lattice(
                 "a lattice cell of size {} along axis {k} is wider than the body's {} ({}): the lattice is too coarse for it",
                 crate::scene::limits::echo_number(h[k]),
                 body.shape.name(),
-                crate::scene::limits::echo_number(hi[k] - lo[k])
+                // Its extent's last digits are the subtraction's round-off
+                // (0.0019999999999998908).
+                crate::scene::limits::echo_significant(hi[k] - lo[k], 6)
             ),
         ));
     }
