@@ -439,6 +439,28 @@ where
         Ok(k as usize)
     }
 
+    /// The error of a critical step that fell to `estimate`, below what `limit`
+    /// sub-steps of the step carry, with the cause the driver sees: elements
+    /// narrower than at the start, or a nearly singular mass system.
+    fn critical_step_fell(&mut self, estimate: f64, limit: f64) -> StepError {
+        let cause = match self.narrower_elements_cause() {
+            Some(cause) => Some(cause),
+            None => {
+                let lumped = self.lumped_critical_time_step().ok();
+                self.singular_mass_cause_with(lumped.map(|l| (estimate, l)))
+            }
+        };
+        StepError::CriticalStepFell {
+            step: self.step + 1,
+            time: self.time,
+            critical: estimate,
+            start: self.dt_critical,
+            dt: self.dt_outer,
+            limit: limit as usize,
+            cause,
+        }
+    }
+
     /// The most sub-steps a step may take for the critical step:
     /// [`MAX_SUBSTEPS`], times the factor by which the narrowest element the
     /// particles are in is narrower than when the watch started (at most
@@ -604,24 +626,8 @@ where
         let whole = (dt / (watch.courant * estimate)).ceil();
         let limit = self.critical_substep_limit(&watch);
         if whole > limit {
-            let start = self.dt_critical;
             self.watch = Some(watch);
-            let cause = match self.narrower_elements_cause() {
-                Some(cause) => Some(cause),
-                None => {
-                    let lumped = self.lumped_critical_time_step().ok();
-                    self.singular_mass_cause_with(lumped.map(|l| (estimate, l)))
-                }
-            };
-            return Err(StepError::CriticalStepFell {
-                step: self.step + 1,
-                time: self.time,
-                critical: estimate,
-                start,
-                dt,
-                limit: limit as usize,
-                cause,
-            });
+            return Err(self.critical_step_fell(estimate, limit));
         }
         watch.substeps = watch.substeps.max(whole as usize);
         let courant = watch.courant;
@@ -662,24 +668,8 @@ where
         let k = substep_count(dt, estimate, watch.courant, watch.trigger, watch.substeps);
         let limit = self.critical_substep_limit(&watch);
         if k > limit {
-            let start = self.dt_critical;
             self.watch = Some(watch);
-            let cause = match self.narrower_elements_cause() {
-                Some(cause) => Some(cause),
-                None => {
-                    let lumped = self.lumped_critical_time_step().ok();
-                    self.singular_mass_cause_with(lumped.map(|l| (estimate, l)))
-                }
-            };
-            return Err(StepError::CriticalStepFell {
-                step: self.step + 1,
-                time: self.time,
-                critical: estimate,
-                start,
-                dt,
-                limit: limit as usize,
-                cause,
-            });
+            return Err(self.critical_step_fell(estimate, limit));
         }
         let k = k as usize;
         watch.substeps = k;

@@ -2213,13 +2213,8 @@ v0 = 0.01
     };
     let warnings = |text: &str| {
         let file = SceneFile::new("reference", text);
-        let out = cli()
-            .args(["run", file.arg(), "--diag-every", "0"])
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(0), "{out:?}");
-        String::from_utf8(out.stderr)
-            .unwrap()
+        let (_, stderr) = succeeds(&["run", file.arg(), "--diag-every", "0"]);
+        stderr
             .lines()
             .filter(|l| l.contains("`[reference]`"))
             .map(String::from)
@@ -2286,14 +2281,8 @@ t_end = 0.01
 "#,
     );
     let warned = |mass: &str| {
-        let out = cli()
-            .args(["run", file.arg(), "--diag-every", "0", "--mass", mass])
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(0), "{out:?}");
-        String::from_utf8(out.stderr)
-            .unwrap()
-            .contains("warning: contact between bodies with the `")
+        let (_, stderr) = succeeds(&["run", file.arg(), "--diag-every", "0", "--mass", mass]);
+        stderr.contains("warning: contact between bodies with the `")
     };
     assert!(warned("extended"));
     assert!(!warned("default"));
@@ -2335,13 +2324,8 @@ t_end = 0.4
     };
     let crossing = |text: &str| {
         let file = SceneFile::new("crossing", text);
-        let out = cli()
-            .args(["run", file.arg(), "--diag-every", "0"])
-            .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(0), "{out:?}");
-        String::from_utf8(out.stderr)
-            .unwrap()
+        let (_, stderr) = succeeds(&["run", file.arg(), "--diag-every", "0"]);
+        stderr
             .lines()
             .find(|l| l.contains("(grid crossing)"))
             .map(String::from)
