@@ -898,12 +898,7 @@ pub fn reference_poisson_warning(scene: &Scene) -> Option<String> {
         Some(Reference::VibratingBar { .. }) => (["bottom", "top"], Component::Y),
         _ => (["left", "right"], Component::X),
     };
-    let held = matches!(scene.mesh, crate::scene::MeshSpec::Blocks { .. })
-        && faces.iter().all(|face| {
-            scene.boundaries.iter().any(|b| {
-                b.tag == *face && b.fix.iter().any(|&c| c == across || c == Component::Normal)
-            })
-        });
+    let held = faces.iter().all(|face| scene.side_holds(face, across));
     (scene.dim == 2 && nu != 0.0).then(|| {
         let (how, factor) = if held {
             (

@@ -274,6 +274,7 @@ where
     /// [`Driver::critical_time_step`], whose vector it starts from).
     pub fn watch_critical_step(&mut self, courant: f64, trigger: f64) {
         let n = self.basis.num_functions();
+        let narrowest = self.narrowest_occupied_element();
         let mut watch = Watch {
             courant,
             trigger,
@@ -297,8 +298,8 @@ where
             since_check: 0,
             interval: WATCH_EVERY,
             counts: (self.last_report.active, self.last_report.treated()),
-            narrowest: self.narrowest_occupied_element(),
-            narrowest_start: self.narrowest_occupied_element(),
+            narrowest,
+            narrowest_start: narrowest,
             probed: vec![false; n],
             #[cfg(test)]
             audit: Vec::new(),
@@ -469,7 +470,7 @@ where
     /// 43 times longer than high: its critical step fell 65 to 100 times as it
     /// landed, at any `courant`, since the sub-steps are at `courant` times it).
     fn critical_substep_limit(&self, watch: &Watch<T>) -> f64 {
-        let narrower = match (watch.narrowest_start, self.narrowest_occupied_element()) {
+        let narrower = match (watch.narrowest_start, watch.narrowest) {
             (Some((_, start)), Some((_, now))) if now > 0.0 => (start / now).max(1.0),
             _ => 1.0,
         };
@@ -478,7 +479,7 @@ where
 
     /// The narrowest element (smallest [`element_widths`]) holding a particle, and
     /// its width (ties to the lower element: the same for any thread count).
-    pub(super) fn narrowest_occupied_element(&self) -> Option<(usize, f64)> {
+    fn narrowest_occupied_element(&self) -> Option<(usize, f64)> {
         let width = &self.element_width;
         self.particles
             .element
@@ -514,11 +515,13 @@ where
     /// A check of the watch ([`Driver::watch_critical_step`]) at the state just
     /// factorised, `counts` the functions active and treated in it: the estimate
     /// of the critical step, booked in `watch` (the interval to the next check,
-    /// the latest and the lowest estimate).
+    /// the latest and the lowest estimate, the narrowest occupied element
+    /// `narrowest`, [`Driver::narrowest_occupied_element`]).
     fn watch_estimate(
         &mut self,
         watch: &mut Watch<T>,
         counts: (usize, usize),
+        narrowest: Option<(usize, f64)>,
     ) -> Result<f64, StepError> {
         watch.since_check = 0;
         // Warm start: the last Ritz vector, with a share of the fixed non-smooth
@@ -533,7 +536,7 @@ where
         // A probe on the narrowest occupied element's functions: the stiffest
         // mode lives where the elements are narrowest, and a few Lanczos steps
         // find it only from a start that reaches it.
-        watch.narrowest = self.narrowest_occupied_element();
+        watch.narrowest = narrowest;
         if let Some((_, narrowest)) = watch.narrowest {
             let probed = &mut watch.probed;
             probed.iter_mut().for_each(|p| *p = false);
@@ -609,7 +612,7 @@ where
             self.watch = Some(watch);
             return Ok(None);
         }
-        let estimate = match self.watch_estimate(&mut watch, counts) {
+        let estimate = match self.watch_estimate(&mut watch, counts, narrowest) {
             Ok(e) => e,
             Err(e) => {
                 self.watch = Some(watch);
@@ -647,17 +650,18 @@ where
         // `WATCH_EVERY` steps have passed when the strategy's system changed (the
         // functions in it, or those it treats).
         let counts = (self.last_report.active, self.last_report.treated());
+        let narrowest = self.narrowest_occupied_element();
         watch.since_check += 1;
         let due = watch.substeps > 1
             || watch.since_check >= watch.interval
             || (counts != watch.counts && watch.since_check >= WATCH_CHANGED)
-            || narrower(self.narrowest_occupied_element(), watch.narrowest);
+            || narrower(narrowest, watch.narrowest);
         if !due {
             let k = watch.substeps;
             self.watch = Some(watch);
             return Ok(k);
         }
-        let estimate = match self.watch_estimate(&mut watch, counts) {
+        let estimate = match self.watch_estimate(&mut watch, counts, narrowest) {
             Ok(e) => e,
             Err(e) => {
                 self.watch = Some(watch);

@@ -487,8 +487,7 @@ where
     /// 43 times longer than high: the critical step fell 100 times as it landed).
     pub(super) fn narrower_elements_cause(&self) -> Option<String> {
         let watch = self.watch.as_ref()?;
-        let (start, (element, width)) =
-            (watch.narrowest_start?, self.narrowest_occupied_element()?);
+        let (start, (element, width)) = (watch.narrowest_start?, watch.narrowest?);
         if width >= super::critical::WATCH_NARROWER * start.1 {
             return None;
         }
@@ -629,19 +628,7 @@ where
         let aspect = corners
             .chunks(3)
             .filter(|t| t.len() == 3)
-            .map(|t| {
-                let (a, b, c) = (t[0], t[1], t[2]);
-                let (u, v) = (b - a, c - a);
-                let area2 = (u[0] * v[1] - u[1] * v[0]).abs();
-                let longest = [(b - a).norm(), (c - b).norm(), (a - c).norm()]
-                    .into_iter()
-                    .fold(0.0, f64::max);
-                if area2 > 0.0 {
-                    longest * longest / area2
-                } else {
-                    f64::INFINITY
-                }
-            })
+            .map(|t| triangle_aspect([t[0][0], t[0][1]], [t[1][0], t[1][1]], [t[2][0], t[2][1]]))
             .fold(0.0, f64::max);
         (aspect >= SLIVER_ASPECT).then_some(aspect)
     }
@@ -700,6 +687,20 @@ where
             source,
             hint,
         }
+    }
+}
+
+/// A triangle's longest edge over its height on that edge (`L² / 2A`; infinite
+/// for a degenerate one): 1.15 equilateral, 2 for a right isosceles triangle.
+pub(crate) fn triangle_aspect(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+    let area2 = (u[0] * v[1] - u[1] * v[0]).abs();
+    let length = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
+    let longest = length(a, b).max(length(b, c)).max(length(c, a));
+    if area2 > 0.0 {
+        longest * longest / area2
+    } else {
+        f64::INFINITY
     }
 }
 

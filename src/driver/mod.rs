@@ -35,6 +35,7 @@ pub use critical::{
     WATCH_ITERATIONS, WATCH_SEED_SHARE,
 };
 pub(crate) use failure::point;
+pub(crate) use failure::triangle_aspect;
 pub use failure::{BodySampling, SetupError, StepError, NEARLY_SINGULAR, SLIVER_ASPECT};
 
 pub use crate::diagnostics::{PhaseTimes, StepReport};

@@ -2,7 +2,9 @@
 //! velocity, lattice spacing, wave speed, gravity, time step and step count,
 //! mesh size and block counts.
 
-use super::{Body, BodyShape, EffectSpec, InitialVelocity, MaterialSpec, MeshSpec, Scene};
+use super::{
+    Body, BodyShape, Component, EffectSpec, InitialVelocity, MaterialSpec, MeshSpec, Scene,
+};
 
 impl Body {
     /// The bounding box `(min, max)` of the body's region (the second entries 0 in
@@ -184,5 +186,30 @@ impl Scene {
             MeshSpec::Interval { elements, .. } => Some([*elements, 1]),
             _ => None,
         }
+    }
+}
+
+impl Scene {
+    /// On a `blocks` or `interval` mesh, a wall on the side `tag` (`left`,
+    /// `right`, `bottom`, `top`) holds the velocity component `axis`: it fixes
+    /// `axis`, or the normal where the side's normal is along `axis`. `false` on
+    /// other meshes, whose sides' names say nothing of where they are.
+    pub fn side_holds(&self, tag: &str, axis: Component) -> bool {
+        if !matches!(
+            self.mesh,
+            MeshSpec::Blocks { .. } | MeshSpec::Interval { .. }
+        ) {
+            return false;
+        }
+        let normal = match tag {
+            "left" | "right" => Component::X,
+            _ => Component::Y,
+        };
+        self.boundaries.iter().any(|b| {
+            b.tag == tag
+                && b.fix
+                    .iter()
+                    .any(|&c| c == axis || (c == Component::Normal && normal == axis))
+        })
     }
 }

@@ -465,13 +465,8 @@ pub const SLIVER_TRIANGLE: f64 = 10.0;
 fn sliver_warning(mesh: &TriMesh) -> Option<String> {
     let v = mesh.vertices();
     let aspect = |t: &[usize; 3]| {
-        let (a, b, c) = (v[t[0]], v[t[1]], v[t[2]]);
-        let (u, w) = (b - a, c - a);
-        let area2 = (u.x * w.y - u.y * w.x).abs();
-        let longest = [(b - a).norm(), (c - b).norm(), (a - c).norm()]
-            .into_iter()
-            .fold(0.0, f64::max);
-        longest * longest / area2
+        let [a, b, c] = t.map(|i| [v[i].x, v[i].y]);
+        crate::driver::triangle_aspect(a, b, c)
     };
     let mut count = 0;
     let mut worst: Option<(f64, usize)> = None;

@@ -307,27 +307,9 @@ fn reference_warnings(scene: &Scene) -> Vec<String> {
         return Vec::new();
     }
     let one_d = scene.dim == 1;
-    // A side holds the axis when a wall there fixes it (or its normal: the
-    // sides of a block mesh are along the axes).
-    let holds = |tag: &str, axis: Component| {
-        let normal = match tag {
-            "left" | "right" => Component::X,
-            _ => Component::Y,
-        };
-        scene.boundaries.iter().any(|b| {
-            b.tag == tag
-                && b.fix
-                    .iter()
-                    .any(|&c| c == axis || (c == Component::Normal && normal == axis))
-        })
-    };
+    let holds = |tag: &str, axis: Component| scene.side_holds(tag, axis);
     let axis_name = |c: Component| if c == Component::X { "x" } else { "y" };
-    let kind = |e: &EffectSpec| {
-        serde_json::to_value(e)
-            .ok()
-            .and_then(|v| v.get("kind").and_then(|k| k.as_str()).map(String::from))
-            .unwrap_or_default()
-    };
+    let kind = |e: &EffectSpec| kind_of(e);
     let mut missing = Vec::new();
     let what = match reference {
         Reference::VibratingBar { .. } => {
@@ -376,14 +358,15 @@ fn reference_warnings(scene: &Scene) -> Vec<String> {
     }
     vec![format!(
         "the `[reference]` (`{}`) is {what}, but {}: its error measures another motion than this scene's; add what it assumes, or leave out [reference]",
-        kind_of_reference(reference),
+        kind_of(reference),
         missing.join(", ")
     )]
 }
 
-/// The `kind` of a `[reference]` as a scene writes it.
-fn kind_of_reference(reference: &crate::scene::Reference) -> String {
-    serde_json::to_value(reference)
+/// The `kind` of a table a scene tags with it (an `[[effect]]`, the
+/// `[reference]`), as the scene writes it.
+fn kind_of(table: &impl serde::Serialize) -> String {
+    serde_json::to_value(table)
         .ok()
         .and_then(|v| v.get("kind").and_then(|k| k.as_str()).map(String::from))
         .unwrap_or_default()
