@@ -56,7 +56,8 @@
 
 //!
 //! The module is split by concept: the schema (here), [`validate`](Scene::validate)
-//! (validate.rs), locating errors in the TOML text (locate.rs), the built-in scenes
+//! (validate.rs), locating errors in the TOML text (locate.rs), the form of each
+//! table, one or an array of tables (table_forms.rs), the built-in scenes
 //! (builtin.rs), the names of bases and split points in files (names.rs), values
 //! derived from a scene (derived.rs) and changes made by comparisons and studies
 //! (builders.rs).
@@ -74,6 +75,7 @@ mod derived;
 pub mod limits;
 mod locate;
 pub(crate) mod names;
+mod table_forms;
 mod validate;
 
 pub use annotate::annotate;
@@ -851,7 +853,22 @@ impl Scene {
     /// A file without `[material]` must give every body its own `material` (the
     /// error names the first body without one); the scene then takes the first
     /// body's material as [`Scene::material`], which no body uses.
+    ///
+    /// A table written as an array of tables, or the reverse (`[[material]]`,
+    /// `[body]`), is an error naming the field, at its header (before the file's
+    /// other errors but its syntax errors).
     pub fn from_toml(text: &str, file: &str) -> Result<Self, SceneFileError> {
+        if let Some(wrong) = table_forms::wrong_table_form(text) {
+            let (line, column) = locate::line_column(text, wrong.at);
+            return Err(SceneFileError {
+                file: file.to_string(),
+                line,
+                column,
+                field: Some(wrong.field),
+                kind: None,
+                message: wrong.message,
+            });
+        }
         let scene: Scene = match toml::from_str(text) {
             Ok(scene) => scene,
             // Missing fields are reported after every present field parsed, so the

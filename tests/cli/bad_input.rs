@@ -467,9 +467,6 @@ fn type_cases() -> Vec<Case> {
         case("negative-count", BAR)
             .edit("per_block = [4, 4]", "per_block = [4, @@-2]")
             .expect("body[0].per_block: invalid value: integer `-2`, expected a whole number in 1..=1000 along each axis"),
-        case("table-for-array-of-tables", BAR)
-            .edit("[[body]]", "@@[body]")
-            .expect("invalid type: map, expected a sequence"),
         case("float-for-block-count", BAR)
             .edit("[mesh]", "@@[mesh]")
             .edit("blocks = [4, 1]", "blocks = [4.5, 1]")
@@ -513,6 +510,75 @@ fn type_cases() -> Vec<Case> {
         case("huge-integer", BAR)
             .edit("blocks = [4, 1]", "blocks = [@@99999999999999999999, 1]")
             .expect("mesh.blocks: the integer `99999999999999999999` is out of range (integers in a scene file are 64-bit)"),
+    ]
+}
+
+/// A table written as an array of tables, or the reverse (by header or inline):
+/// the field, at its (first) header or its value, and how it is written.
+fn table_form_cases() -> Vec<Case> {
+    let bar_material =
+        "[material]\nmodel = \"linear-elastic\"\nyoung = 100.0\npoisson = 0.25\ndensity = 1.0\n\n";
+    let bar_body = "[[body]]\nmin = [0.0, 0.0]\nmax = [4.0, 1.0]\nper_block = [4, 4]\n\n";
+    vec![
+        case("array-of-tables-for-material", BAR)
+            .edit("[material]", "@@[[material]]")
+            .expect("material: a table, written `[material]`, not an array of tables `[[material]]`"),
+        // Two entries: the first header is pointed at.
+        case("two-materials", BAR)
+            .edit("[material]", "@@[[material]]")
+            .edit("[[body]]", "[[material]]\nyoung = 1.0\ndensity = 1.0\n\n[[body]]")
+            .expect("material: a table, written `[material]`, not an array of tables `[[material]]`"),
+        case("table-for-array-of-tables", BAR)
+            .edit("[[body]]", "@@[body]")
+            .expect("body: an array of tables, written `[[body]]` for each body, not `[body]`"),
+        case("array-of-tables-for-mesh", BAR)
+            .edit("[mesh]", "@@[[mesh]]")
+            .expect("mesh: a table, written `[mesh]`, not an array of tables `[[mesh]]`"),
+        case("array-of-tables-for-initial-velocity", BAR)
+            .edit("[initial_velocity]", "@@[[initial_velocity]]")
+            .expect("initial_velocity: a table, written `[initial_velocity]`, not an array of tables `[[initial_velocity]]`"),
+        case("array-of-tables-for-time", BAR)
+            .edit("[time]", "@@[[time]]")
+            .expect("time: a table, written `[time]`, not an array of tables `[[time]]`"),
+        case("array-of-tables-for-reference", BAR)
+            .edit("[reference]", "@@[[reference]]")
+            .expect("reference: a table, written `[reference]`, not an array of tables `[[reference]]`"),
+        case("array-of-tables-for-output", BAR)
+            .edit("[output]", "@@[[output]]")
+            .expect("output: a table, written `[output]`, not an array of tables `[[output]]`"),
+        case("array-of-tables-for-study", BAR)
+            .edit("[study]", "@@[[study]]")
+            .expect("study: a table, written `[study]`, not an array of tables `[[study]]`"),
+        case("table-for-boundaries", BAR_1D)
+            .edit("[[boundary]]", "@@[boundary]")
+            .expect("boundary: an array of tables, written `[[boundary]]` for each boundary, not `[boundary]`"),
+        case("table-for-effects", SQUARE)
+            .edit("[[effect]]", "@@[effect]")
+            .expect("effect: an array of tables, written `[[effect]]` for each effect, not `[effect]`"),
+        case("table-for-resolutions", BAR)
+            .edit("[[resolution]]", "@@[resolution]")
+            .expect("resolution: an array of tables, written `[[resolution]]` for each resolution, not `[resolution]`"),
+        case("table-for-mesh-holes", SQUARE)
+            .edit("edge_length = 0.25", "edge_length = 0.25\n\n@@[mesh.holes]\noutline = [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]\ntag = \"hole\"")
+            .expect("mesh.holes: an array of tables, written `[[mesh.holes]]` for each hole, not `[mesh.holes]`"),
+        case("array-of-tables-for-a-body-material", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\n\n@@[[body.material]]\nyoung = 100.0\ndensity = 1.0")
+            .expect("body[0].material: a table, written `[body.material]`, not an array of tables `[[body.material]]`"),
+        case("array-of-tables-for-a-second-body-initial-velocity", BAR)
+            .edit("[initial_velocity]", "[[body]]\nmin = [1.0, 0.0]\nmax = [2.0, 1.0]\ncount = [2, 2]\n\n@@[[body.initial_velocity]]\nkind = \"rest\"\n\n[initial_velocity]")
+            .expect("body[1].initial_velocity: a table, written `[body.initial_velocity]`, not an array of tables `[[body.initial_velocity]]`"),
+        // Inline forms: at the value.
+        case("inline-array-for-material", BAR)
+            .edit(bar_material, "")
+            .edit("mass = \"consistent\"", "mass = \"consistent\"\nmaterial = @@[{ young = 100.0, density = 1.0 }]")
+            .expect("material: a table, written `[material]` or `material = { … }`, not an array `material = [{ … }]`"),
+        case("inline-table-for-body", BAR)
+            .edit(bar_body, "")
+            .edit("mass = \"consistent\"", "mass = \"consistent\"\nbody = @@{ min = [0.0, 0.0], max = [4.0, 1.0], per_block = [4, 4] }")
+            .expect("body: an array of tables, written `body = [{ … }]` or `[[body]]` for each body, not one table `body = { … }`"),
+        case("inline-array-for-a-body-material", BAR)
+            .edit("per_block = [4, 4]", "per_block = [4, 4]\nmaterial = @@[{ young = 100.0, density = 1.0 }]")
+            .expect("body[0].material: a table, written `[body.material]` or `material = { … }`, not an array `material = [{ … }]`"),
     ]
 }
 
@@ -1300,6 +1366,7 @@ fn malformed_scenes_name_file_line_column_and_field() {
         syntax_cases(),
         unknown_field_cases(),
         type_cases(),
+        table_form_cases(),
         unknown_name_cases(),
         range_cases(),
         inconsistent_cases(),
