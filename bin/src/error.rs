@@ -10,7 +10,8 @@ Exit status (every command):
   2    bad input: usage, scene, mesh or option errors (nothing was run), or an
        output file that cannot be written
   130  interrupted (SIGINT/SIGTERM): `run` finishes the current step, writes its
-       files and summary (marked interrupted); a second signal exits at once
+       files and summary (marked interrupted); a second signal exits at once, as
+       does the first during the set-up (before the first step)
   141  `run`: standard output was closed by its reader (a broken pipe); the run
        stops quietly as on an interrupt";
 

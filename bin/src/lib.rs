@@ -103,7 +103,8 @@ enum Command {
     /// FILE.toml (`mpm-cli scene show NAME` prints one to start from). Energies
     /// are per unit thickness. Exit status 1 if the run fails numerically or is
     /// judged UNSTABLE; 130 if interrupted (SIGINT/SIGTERM: the current step is
-    /// finished and the files and summary are written; a second signal exits at once).
+    /// finished and the files and summary are written; a second signal exits at once,
+    /// as does the first during the set-up).
     /// With --format json or csv the rows are printed (and flushed) as they are
     /// computed; the table is aligned and printed at the end.
     #[command(after_help = error::EXIT_STATUS)]

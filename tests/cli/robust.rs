@@ -864,6 +864,46 @@ fn sigterm_stops_a_run_with_130_and_says_so() {
     assert!(stderr.contains("error: interrupted"), "{stderr}");
 }
 
+/// A signal during the set-up exits at once, saying that nothing was run: the
+/// set-up of a large mesh takes seconds to minutes (a user's 1000 × 1000 PS mesh
+/// for 36 particles), which a stop after it made the user wait out. This mesh's
+/// set-up takes several seconds; the signal comes after half a second.
+#[test]
+fn a_signal_during_the_set_up_exits_at_once() {
+    let scene = SceneFile::new(
+        "set-up-signal",
+        "name = \"big-mesh\"\ndim = 2\nbasis = \"ps\"\n[mesh]\nkind = \"blocks\"\nx = [0.0, 10.0]\ny = [0.0, 10.0]\nblocks = [200, 200]\n[material]\nyoung = 1e4\npoisson = 0.3\ndensity = 1.0\n[[body]]\nmin = [4.0, 4.0]\nmax = [4.5, 4.5]\nper_block = [3, 3]\n[time]\ncourant = 0.5\nt_end = 1.0\n",
+    );
+    let child = binary()
+        .args(["run", scene.arg(), "--threads", "1"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let signalled = std::time::Instant::now();
+    let killed = std::process::Command::new("kill")
+        .arg("-INT")
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let waited = signalled.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert_eq!(
+        stderr, "interrupted during the set-up: nothing was run\n",
+        "{stderr}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(waited < 2.0, "exited {waited} s after the signal");
+}
+
 /// `mpm_cli::check` (what the `cli_args` fuzz target drives) validates a command
 /// line as the command would, without running it.
 #[test]
