@@ -438,6 +438,51 @@ struct Tally {
     /// The largest `kinetic − kinetic_motion` of a step, with its time and
     /// `kinetic` then ([`unseen_velocity_warning`]).
     unseen: (f64, f64, f64),
+    /// The step that deactivated the largest share of the functions with
+    /// particles ([`deactivation_warning`]).
+    deactivation: Deactivation,
+}
+
+/// At the step of a run that deactivated the largest share of the functions with
+/// particles: the time, the functions deactivated and kept, and the largest `M_ii`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Deactivation {
+    pub time: f64,
+    pub deactivated: usize,
+    pub active: usize,
+    pub largest_mass: f64,
+}
+
+impl Deactivation {
+    fn share(&self) -> f64 {
+        self.deactivated as f64 / (self.deactivated + self.active).max(1) as f64
+    }
+}
+
+/// Share of the functions with particles that deactivation may remove at a step
+/// before a run warns ([`deactivation_warning`]): the seeds' columns lose at most
+/// 2 of 51 (`mpm-cli run column-large --mass deactivate`).
+pub const DEACTIVATED_SHARE: f64 = 0.25;
+
+/// The warning for a run whose deactivation (`spec`, an absolute threshold on
+/// `M_ii`) removed [`DEACTIVATED_SHARE`] or more of the functions with particles
+/// at some step. A user's block of density 1 falling freely (`deactivate:0.01`,
+/// the thesis's threshold, for its columns' masses) kept 12 of 39 functions and
+/// moved 2.7e-6 in 0.3 s instead of 0.44, judged stable: a body moves only
+/// through the functions kept.
+pub fn deactivation_warning(at: &Deactivation, spec: &str) -> Option<String> {
+    use crate::scene::limits::echo_significant;
+    (at.deactivated > 0 && at.share() >= DEACTIVATED_SHARE).then(|| {
+        format!(
+            "at t = {} deactivation (`{spec}`, an absolute threshold on the diagonal mass M_ii, the thesis's for its columns' masses) removed {} of the {} functions with particles ({:.0} %): the bodies move only through the functions kept (a body whose functions all fall below the threshold stays where it is: a user's block of density 1 falling freely moved 2.7e-6 in 0.3 s instead of 0.44), and the verdict does not see it; the largest M_ii then was {}: a threshold well below the masses (`deactivate:{}`) keeps the body's functions, but brings back the nearly empty ones it removes (the consistent mass's failure); for a body moving through a mostly empty mesh take the default mass strategy",
+            echo_significant(at.time, 5),
+            at.deactivated,
+            at.deactivated + at.active,
+            100.0 * at.share(),
+            echo_significant(at.largest_mass, 3),
+            echo_significant(at.largest_mass * 1e-3, 1),
+        )
+    })
 }
 
 /// Share of the energy scale above which the kinetic energy of the particle
@@ -958,18 +1003,25 @@ pub fn pl_edge_particles_warning(bodies: &[(usize, usize)]) -> Option<String> {
     let warned: Vec<usize> = (0..bodies.len()).filter(|&b| share(bodies[b])).collect();
     let first = *warned.first()?;
     let (on, n) = bodies[first];
+    let percent = 100.0 * on as f64 / n as f64;
     let who = match (bodies.len(), warned.len()) {
-        (1, _) => format!("{on} of the {n} particles"),
-        (_, 1) => format!("{on} of the {n} particles of body {}", first + 1),
+        (1, _) => format!("{on} of the {n} particles ({percent:.0} %)"),
+        (_, 1) => format!(
+            "{on} of the {n} particles of body {} ({percent:.0} %)",
+            first + 1
+        ),
+        (_, 2) => format!(
+            "{on} of the {n} particles of body {} ({percent:.0} %; one other body likewise)",
+            first + 1
+        ),
         (_, k) => format!(
-            "{on} of the {n} particles of body {} (and of {} other bodies)",
+            "{on} of the {n} particles of body {} ({percent:.0} %; {} other bodies likewise)",
             first + 1,
             k - 1
         ),
     };
     Some(format!(
-        "{who} ({:.0} %) lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4]; `jitter` moves the particles off the edges but measured no better), or the smooth basis `ps`",
-        100.0 * on as f64 / n as f64
+        "{who} lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4]; `jitter` moves the particles off the edges but measured no better), or the smooth basis `ps`"
     ))
 }
 
@@ -1275,6 +1327,7 @@ where
         .max_rotation_of_non_objective(&driver.particles.f, max_rotation);
     let mut interrupted = false;
     let mut unseen = (0.0f64, 0.0, 0.0);
+    let mut deactivation = Deactivation::default();
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
@@ -1335,6 +1388,15 @@ where
         }
         lumped = lumped.max(r.mass_report.lumped_rows);
         deactivated = deactivated.max(r.mass_report.deactivated);
+        let now = Deactivation {
+            time: r.time,
+            deactivated: r.mass_report.deactivated,
+            active: r.mass_report.active,
+            largest_mass: r.mass_report.largest_mass,
+        };
+        if now.share() > deactivation.share() {
+            deactivation = now;
+        }
         extended = extended.max(r.mass_report.extended);
         phases.evaluate += r.phases.evaluate;
         phases.assemble += r.phases.assemble;
@@ -1365,6 +1427,7 @@ where
         last_energy,
         max_strain,
         unseen,
+        deactivation,
     }
 }
 
@@ -1833,6 +1896,10 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     tally.unseen,
                     tally.verdict.scale(),
                     scene.contact_walls() || scene.boundaries.iter().any(|b| !b.fix.is_empty()),
+                ))
+                .chain(deactivation_warning(
+                    &tally.deactivation,
+                    &driver.mass_strategy().spec(),
                 ))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .chain(crate::arrangement::irregularity_warning(

@@ -55,6 +55,7 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
                 largest: crate::scene::limits::significant(largest, 3),
             });
         }
+        report.largest_mass = largest;
         self.solver.factorize(pattern, values)?;
         Ok(report)
     }

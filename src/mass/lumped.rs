@@ -1,4 +1,11 @@
 //! The lumped (row-sum) mass `M_ii^L = Σ_j M_ij = Σ_p m_p phi_i(x_p)`.
+//!
+//! A function whose lumped mass is round-off ([`ROUNDOFF_MASS`] of the largest or
+//! less) is treated as a function without mass, as it is in exact arithmetic: a
+//! particle exactly on an edge that bounds a function's support gives it a value
+//! of about 1e-16 instead of 0, and dividing by that mass put the critical step at
+//! 1e-10 (a user's PL disk whose lattice put a particle on a block diagonal:
+//! `docs/stability.md`, "Round-off masses").
 
 use super::{MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext};
 use crate::sparse::{Scalar, SymmetricPattern};
@@ -47,6 +54,7 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
         } else {
             pattern.row_sums(values, &mut self.diagonal);
         }
+        without_roundoff_masses(&mut self.diagonal);
         let active = self.diagonal.iter().filter(|&&m| m > T::zero()).count();
         Ok(MassReport {
             active,
@@ -68,6 +76,26 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
     /// `max M_ii / min M_ii` over active rows.
     fn condition_estimate(&mut self, _pattern: &SymmetricPattern) -> f64 {
         diagonal_condition(&self.diagonal)
+    }
+}
+
+/// Lumped masses at or below this share of the largest are round-off: the value
+/// of a function at a particle on the edge of its support, zero in exact
+/// arithmetic, is about 1e-16 in floating point. A share of 1e-12 is a particle
+/// within about 1e-11 of an element's size of the edge (the masses of the
+/// functions a body covers are 10–50 particle masses), where the function's
+/// critical step would be a millionth of the others'.
+pub const ROUNDOFF_MASS: f64 = 1e-12;
+
+/// Sets the lumped masses at or below [`ROUNDOFF_MASS`] of the largest to zero:
+/// functions without mass, which the solves leave at zero.
+pub(super) fn without_roundoff_masses<T: Scalar>(diagonal: &mut [T]) {
+    let largest = diagonal.iter().fold(T::zero(), |a, &m| a.max(m));
+    let floor = largest * T::of(ROUNDOFF_MASS);
+    for m in diagonal.iter_mut() {
+        if *m <= floor {
+            *m = T::zero();
+        }
     }
 }
 

@@ -362,6 +362,9 @@ pub struct MassReport {
     /// strategy measures it; the functions an extension expresses through their
     /// neighbours are not solved for and are left out.
     pub worst_coverage: Option<(usize, f64)>,
+    /// The largest diagonal mass `M_ii`, where the strategy compares masses
+    /// with a threshold of its own (deactivation); `0` otherwise.
+    pub largest_mass: f64,
 }
 
 impl MassReport {
