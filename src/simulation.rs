@@ -127,6 +127,9 @@ pub struct Summary {
     pub energy_initial: f64,
     /// Total energy at the end.
     pub energy_final: f64,
+    /// The energy scale the drift and growth are relative to
+    /// ([`crate::diagnostics::Verdict::scale`]).
+    pub energy_scale: f64,
     /// Largest `|E(t) − E(0)|` relative to the energy scale of the run (the largest
     /// kinetic plus strain energy, or the range swept by the potential energy or by
     /// the work of the effects: [`crate::diagnostics::Verdict`]).
@@ -1815,6 +1818,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             energy_drift,
             energy_growth,
             energy_growth_centred: tally.verdict.centred_growth(),
+            energy_scale: tally.verdict.scale(),
             stable,
             energy_growth_hint,
             failure: failure.as_ref().map(|e| {

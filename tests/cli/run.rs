@@ -64,6 +64,7 @@ fn json_lines_then_a_summary_with_the_documented_keys() {
         "max_lumped_rows",
         "energy_initial",
         "energy_final",
+        "energy_scale",
         "stable",
         "pieces",
         "stray",
