@@ -289,8 +289,9 @@ pub(crate) fn set_up<const D: usize, B: Basis<f64, D>>(
 /// about 1e5 times too soft. The first wall and the body that sinks most are named.
 /// What a `[reference]` assumes and the scene does not give, on a `blocks` or
 /// `interval` mesh (whose sides' names say where the walls are): the vibrating
-/// bar is free vibration of a bar held along x at both ends, the columns stand on
-/// their end held along gravity there, and the settling column (B5b) is undamped.
+/// bar is free vibration of a bar held along x at both ends, the columns are held
+/// along their axis at their lower end (standing on it or hanging from it), and
+/// the settling column (B5b) is undamped.
 /// Otherwise the error measures another motion (a bar whose right wall was left
 /// out scored `E_u` 2.8e-7, as good as the held bar's 1.4e-7, at the half period
 /// of the fixed–free bar it became; a column hung from its top scored
@@ -325,20 +326,14 @@ fn reference_warnings(scene: &Scene) -> Vec<String> {
         }
         Reference::ColumnSelfWeight {} | Reference::ColumnEquilibrium {} => {
             let axis = if one_d { Component::X } else { Component::Y };
-            let g = scene.effects.iter().find_map(|e| match e {
-                EffectSpec::Gravity { g } => g.get(if one_d { 0 } else { 1 }).copied(),
-                _ => None,
-            });
-            // The end gravity pulls the column onto.
-            let end = match (one_d, g.is_some_and(|g| g > 0.0)) {
-                (true, false) => "left",
-                (true, true) => "right",
-                (false, false) => "bottom",
-                (false, true) => "top",
-            };
+            // The end the references hold the column at, its lower end (`Y = 0`),
+            // for either sign of `g`: with `g` toward it the column stands on it,
+            // with `g` away from it the column hangs from it (a bar hanging from
+            // `x = 0` with `g = [10]` was told to hold its free end).
+            let end = if one_d { "left" } else { "bottom" };
             if !holds(end, axis) {
                 missing.push(format!(
-                    "no wall holds {} at `{end}`, the end gravity pulls it onto",
+                    "no wall holds {} at `{end}`, the lower end the reference holds it at",
                     axis_name(axis)
                 ));
             }
@@ -349,7 +344,7 @@ fn reference_warnings(scene: &Scene) -> Vec<String> {
                     }
                 }
             }
-            "a column standing on its end, held there along gravity"
+            "a column held along its axis at its lower end (standing on it, or hanging from it when gravity points away)"
         }
         Reference::AxisAligned { .. } => return Vec::new(),
     };
@@ -567,8 +562,15 @@ fn held_motion_warnings<const D: usize, B: Basis<f64, D>>(
             .fold(0.0, f64::max);
         first += n;
         if held >= HELD_MOMENTUM {
+            // Contact walls are 2D; in 1D a body meant to strike the wall starts
+            // an element away from it.
+            let free_body_fix = if D == 1 {
+                "a body that should strike the wall: start it at least an element away from it (it then rebounds from the fixed wall; contact walls are 2D)"
+            } else {
+                "a body that should strike or leave the wall: start it at least an element away from the walls (a body that reaches a fixed wall from there rebounds from it), or make the wall a contact wall (`[[effect]] kind = \"contact-wall\"` with its `tag`, in place of the `[[boundary]]`), which only pushes"
+            };
             warnings.push(format!(
-                "body[{b}]: {:.0} % of its initial momentum falls on functions the walls (`fix`: {}) hold, which they hold both ways: the particles near such a wall take its velocity, so a body started against it and moving away stays stuck to it, and one moving into it stops dead; start the body at least an element away from the walls (a body that reaches a fixed wall from there rebounds from it), or make the wall a contact wall (`[[effect]] kind = \"contact-wall\"` with its `tag`, in place of the `[[boundary]]`), which only pushes",
+                "body[{b}]: {:.0} % of its initial momentum falls on functions the walls (`fix`: {}) hold, which they hold both ways: the particles near such a wall take its velocity at the first step, so a body started against it and moving away stays stuck to it, and one moving into it stops dead; {free_body_fix}; a body meant to be held there (fixed to the wall) keeps only the motion the wall allows: to start from such a motion, give an initial velocity that vanishes at the wall (`kind = \"linear\"`)",
                 100.0 * held,
                 walls.join(", ")
             ));

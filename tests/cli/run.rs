@@ -2181,7 +2181,9 @@ t_end = {t_end}
 /// without a word (users' scenes): a vibrating bar without its right wall scored
 /// `E_u` as well as the held bar at the half period of the fixed–free bar it
 /// became, a column hung from its top scored 1.05 against a profile it matched to
-/// 4.5 %. The run now says what the reference assumes and the scene lacks.
+/// 4.5 %. The run now says what the reference assumes and the scene lacks; a bar
+/// hanging from its lower end, which the column references describe, is not
+/// warned about.
 #[test]
 fn a_reference_the_scene_does_not_meet_is_warned_about() {
     let bar = |walls: &str, effects: &str| {
@@ -2238,8 +2240,17 @@ v0 = 0.01
         );
     assert_eq!(
         warnings(&column),
-        ["warning: the `[reference]` (`column-self-weight`) is a column standing on its end, held there along gravity, but no wall holds x at `left`, the end gravity pulls it onto: its error measures another motion than this scene's; add what it assumes, or leave out [reference]"]
+        ["warning: the `[reference]` (`column-self-weight`) is a column held along its axis at its lower end (standing on it, or hanging from it when gravity points away), but no wall holds x at `left`, the lower end the reference holds it at: its error measures another motion than this scene's; add what it assumes, or leave out [reference]"]
     );
+    // A bar hanging from its left end (x = 0) with gravity along +x: what the
+    // column references describe (a teacher's bar was told to hold its free end).
+    let hanging = bar(left, "[[effect]]\nkind = \"gravity\"\ng = [10.0]\n")
+        .replace("[initial_velocity]\nkind = \"exact\"\n", "")
+        .replace(
+            "kind = \"vibrating-bar\"\nv0 = 0.01",
+            "kind = \"column-equilibrium\"",
+        );
+    assert_eq!(warnings(&hanging), Vec::<String>::new());
 }
 
 /// Contact between bodies on PS with a mass that lumps no rows (a user's two
@@ -2437,4 +2448,58 @@ t_end = 0.05
         "{warned}"
     );
     assert_eq!(warning("deactivate:3e-5"), None);
+}
+
+/// In 1D the warning about momentum the walls hold gives the fixes 1D has: a
+/// teacher's fixed–free bar started with a uniform velocity was told to make the
+/// wall a contact wall (a 2D effect, which 1D refuses) or to start the bar an
+/// element away from its fixed end. It now names a velocity that vanishes at the
+/// wall, which the bar then starts from without the warning.
+#[test]
+fn held_momentum_in_1d_names_fixes_that_1d_has() {
+    let bar = |velocity: &str| {
+        format!(
+            r#"name = "wave1d"
+dim = 1
+basis = "bspline"
+[mesh]
+kind = "interval"
+x = [0.0, 1.5]
+elements = 48
+[material]
+young = 100.0
+density = 1.0
+[[body]]
+min = [0.0]
+max = [1.0]
+per_block = [4]
+[initial_velocity]
+{velocity}
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[time]
+dt = 1e-3
+t_end = 0.01
+"#
+        )
+    };
+    let held = |velocity: &str| {
+        let file = SceneFile::new("held-1d", &bar(velocity));
+        let (_, stderr) = succeeds(&["run", file.arg(), "--diag-every", "0"]);
+        stderr
+            .lines()
+            .find(|l| l.contains("of its initial momentum falls on functions the walls"))
+            .map(str::to_string)
+    };
+    let warned = held("kind = \"uniform\"\nvalue = [0.01]").expect("warned");
+    assert!(
+        !warned.contains("contact wall (`[[effect]]") && warned.contains("contact walls are 2D"),
+        "{warned}"
+    );
+    assert!(warned.contains("`kind = \"linear\"`"), "{warned}");
+    assert_eq!(
+        held("kind = \"linear\"\nvalue = [0.0]\norigin = [0.0]\ngradient = [[0.01]]"),
+        None
+    );
 }
