@@ -464,20 +464,25 @@ impl Deactivation {
 
 /// Share of the functions with particles that deactivation may remove at a step
 /// before a run warns ([`deactivation_warning`]): the seeds' columns lose at most
-/// 2 of 51 (`mpm-cli run column-large --mass deactivate`).
-pub const DEACTIVATED_SHARE: f64 = 0.25;
+/// 2 of 51 (`mpm-cli run column-large --mass deactivate`), a user's disk held on a
+/// frictionless slope lost 18 % from the first step, a falling block that rebounded
+/// in mid-air 10 % or more from t = 0.08.
+pub const DEACTIVATED_SHARE: f64 = 0.1;
 
 /// The warning for a run whose deactivation (`spec`, an absolute threshold on
 /// `M_ii`) removed [`DEACTIVATED_SHARE`] or more of the functions with particles
-/// at some step. A user's block of density 1 falling freely (`deactivate:0.01`,
-/// the thesis's threshold, for its columns' masses) kept 12 of 39 functions and
-/// moved 2.7e-6 in 0.3 s instead of 0.44, judged stable: a body moves only
-/// through the functions kept.
+/// at some step. A deactivated function takes zero velocity, so at a moving body's
+/// edge it holds the body as a wall would. Users' runs judged stable
+/// (`deactivate:0.01`, the thesis's threshold, for its columns' masses): a block
+/// of density 1 falling freely kept 12 of 39 functions and moved 2.7e-6 in 0.3 s
+/// instead of 0.44; a block of density 100 fell until the functions below it were
+/// deactivated (14 of 108 at t = 0.1) and rebounded in mid-air; a PL disk on a
+/// frictionless slope, 18 % of its functions deactivated, stayed put.
 pub fn deactivation_warning(at: &Deactivation, spec: &str) -> Option<String> {
     use crate::scene::limits::echo_significant;
     (at.deactivated > 0 && at.share() >= DEACTIVATED_SHARE).then(|| {
         format!(
-            "at t = {} deactivation (`{spec}`, an absolute threshold on the diagonal mass M_ii, the thesis's for its columns' masses) removed {} of the {} functions with particles ({:.0} %): the bodies move only through the functions kept (a body whose functions all fall below the threshold stays where it is: a user's block of density 1 falling freely moved 2.7e-6 in 0.3 s instead of 0.44), and the verdict does not see it; the largest M_ii then was {}: a threshold well below the masses (`deactivate:{}`) keeps the body's functions, but brings back the nearly empty ones it removes (the consistent mass's failure); for a body moving through a mostly empty mesh take the default mass strategy",
+            "at t = {} deactivation (`{spec}`, an absolute threshold on the diagonal mass M_ii, the thesis's for its columns' masses) removed {} of the {} functions with particles ({:.0} %): a deactivated function takes zero velocity, so at a moving body's edge it holds the body as a wall would (users' bodies judged stable: a block falling freely rebounded in mid-air as the functions below it were deactivated, a disk on a frictionless slope with 18 % of its functions deactivated stayed put), and the verdict does not see it; the largest M_ii then was {}: a threshold well below the masses (`deactivate:{}`) keeps the body's functions, but brings back the nearly empty ones it removes (the consistent mass's failure); for a body moving through a mostly empty mesh take the default mass strategy",
             echo_significant(at.time, 5),
             at.deactivated,
             at.deactivated + at.active,

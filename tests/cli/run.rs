@@ -2448,6 +2448,31 @@ t_end = 0.05
         "{warned}"
     );
     assert_eq!(warning("deactivate:3e-5"), None);
+    // A heavier block (density 100) keeps its functions until it falls into
+    // elements whose functions it barely covers: deactivated, they take zero
+    // velocity and it rebounds from them in mid-air (14 of 108 at t = 0.1).
+    let heavy = SceneFile::new(
+        "deactivate-heavy",
+        &std::fs::read_to_string(&file.path)
+            .unwrap()
+            .replace("density = 1.0", "density = 100.0")
+            .replace("young = 1e4", "young = 1e5")
+            .replace("blocks = [8, 8]", "blocks = [16, 16]")
+            .replace("max = [2.5, 3.0]", "max = [2.5, 2.75]")
+            .replace("t_end = 0.05", "t_end = 0.12"),
+    );
+    let (_, stderr) = succeeds(&[
+        "run",
+        heavy.arg(),
+        "--mass",
+        "deactivate",
+        "--diag-every",
+        "0",
+    ]);
+    assert!(
+        stderr.contains("it holds the body as a wall would"),
+        "{stderr}"
+    );
 }
 
 /// In 1D the warning about momentum the walls hold gives the fixes 1D has: a
