@@ -271,6 +271,24 @@ pub fn run(scene: &Scene, on_step: &mut dyn FnMut(&StepReport)) -> Result<Summar
     observe(scene, &mut |r, _| on_step(r))
 }
 
+/// [`run`] that stops after the step during which `stop` became true (checked
+/// between steps); the summary then says `interrupted`.
+pub fn run_until(
+    scene: &Scene,
+    on_step: &mut dyn FnMut(&StepReport),
+    stop: &AtomicBool,
+) -> Result<Summary, RunError> {
+    let mut steps_only = |r: &StepReport, _: ParticlesRef<'_>| {
+        if r.step > 0 {
+            on_step(r)
+        }
+    };
+    match scene.dim {
+        2 => run_2d_observed(scene, &mut steps_only, Some(stop)).map(|o| o.summary),
+        _ => run_1d_observed(scene, &mut steps_only, Some(stop)).map(|o| o.summary),
+    }
+}
+
 /// Runs `scene` (1D or 2D), showing every step's report and particles to `observer`.
 pub fn observe(scene: &Scene, observer: &mut Observer) -> Result<Summary, RunError> {
     let mut steps_only = |r: &StepReport, p: ParticlesRef<'_>| {

@@ -15,7 +15,7 @@ use psmpm::mass::MassKind;
 use psmpm::scene::Scene;
 use psmpm::simulation::{self, RunError, Summary};
 use psmpm::threads::ThreadPool;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Arguments of `mpm-cli compare`.
@@ -110,13 +110,16 @@ fn listed_twice<T: PartialEq>(list: &[T]) -> Option<&T> {
 
 /// Runs `scenes`, up to `jobs` at the same time, their steps on `pool`; results in
 /// the order of `scenes`, a set-up error as `describe` tells it (naming the
-/// command-line flags that set its field: [`crate::run::run_error`]).
+/// command-line flags that set its field: [`crate::run::run_error`]). Once `stop`
+/// is set the runs stop after their step (their summaries say `interrupted`) and
+/// no other starts: `None` for those.
 pub fn run_all(
     scenes: &[Scene],
     jobs: usize,
     pool: &ThreadPool,
+    stop: &AtomicBool,
     describe: impl Fn(RunError) -> CliError,
-) -> Vec<Result<Summary, CliError>> {
+) -> Vec<Option<Result<Summary, CliError>>> {
     let next = AtomicUsize::new(0);
     let progress =
         crate::progress::Progress::new(scenes.iter().map(|s| s.steps() as u64).sum(), "steps");
@@ -125,9 +128,13 @@ pub fn run_all(
     std::thread::scope(|scope| {
         for _ in 0..jobs.clamp(1, scenes.len().max(1)) {
             scope.spawn(|| loop {
+                if stop.load(Ordering::SeqCst) {
+                    break;
+                }
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 let Some(scene) = scenes.get(k) else { break };
-                let r = pool.install(|| simulation::run(scene, &mut |_| progress.inc(1)));
+                let r =
+                    pool.install(|| simulation::run_until(scene, &mut |_| progress.inc(1), stop));
                 if let Ok(mut all) = results.lock() {
                     all[k] = Some(r);
                 }
@@ -139,10 +146,7 @@ pub fn run_all(
         .into_inner()
         .unwrap_or_default()
         .into_iter()
-        .map(|r| match r {
-            Some(r) => r.map_err(&describe),
-            None => Err(CliError::Input("a run did not finish".into())),
-        })
+        .map(|r| r.map(|r| r.map_err(&describe)))
         .collect()
 }
 
@@ -186,6 +190,7 @@ const CSV_COLUMNS: [&str; 10] = [
 fn verdict(s: &Summary) -> &'static str {
     match (s.stable, s.failure.is_some()) {
         (_, true) => "stopped",
+        _ if s.interrupted => "interrupted",
         (true, false) if s.came_apart() => "yes, in pieces",
         (true, false) => "yes",
         (false, false) => "NO",
@@ -211,12 +216,31 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
     let pool = crate::run::thread_pool(args.threads)?;
-    let results = run_all(&scenes, jobs, &pool, |e| {
+    // A first signal stops the runs after their step and prints the table of
+    // what ran (a student's interrupted comparison printed nothing); a second
+    // exits at once.
+    let (stop, setting_up) = crate::run::stop_on_signals()?;
+    setting_up.store(false, Ordering::SeqCst);
+    let results = run_all(&scenes, jobs, &pool, &stop, |e| {
         crate::run::run_error(&args.scene, &args.overrides, e)
     });
+    let interrupted = stop.load(Ordering::SeqCst);
     let mut summaries = Vec::new();
-    for r in results {
+    for r in results.into_iter().flatten() {
         summaries.push(r?);
+    }
+    if interrupted {
+        if !summaries.is_empty() {
+            print_summaries(&summaries, args.format, args.jobs != Some(1));
+        }
+        let whole = summaries.iter().filter(|s| !s.interrupted).count();
+        eprintln!(
+            "interrupted: {whole} of the {} variants ran to their end, {} stopped early (`interrupted` in the table), {} not started",
+            scenes.len(),
+            summaries.len() - whole,
+            scenes.len() - summaries.len()
+        );
+        return Err(CliError::Interrupted);
     }
     // What `run` warns about, per variant (on standard error, before the table).
     for s in &summaries {

@@ -11,7 +11,8 @@ Exit status (every command):
        output file that cannot be written
   130  interrupted (SIGINT/SIGTERM): `run` finishes the current step, writes its
        files and summary (marked interrupted); a second signal exits at once, as
-       does the first during the set-up (before the first step)
+       does the first during the set-up (before the first step); `compare` stops
+       its runs after their step and prints the table of what ran
   141  `run`: standard output was closed by its reader (a broken pipe); the run
        stops quietly as on an interrupt";
 

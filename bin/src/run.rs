@@ -548,7 +548,7 @@ impl Stdout<'_> {
 /// first signal exits at once too, saying so: nothing has run, and the set-up of a
 /// large mesh takes minutes (a user's 1000 × 1000 PS mesh for 36 particles) that a
 /// stop after it would make the user wait out.
-fn stop_on_signals() -> Result<(Arc<AtomicBool>, Arc<AtomicBool>), CliError> {
+pub(crate) fn stop_on_signals() -> Result<(Arc<AtomicBool>, Arc<AtomicBool>), CliError> {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let stop = Arc::new(AtomicBool::new(false));
     let setting_up = Arc::new(AtomicBool::new(true));

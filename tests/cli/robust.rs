@@ -904,6 +904,65 @@ fn a_signal_during_the_set_up_exits_at_once() {
     assert!(waited < 2.0, "exited {waited} s after the signal");
 }
 
+/// An interrupted `compare` prints the table of what ran (a student's printed
+/// nothing): the variant running stops after its step and is marked
+/// `interrupted`, those not started are left out and counted, and the exit
+/// status is 130.
+#[test]
+fn an_interrupted_comparison_prints_what_ran() {
+    let child = binary()
+        .args([
+            "compare",
+            "vibrating-bar",
+            "--basis",
+            "ps,pl",
+            "--t-end",
+            "500",
+            "--jobs",
+            "1",
+            "--threads",
+            "1",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = std::process::Command::new("kill")
+        .arg("-INT")
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    // The PS variant's row (and its tracked displacement), none for PL.
+    let rows = |basis: &str| {
+        stdout
+            .lines()
+            .filter(|l| l.trim_start().starts_with(basis))
+            .collect::<Vec<_>>()
+    };
+    assert!(
+        rows("ps ")
+            .first()
+            .is_some_and(|row| row.contains("interrupted"))
+            && rows("pl ").is_empty(),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains(
+            "interrupted: 0 of the 2 variants ran to their end, 1 stopped early (`interrupted` in the table), 1 not started"
+        ),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
 /// `mpm_cli::check` (what the `cli_args` fuzz target drives) validates a command
 /// line as the command would, without running it.
 #[test]
