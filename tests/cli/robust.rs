@@ -780,6 +780,16 @@ fn a_reader_that_closes_early_ends_the_run_quietly() {
     assert!(!stderr.contains("error:"), "{stderr}");
 }
 
+/// Sends `signal` (`INT`, `TERM`) to the process `pid`.
+fn send(signal: &str, pid: u32) {
+    let sent = std::process::Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(pid.to_string())
+        .status()
+        .unwrap();
+    assert!(sent.success());
+}
+
 /// Starts a long run, waits for its first rows, sends `signal` and returns the exit
 /// status and stderr.
 fn interrupt(signal: &str, extra: &[&str]) -> (Option<i32>, String) {
@@ -802,12 +812,7 @@ fn interrupt(signal: &str, extra: &[&str]) -> (Option<i32>, String) {
     let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
     lines.next().unwrap().unwrap();
     lines.next().unwrap().unwrap();
-    let killed = std::process::Command::new("kill")
-        .arg(format!("-{signal}"))
-        .arg(child.id().to_string())
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    send(signal, child.id());
     // Read on until the run ends.
     for line in lines {
         line.unwrap();
@@ -882,12 +887,7 @@ fn a_signal_during_the_set_up_exits_at_once() {
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(500));
     let signalled = std::time::Instant::now();
-    let killed = std::process::Command::new("kill")
-        .arg("-INT")
-        .arg(child.id().to_string())
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    send("INT", child.id());
     let out = child.wait_with_output().unwrap();
     let waited = signalled.elapsed().as_secs_f64();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -928,12 +928,7 @@ fn an_interrupted_comparison_prints_what_ran() {
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(1500));
-    let killed = std::process::Command::new("kill")
-        .arg("-INT")
-        .arg(child.id().to_string())
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    send("INT", child.id());
     let out = child.wait_with_output().unwrap();
     let (stdout, stderr) = (
         String::from_utf8_lossy(&out.stdout),
