@@ -178,6 +178,15 @@ pub fn prepare_out(
     overwrite: bool,
     owned: impl Fn(&str) -> bool,
 ) -> Result<bool, CliError> {
+    // A name with a control character (a TAB typed into a shell) makes a
+    // directory that listings show garbled: refused, as in a scene's `name`.
+    if let Some(c) = dir.to_string_lossy().chars().find(|c| c.is_control()) {
+        return Err(CliError::Input(format!(
+            "--out: the path {:?} contains the control character {c:?} (U+{:04X}); use printable text",
+            dir.to_string_lossy(),
+            c as u32
+        )));
+    }
     let created = !dir.exists();
     prepare_dir(dir, overwrite, owned).map_err(|e| {
         let hint = match e {

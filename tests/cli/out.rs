@@ -507,6 +507,22 @@ fn an_unwritable_directory_is_an_input_error_naming_it() {
     assert!(stderr.contains(key(&target)), "{stderr}");
     // --out-every needs --out.
     input_error(&["run", "vibrating-bar-1d", "--out-every", "5"]);
+    // A control character in the name (a student's TAB) is refused, as in a
+    // scene's `name`, and nothing is created.
+    let tabbed = dir.join("a\tb");
+    let stderr = input_error(&[
+        "run",
+        "vibrating-bar-1d",
+        "--t-end",
+        "0.01",
+        "--out",
+        key(&tabbed),
+    ]);
+    assert!(
+        stderr.contains("contains the control character '\\t' (U+0009)"),
+        "{stderr}"
+    );
+    assert!(!tabbed.exists());
 }
 
 #[test]
