@@ -468,9 +468,13 @@ struct Tally {
 /// particles: the time, the functions deactivated and kept, and the largest `M_ii`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Deactivation {
+    /// The time of the step.
     pub time: f64,
+    /// Functions with particles the strategy deactivated.
     pub deactivated: usize,
+    /// Functions with particles it kept.
     pub active: usize,
+    /// The largest diagonal mass `M_ii` of the step.
     pub largest_mass: f64,
 }
 

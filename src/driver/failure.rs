@@ -95,27 +95,27 @@ where
         }
         let (critical, lumped) = critical?;
         let ratio = lumped / critical;
-        let spec = self.mass.spec();
-        // The default extends the nearly empty functions: what is left to it is
-        // the sampling. The strategies that solve for them (consistent, partial,
-        // deactivate, FMPM, ...) fail on a body's edge however many particles each
-        // element holds (a user's thrown block with `partial` stopped at the same
-        // time with 3.8 and 13.8 per element).
-        let per_element = self.particles_per_occupied_element();
-        let fix = if spec.starts_with("extended-hybrid") {
-            format!(
-                "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
-            )
-        } else if per_element < FEW_PER_ELEMENT {
-            format!(
-                "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them"
-            )
-        } else {
-            format!(
-                "the mass strategy `{spec}` solves for the nearly empty functions at the bodies' edges, which more particles per element do not fill ({per_element:.1} per occupied element here); take the default mass strategy (`mass = \"default\"`), which extends them, or `lumped`"
-            )
-        };
         (ratio >= NEARLY_SINGULAR).then(|| {
+            let spec = self.mass.spec();
+            // The default extends the nearly empty functions: what is left to it is
+            // the sampling. The strategies that solve for them (consistent, partial,
+            // deactivate, FMPM, ...) fail on a body's edge however many particles each
+            // element holds (a user's thrown block with `partial` stopped at the same
+            // time with 3.8 and 13.8 per element).
+            let per_element = self.particles_per_occupied_element();
+            let fix = if spec.starts_with("extended-hybrid") {
+                format!(
+                    "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
+                )
+            } else if per_element < FEW_PER_ELEMENT {
+                format!(
+                    "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them"
+                )
+            } else {
+                format!(
+                    "the mass strategy `{spec}` solves for the nearly empty functions at the bodies' edges, which more particles per element do not fill ({per_element:.1} per occupied element here); take the default mass strategy (`mass = \"default\"`), which extends them, or `lumped`"
+                )
+            };
             format!(
                 "its critical step is {ratio:.1e} times below the lumped mass's ({lumped:.3e}; an invertible mass stays within a few times of it): {fix}"
             )
