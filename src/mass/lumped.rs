@@ -54,8 +54,7 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
         } else {
             pattern.row_sums(values, &mut self.diagonal);
         }
-        without_roundoff_masses(&mut self.diagonal);
-        let active = self.diagonal.iter().filter(|&&m| m > T::zero()).count();
+        let active = without_roundoff_masses(&mut self.diagonal);
         Ok(MassReport {
             active,
             lumped_rows: active,
@@ -88,15 +87,20 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
 pub const ROUNDOFF_MASS: f64 = 1e-12;
 
 /// Sets the lumped masses at or below [`ROUNDOFF_MASS`] of the largest to zero:
-/// functions without mass, which the solves leave at zero.
-pub(super) fn without_roundoff_masses<T: Scalar>(diagonal: &mut [T]) {
+/// functions without mass, which the solves leave at zero. Returns the number of
+/// functions with mass left.
+pub(super) fn without_roundoff_masses<T: Scalar>(diagonal: &mut [T]) -> usize {
     let largest = diagonal.iter().fold(T::zero(), |a, &m| a.max(m));
     let floor = largest * T::of(ROUNDOFF_MASS);
+    let mut with_mass = 0;
     for m in diagonal.iter_mut() {
         if *m <= floor {
             *m = T::zero();
+        } else {
+            with_mass += 1;
         }
     }
+    with_mass
 }
 
 /// `max / min` of the positive entries (1 without any).
@@ -112,5 +116,21 @@ pub(super) fn diagonal_condition<T: Scalar>(diagonal: &[T]) -> f64 {
         hi / lo
     } else {
         1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Masses at round-off of the largest are zero; the others are kept, and
+    /// counted.
+    #[test]
+    fn roundoff_masses_are_no_mass() {
+        let mut diagonal = vec![1.0, 1e-16, 0.5, 0.0, 2e-12, 1e-11];
+        assert_eq!(without_roundoff_masses(&mut diagonal), 3);
+        assert_eq!(diagonal, vec![1.0, 0.0, 0.5, 0.0, 0.0, 1e-11]);
+        let mut empty = vec![0.0f64; 3];
+        assert_eq!(without_roundoff_masses(&mut empty), 0);
     }
 }
