@@ -127,7 +127,7 @@ mod tests {
     /// counted.
     #[test]
     fn roundoff_masses_are_no_mass() {
-        let mut diagonal = vec![1.0, 1e-16, 0.5, 0.0, 2e-12, 1e-11];
+        let mut diagonal = vec![1.0, 1e-16, 0.5, 0.0, 5e-13, 1e-11];
         assert_eq!(without_roundoff_masses(&mut diagonal), 3);
         assert_eq!(diagonal, vec![1.0, 0.0, 0.5, 0.0, 0.0, 1e-11]);
         let mut empty = vec![0.0f64; 3];
