@@ -2528,3 +2528,72 @@ t_end = 0.01
         None
     );
 }
+
+/// A critical step far below the lumped mass's on a strategy that solves for the
+/// nearly empty functions at a body's edge names them and the default, not the
+/// particles per element, once those are not few: a user's block thrown at a
+/// post with `partial` stopped at the same time with 3.8 and 13.8 particles per
+/// element and was told both times to add particles. The default completes.
+#[test]
+fn a_tiny_critical_step_of_partial_lumping_names_the_default() {
+    let scene = |spacing: &str| {
+        SceneFile::new(
+            &format!("throw-partial-{spacing}"),
+            &format!(
+                r#"name = "throw-at-post"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "polygon"
+outline = [[0.0, 0.0], [4.0, 0.0], [4.0, 2.0], [0.0, 2.0]]
+tags = ["bottom", "right", "top", "left"]
+edge_length = 0.1
+[[mesh.holes]]
+outline = [[2.5, 0.75], [3.0, 0.75], [3.0, 1.25], [2.5, 1.25]]
+tag = "post"
+[material]
+young = 2e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.0, 0.8]
+max = [1.4, 1.2]
+spacing = [{spacing}, {spacing}]
+[initial_velocity]
+kind = "uniform"
+value = [4.0, 0.0]
+[[effect]]
+kind = "contact-wall"
+tag = "post"
+[time]
+courant = 0.25
+t_end = 0.5
+"#
+            ),
+        )
+    };
+    let stopped = |file: &SceneFile, mass: &str| {
+        let out = cli()
+            .args(["run", file.arg(), "--mass", mass, "--diag-every", "0"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        (out.status.code(), stderr)
+    };
+    let (coarse, fine) = (scene("0.025"), scene("0.0125"));
+    let (code, stderr) = stopped(&coarse, "partial");
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("3.8 particles per occupied element are too few")
+            && stderr.contains("the default mass strategy (`mass = \"default\"`) extends them"),
+        "{stderr}"
+    );
+    let (code, stderr) = stopped(&fine, "partial");
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("the mass strategy `partial` solves for the nearly empty functions at the bodies' edges, which more particles per element do not fill (13.8 per occupied element here)"),
+        "{stderr}"
+    );
+    let (code, stderr) = stopped(&fine, "default");
+    assert_eq!(code, Some(0), "{stderr}");
+}
