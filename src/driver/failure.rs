@@ -103,13 +103,14 @@ where
             // element holds (a user's thrown block with `partial` stopped at the same
             // time with 3.8 and 13.8 per element).
             let per_element = self.particles_per_occupied_element();
+            let few = format!(
+                "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
+            );
             let fix = if spec.starts_with("extended-hybrid") {
-                format!(
-                    "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
-                )
+                few
             } else if per_element < FEW_PER_ELEMENT {
                 format!(
-                    "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them"
+                    "{few}; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them"
                 )
             } else {
                 format!(
