@@ -209,6 +209,9 @@ impl<T: Real, const D: usize, B: Basis<T, D>> Basis<T, D> for PerBody<B> {
     fn degree(&self) -> usize {
         self.base.degree()
     }
+    fn dual_value(&self, function: usize, p: &psmpm_basis::Quadratic<D>) -> Option<f64> {
+        self.base.dual_value(function % self.functions, p)
+    }
 }
 
 /// Frictionless contact between the bodies of a [`PerBody`] basis (module doc).

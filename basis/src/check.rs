@@ -20,6 +20,7 @@
 //! Sample points are deterministic: fixed barycentric points in every polynomial
 //! piece ([`Basis::polynomial_pieces`]), at its corners, edge midpoints and inside.
 
+pub use crate::basis::Quadratic;
 use crate::basis::{Basis, BasisEval, Constraint, Point};
 use crate::rng::SplitMix64;
 use crate::scalar::Real;
@@ -252,38 +253,6 @@ pub fn linear_precision<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(basis:
     (worst, worst_grad)
 }
 
-/// A quadratic polynomial about a centre `m`: `q(x) = c + g · (x − m) + (x − m)ᵀ A (x − m)`
-/// (`A` symmetric; the centre keeps round-off relative to the mesh, not to `|x|`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quadratic<const D: usize> {
-    /// The centre `m`.
-    pub centre: SVector<f64, D>,
-    /// Value at the centre.
-    pub c: f64,
-    /// Gradient at the centre.
-    pub g: SVector<f64, D>,
-    /// Half the Hessian (symmetric).
-    pub a: SMatrix<f64, D, D>,
-}
-
-impl<const D: usize> Quadratic<D> {
-    /// `q(x)`.
-    pub fn value(&self, x: &SVector<f64, D>) -> f64 {
-        let d = x - self.centre;
-        self.c + self.g.dot(&d) + d.dot(&(self.a * d))
-    }
-    /// `∇q(x) = g + 2 A (x − m)`.
-    pub fn gradient(&self, x: &SVector<f64, D>) -> SVector<f64, D> {
-        self.g + self.a * (x - self.centre) * 2.0
-    }
-    /// The polar form (blossom) `c + g · ((u + v)/2 − m) + (u − m)ᵀ A (v − m)`:
-    /// symmetric, affine in each argument, `polar(x, x) = q(x)`.
-    pub fn polar(&self, u: &SVector<f64, D>, v: &SVector<f64, D>) -> f64 {
-        let (du, dv) = (u - self.centre, v - self.centre);
-        self.c + self.g.dot(&(du + dv)) * 0.5 + du.dot(&(self.a * dv))
-    }
-}
-
 /// The extent of the mesh: centre and half the diagonal of the bounding box of all
 /// pieces.
 fn extent<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(basis: &B) -> (Point<f64, D>, f64) {
@@ -298,13 +267,14 @@ fn extent<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(basis: &B) -> (Point
 
 /// Quadratic precision: for every product `q = (x_i − m_i)(x_j − m_j) / s²` (`m` the
 /// centre of the mesh's bounding box, `s` half its diagonal, so `|q| ≤ 1`), the field
-/// `Σ_k coefficient(k, q) phi_k` against `q`: `max |Σ c φ − q|` and
-/// `s · max |Σ c ∇φ − ∇q|` over the sample points. `coefficient` gives the
-/// coefficients reproducing a quadratic (they depend on the basis: Hermite data at
-/// the vertices for PS, the polar form at the knots for B-splines).
+/// `Σ_k λ_k(q) phi_k` with the basis's dual values ([`Basis::dual_value`]: Hermite
+/// data at the vertices for PS, the polar form at the knots for B-splines) against
+/// `q`: `max |Σ c φ − q|` and `s · max |Σ c ∇φ − ∇q|` over the sample points.
+///
+/// # Panics
+/// If the basis gives no dual value for a function.
 pub fn quadratic_precision<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(
     basis: &B,
-    coefficient: impl Fn(usize, &Quadratic<D>) -> f64,
 ) -> (f64, f64) {
     let (m, s) = extent(basis);
     let mut eval = BasisEval::for_basis(basis);
@@ -321,7 +291,7 @@ pub fn quadratic_precision<T: Real, const D: usize, B: Basis<T, D> + ?Sized>(
                 a,
             };
             let c: Vec<f64> = (0..basis.num_functions())
-                .map(|k| coefficient(k, &q))
+                .map(|k| basis.dual_value(k, &q).expect("a basis with dual values"))
                 .collect();
             for_each_sample(basis, true, |e, x, _| {
                 basis.eval(e, &to_t(&x), &mut eval);

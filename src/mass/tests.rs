@@ -28,6 +28,11 @@ fn filled_to(height: f64) -> Column {
         SplitPoint::Incentre,
     )
     .unwrap();
+    filled(ps, (1.0, height), (400.0 * height / 1.2) as usize)
+}
+
+/// `count` random particles in `[0, extent.0] × [0, extent.1]` on `ps`.
+fn filled(ps: PowellSabin<f64>, extent: (f64, f64), count: usize) -> Column {
     let pattern = SymmetricPattern::new(&ps);
     let mut values = vec![0.0; pattern.nnz()];
     let mut particle_volume = vec![0.0; ps.num_functions()];
@@ -35,8 +40,8 @@ fn filled_to(height: f64) -> Column {
     let mut eval = BasisEval::for_basis(&ps);
     let mut rng = SplitMix64(3);
     let mut occupied = vec![false; ps.num_elements()];
-    for _ in 0..(400.0 * height / 1.2) as usize {
-        let x = Vector2::new(rng.next_f64(), height * rng.next_f64());
+    for _ in 0..count {
+        let x = Vector2::new(extent.0 * rng.next_f64(), extent.1 * rng.next_f64());
         let e = ps.locate(&x, None).unwrap();
         occupied[e] = true;
         ps.eval(e, &x, &mut eval);
@@ -94,6 +99,11 @@ fn context(c: &Column) -> StepContext<'_> {
 /// Solving `M' y = M 1` returns `y = 1` on the active functions: the strategy keeps
 /// the row sums of `M` (mass and momentum are conserved).
 fn assert_keeps_row_sums(c: &Column, m: &mut Box<dyn MassStrategy<f64>>, label: &str) {
+    keeps_row_sums_to(c, m, label, 1e-9);
+}
+
+/// [`assert_keeps_row_sums`] to `tolerance`.
+fn keeps_row_sums_to(c: &Column, m: &mut Box<dyn MassStrategy<f64>>, label: &str, tolerance: f64) {
     let n = c.ps.num_functions();
     let mut rhs = vec![0.0; n];
     c.pattern.row_sums(&c.values, &mut rhs);
@@ -102,7 +112,7 @@ fn assert_keeps_row_sums(c: &Column, m: &mut Box<dyn MassStrategy<f64>>, label: 
     for i in 0..n {
         let expected = if active[i] { 1.0 } else { 0.0 };
         assert!(
-            (rhs[i] - expected).abs() < 1e-9,
+            (rhs[i] - expected).abs() < tolerance,
             "{label}: y[{i}] = {}",
             rhs[i]
         );
@@ -152,6 +162,36 @@ fn extension_keeps_row_sums_where_consistent_fails() {
     assert_keeps_row_sums(&c, &mut m, "extended");
     let condition = m.condition_estimate(&c.pattern);
     assert!((1.0..1e4).contains(&condition), "condition {condition}");
+}
+
+/// The extension keeps the row sums on every fill of the column, at thresholds that
+/// extend few functions and many: each row's weights reproduce the constants (a
+/// ring that cannot reproduce the polynomials is refused by its residual, whatever
+/// round-off leaves of its pivots).
+#[test]
+fn extension_keeps_row_sums_on_every_fill() {
+    let domain = psmpm_basis::mesh::generators::PolygonDomain::rectangle(0.0, 4.0, 0.0, 3.0);
+    let mesh = psmpm_basis::mesh::generators::polygon_mesh(&domain, 0.2).unwrap();
+    for tenths in 2..20 {
+        let blob = (0.2 * tenths as f64, 0.1 * tenths as f64);
+        let ps = PowellSabin::<f64>::new(mesh.clone(), SplitPoint::Incentre).unwrap();
+        let columns = [
+            filled_to(0.1 * tenths as f64),
+            filled(ps, blob, (blob.0 * blob.1 * 400.0) as usize),
+        ];
+        for (c, coverage) in columns
+            .iter()
+            .flat_map(|c| [0.25, 0.5, 0.9].map(|w| (c, w)))
+        {
+            let mut m = prepared(c, MassKind::Extended { coverage });
+            if m.factorize(&c.pattern, &c.values, context(c)).is_ok() {
+                // The solve's own round-off on the blob's larger systems reaches
+                // 2e-9; a row missing the constants missed them by 0.1.
+                let label = format!("fill {tenths}/10, {coverage}");
+                keeps_row_sums_to(c, &mut m, &label, 1e-7);
+            }
+        }
+    }
 }
 
 /// The hybrid (extension below the first coverage, lumped rows below the second)

@@ -14,7 +14,7 @@
 //! mesh's geometry instead, so that the scene stays symmetric where its particles
 //! lie on grid diagonals.
 
-use super::{Basis, BasisError, BasisEval, Constraint, Point};
+use super::{Basis, BasisError, BasisEval, Constraint, Point, Quadratic};
 use crate::mesh::{MirrorAxis, TriMesh, Vec2};
 use crate::scalar::Real;
 use nalgebra::Vector2;
@@ -161,6 +161,10 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
     }
     fn degree(&self) -> usize {
         1
+    }
+    /// `λ_i(p) = p(V_i)`, the nodal value (a linear `p`).
+    fn dual_value(&self, function: usize, p: &Quadratic<2>) -> Option<f64> {
+        Some(p.value(&self.mesh.vertices()[function]))
     }
 }
 

@@ -1,6 +1,6 @@
 //! Piecewise-linear Lagrange basis in 1D (PL 1D): one hat function per node.
 
-use super::{Basis, BasisError, BasisEval, Constraint, Point};
+use super::{Basis, BasisError, BasisEval, Constraint, Point, Quadratic};
 use crate::mesh::Mesh1d;
 use crate::scalar::Real;
 use nalgebra::Vector1;
@@ -95,6 +95,10 @@ impl<T: Real> Basis<T, 1> for Linear1d<T> {
     }
     fn degree(&self) -> usize {
         1
+    }
+    /// `λ_i(p) = p(x_i)`, the nodal value (a linear `p`).
+    fn dual_value(&self, function: usize, p: &Quadratic<1>) -> Option<f64> {
+        Some(p.value(&Vector1::new(self.mesh.nodes()[function])))
     }
 }
 

@@ -100,6 +100,40 @@ impl<T: Real, const D: usize> Constraint<T, D> {
     }
 }
 
+/// A polynomial of degree at most two about a centre `m`:
+/// `q(x) = c + g · (x − m) + (x − m)ᵀ A (x − m)` (`A` symmetric; the centre keeps
+/// round-off relative to the mesh, not to `|x|`). What [`Basis::dual_value`]
+/// expands in a basis, and what the quadratic-precision check reproduces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quadratic<const D: usize> {
+    /// The centre `m`.
+    pub centre: Point<f64, D>,
+    /// Value at the centre.
+    pub c: f64,
+    /// Gradient at the centre.
+    pub g: Point<f64, D>,
+    /// Half the Hessian (symmetric).
+    pub a: nalgebra::SMatrix<f64, D, D>,
+}
+
+impl<const D: usize> Quadratic<D> {
+    /// `q(x)`.
+    pub fn value(&self, x: &Point<f64, D>) -> f64 {
+        let d = x - self.centre;
+        self.c + self.g.dot(&d) + d.dot(&(self.a * d))
+    }
+    /// `∇q(x) = g + 2 A (x − m)`.
+    pub fn gradient(&self, x: &Point<f64, D>) -> Point<f64, D> {
+        self.g + self.a * (x - self.centre) * 2.0
+    }
+    /// The polar form (blossom) `c + g · ((u + v)/2 − m) + (u − m)ᵀ A (v − m)`:
+    /// symmetric, affine in each argument, `polar(x, x) = q(x)`.
+    pub fn polar(&self, u: &Point<f64, D>, v: &Point<f64, D>) -> f64 {
+        let (du, dv) = (u - self.centre, v - self.centre);
+        self.c + self.g.dot(&(du + dv)) * 0.5 + du.dot(&(self.a * dv))
+    }
+}
+
 /// Errors of basis construction and queries.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BasisError {
@@ -170,4 +204,15 @@ pub trait Basis<T: Real, const D: usize>: Sync {
     fn polynomial_pieces(&self, element: usize, out: &mut Vec<Point<f64, D>>);
     /// Polynomial degree of the functions on each piece.
     fn degree(&self) -> usize;
+    /// The coefficient `λ_i(p)` of `function` in the expansion `p = Σ_i λ_i(p) phi_i`
+    /// of a polynomial `p` of degree at most [`degree`](Basis::degree) (which the
+    /// basis reproduces), where the basis has it in closed form: the value at the
+    /// vertex for Lagrange bases, the tangent plane at the vertex evaluated at the
+    /// control point for Powell–Sabin, the blossom at the interior knots for
+    /// B-splines. `None` (the default) leaves it to the caller, which projects `p`
+    /// onto the basis.
+    fn dual_value(&self, function: usize, p: &Quadratic<D>) -> Option<f64> {
+        let _ = (function, p);
+        None
+    }
 }

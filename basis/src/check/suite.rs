@@ -72,10 +72,6 @@ pub(crate) trait Subject<const D: usize>: Basis<f64, D> + Sized {
     const CLAIMS: Claims;
     /// The basis on `mesh`.
     fn build(mesh: Self::Mesh) -> Self;
-    /// The coefficient of `function` in the expansion of `q` (claims with `quadratic`).
-    fn quadratic_coefficient(&self, _function: usize, _q: &Quadratic<D>) -> f64 {
-        unreachable!("{} claims no quadratic precision", self.name())
-    }
     /// Checks of this basis only, run on every mesh of the suite.
     fn specific_checks(&self) {}
 }
@@ -127,7 +123,7 @@ pub(crate) fn assert_properties<const D: usize, S: Subject<D>>(family: Family<D,
         "{name}: linear precision of the gradients off by {lp_grad:e} (aspect {aspect:e})"
     );
     if let Some((value, gradient)) = claims.quadratic {
-        let (qp, qp_grad) = quadratic_precision(&basis, |i, q| basis.quadratic_coefficient(i, q));
+        let (qp, qp_grad) = quadratic_precision(&basis);
         assert!(
             qp < value && qp_grad < gradient * aspect,
             "{name}: quadratic precision off by {qp:e}, gradients by {qp_grad:e}"

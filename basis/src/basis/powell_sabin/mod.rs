@@ -36,7 +36,7 @@
 pub mod bezier;
 pub mod control_triangle;
 
-use super::{Basis, BasisError, BasisEval, Constraint, Point};
+use super::{Basis, BasisError, BasisEval, Constraint, Point, Quadratic};
 use crate::mesh::{TriMesh, Vec2};
 use crate::refinement::Refinement;
 pub use crate::refinement::SplitPoint;
@@ -571,13 +571,24 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
     fn degree(&self) -> usize {
         2
     }
+    /// `λ_{i,q}(p) = p(V_i) + grad p(V_i) · (Q_i^q − V_i)`: the spline with these
+    /// coefficients has, at `V_i`, the value `Σ_q λ_q α_q` and gradient
+    /// `Σ_q λ_q (β_q, γ_q)` of the plane tangent to `p` there (the `L_q` are the
+    /// barycentric coordinates of the control triangle, so they reproduce that
+    /// plane), and the PS Hermite interpolant of a quadratic's values and
+    /// gradients is the quadratic itself (`ps-splines.md` §4).
+    fn dual_value(&self, function: usize, p: &Quadratic<2>) -> Option<f64> {
+        let v = self.mesh.vertices()[function / 3];
+        let q = self.control[function / 3][function % 3];
+        Some(p.value(&v) + p.gradient(&v).dot(&(q - v)))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::check::suite::{self, Claims, Continuity, Subject};
-    use crate::check::{self, Quadratic};
+    use crate::check;
     use crate::mesh::generators;
     use crate::mesh::signed_area;
 
@@ -819,14 +830,6 @@ mod tests {
         };
         fn build(mesh: TriMesh) -> Self {
             PowellSabin::new(mesh, SplitPoint::Incentre).unwrap()
-        }
-        /// `c_i^q = q(V_i) + ∇q(V_i) · (Q_i^q − V_i)`: the spline with value `q(V_i)`
-        /// and gradient `∇q(V_i)` at every vertex, which is `q` (PS splines contain
-        /// the quadratics).
-        fn quadratic_coefficient(&self, function: usize, q: &Quadratic<2>) -> f64 {
-            let v = self.mesh().vertices()[function / 3];
-            let control = self.control_triangles()[function / 3][function % 3];
-            q.value(&v) + q.gradient(&v).dot(&(control - v))
         }
         /// Exact C¹ across every edge of the refinement, the control triangles and
         /// triplets, gradients of each piece's own quadratic against central
