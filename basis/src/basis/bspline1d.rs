@@ -146,8 +146,8 @@ impl<T: Real> Basis<T, 1> for QuadraticBSpline<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::suite::{Claims, Continuity, Subject};
     use crate::check;
+    use crate::check::suite::{Claims, Continuity, Subject};
 
     /// The B-spline in the property suite ([`crate::check::suite`]): C¹, quadratic
     /// precision with the polar form at the knots as coefficients.

@@ -587,8 +587,8 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::suite::{self, Claims, Continuity, Subject};
     use crate::check;
+    use crate::check::suite::{self, Claims, Continuity, Subject};
     use crate::mesh::generators;
     use crate::mesh::signed_area;
 
