@@ -29,6 +29,8 @@ pub struct Bins {
     pub(super) start: Vec<usize>,
     pub(super) order: Vec<u32>,
     pub(super) cursor: Vec<usize>,
+    /// The elements holding a particle, ascending.
+    occupied: Vec<u32>,
 }
 
 impl Bins {
@@ -38,6 +40,7 @@ impl Bins {
             start: vec![0; elements + 1],
             order: vec![0; particles],
             cursor: vec![0; elements],
+            occupied: Vec::new(),
         }
     }
 
@@ -54,7 +57,11 @@ impl Bins {
             self.start[e + 1] += 1;
         }
         let ne = self.cursor.len();
+        self.occupied.clear();
         for e in 0..ne {
+            if self.start[e + 1] > 0 {
+                self.occupied.push(e as u32);
+            }
             self.start[e + 1] += self.start[e];
         }
         self.cursor.copy_from_slice(&self.start[..ne]);
@@ -79,6 +86,11 @@ impl Bins {
     #[inline]
     pub fn occupied(&self, e: usize) -> bool {
         self.start[e + 1] > self.start[e]
+    }
+
+    /// The elements holding a particle, ascending.
+    pub fn occupied_elements(&self) -> &[u32] {
+        &self.occupied
     }
 }
 
@@ -224,39 +236,119 @@ pub struct Local<T: Scalar, const D: usize> {
     pub(super) body: Vec<T>,
     /// Per element: its blocks may hold nonzero values.
     dirty: Vec<bool>,
+    /// The elements `dirty` flags, ascending (the occupied elements of the last
+    /// visit).
+    dirty_list: Vec<u32>,
+    /// Scratch: the elements a visit through the lists goes to.
+    visit: Vec<u32>,
+}
+
+/// Below this share of elements occupied (now or at the last visit) the element
+/// loops go through the lists of those elements, on one thread, instead of every
+/// element on the pool: a body in a mostly empty mesh. Each element's blocks are
+/// its own sums either way, so the choice changes no bit.
+const SPARSE_ELEMENTS: f64 = 0.125;
+
+/// The next `len` entries of `rest` from entry `e · len` on (`consumed`: the
+/// entries already split off the front), without `unsafe`.
+fn carve<'a, T>(rest: &mut &'a mut [T], consumed: &mut usize, e: usize, len: usize) -> &'a mut [T] {
+    if len == 0 {
+        return &mut [];
+    }
+    let tail = std::mem::take(rest);
+    let (_, tail) = tail.split_at_mut(e * len - *consumed);
+    let (block, tail) = tail.split_at_mut(len);
+    *rest = tail;
+    *consumed = (e + 1) * len;
+    block
 }
 
 impl<T: Scalar, const D: usize> Local<T, D> {
-    /// The local matrix block and vector of each element that holds a particle in
-    /// `bins`, zeroed, in parallel tasks of at least [`ELEMENT_CHUNK`] elements:
-    /// `(e, (matrix, vector))`. The blocks of elements emptied since the last call
-    /// are zeroed.
-    pub(super) fn par_elements<'a>(
-        &'a mut self,
-        bins: &'a Bins,
-    ) -> impl ParallelIterator<Item = (usize, (&'a mut [T], &'a mut [T]))> + 'a {
-        self.occupied_blocks(bins, true)
-            .map(|(e, (lm, lv, _, _))| (e, (lm, lv)))
+    /// Calls `f(e, (matrix, vector))` with the local matrix block and vector of
+    /// each element `e` that holds a particle in `bins`, zeroed, in parallel tasks
+    /// of at least [`ELEMENT_CHUNK`] elements. The blocks of elements emptied
+    /// since the last call are zeroed.
+    pub(super) fn for_each_element<F>(&mut self, bins: &Bins, f: F)
+    where
+        F: Fn(usize, (&mut [T], &mut [T])) + Sync,
+    {
+        self.each_occupied(bins, true, &|e, (lm, lv, _, _)| f(e, (lm, lv)));
     }
 
-    /// [`Local::par_elements`] with each element's coverage and body-force blocks
-    /// (empty without [`Local::with_coverage`] and [`Local::with_body_forces`]; not
-    /// zeroed: their writer overwrites them): `(e, (matrix, vector, coverage, body))`.
-    pub(super) fn par_elements_with_coverage<'a>(
-        &'a mut self,
-        bins: &'a Bins,
-    ) -> impl ParallelIterator<Item = (usize, ElementBlocks<'a, T>)> + 'a {
-        self.occupied_blocks(bins, true)
+    /// [`Local::for_each_element`] with each element's coverage and body-force
+    /// blocks (empty without [`Local::with_coverage`] and
+    /// [`Local::with_body_forces`]; not zeroed: their writer overwrites them):
+    /// `f(e, (matrix, vector, coverage, body))`.
+    pub(super) fn for_each_element_with_coverage<F>(&mut self, bins: &Bins, f: F)
+    where
+        F: Fn(usize, ElementBlocks<'_, T>) + Sync,
+    {
+        self.each_occupied(bins, true, &f);
     }
 
     /// The local vector of each element that holds a particle in `bins`, zeroed
-    /// (its matrix block untouched), as [`Local::par_elements`]: `(e, vector)`.
-    pub(super) fn par_vectors<'a>(
-        &'a mut self,
-        bins: &'a Bins,
-    ) -> impl ParallelIterator<Item = (usize, &'a mut [T])> + 'a {
-        self.occupied_blocks(bins, false)
-            .map(|(e, (_, lv, _, _))| (e, lv))
+    /// (its matrix block untouched), as [`Local::for_each_element`]: `f(e, vector)`.
+    pub(super) fn for_each_vector<F>(&mut self, bins: &Bins, f: F)
+    where
+        F: Fn(usize, &mut [T]) + Sync,
+    {
+        self.each_occupied(bins, false, &|e, (_, lv, _, _)| f(e, lv));
+    }
+
+    /// The element loop of the three above: through the lists of occupied and
+    /// dirty elements when they are few ([`SPARSE_ELEMENTS`]), else every element
+    /// on the pool.
+    fn each_occupied(
+        &mut self,
+        bins: &Bins,
+        matrix: bool,
+        f: &(dyn Fn(usize, ElementBlocks<'_, T>) + Sync),
+    ) {
+        let elements = self.dirty.len();
+        let occupied = bins.occupied_elements();
+        if ((occupied.len() + self.dirty_list.len()) as f64) < SPARSE_ELEMENTS * elements as f64 {
+            self.visit.clear();
+            self.visit.extend_from_slice(occupied);
+            self.visit.extend_from_slice(&self.dirty_list);
+            self.visit.sort_unstable();
+            self.visit.dedup();
+            let stride = self.stride;
+            let lens = [
+                packed_len(stride),
+                stride * D,
+                if self.coverage.is_empty() {
+                    0
+                } else {
+                    2 * stride
+                },
+                if self.body.is_empty() { 0 } else { stride * D },
+            ];
+            let mut rest: [&mut [T]; 4] = [
+                &mut self.matrix[..],
+                &mut self.vector[..],
+                &mut self.coverage[..],
+                &mut self.body[..],
+            ];
+            let mut consumed = [0usize; 4];
+            for &e in &self.visit {
+                let e = e as usize;
+                let [lm, lv, lc, lb] =
+                    std::array::from_fn(|k| carve(&mut rest[k], &mut consumed[k], e, lens[k]));
+                if let Some(blocks) = zero_blocks(
+                    bins.occupied(e),
+                    &mut self.dirty[e],
+                    matrix,
+                    (lm, lv, lc, lb),
+                ) {
+                    f(e, blocks);
+                }
+            }
+        } else {
+            self.occupied_blocks(bins, matrix)
+                .for_each(|(e, blocks)| f(e, blocks));
+        }
+        self.dirty_list.clear();
+        self.dirty_list.extend_from_slice(occupied);
     }
 
     /// The blocks of the occupied elements, the vector zeroed and the matrix block
@@ -292,19 +384,7 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             .with_min_len(ELEMENT_CHUNK)
             .enumerate()
             .filter_map(move |(e, (lm, lv, (lc, lb), dirty))| {
-                let occupied = bins.occupied(e);
-                if (occupied && matrix) || (!occupied && *dirty) {
-                    lm.iter_mut().for_each(|v| *v = T::zero());
-                }
-                if occupied || *dirty {
-                    lv.iter_mut().for_each(|v| *v = T::zero());
-                }
-                if !occupied && *dirty {
-                    lc.iter_mut().for_each(|v| *v = T::zero());
-                    lb.iter_mut().for_each(|v| *v = T::zero());
-                }
-                *dirty = occupied;
-                occupied.then_some((e, (lm, lv, lc, lb)))
+                zero_blocks(bins.occupied(e), dirty, matrix, (lm, lv, lc, lb)).map(|b| (e, b))
             })
     }
 
@@ -317,6 +397,8 @@ impl<T: Scalar, const D: usize> Local<T, D> {
             coverage: Vec::new(),
             body: Vec::new(),
             dirty: vec![false; elements],
+            dirty_list: Vec::new(),
+            visit: Vec::new(),
         }
     }
 
@@ -331,6 +413,30 @@ impl<T: Scalar, const D: usize> Local<T, D> {
         self.coverage = vec![T::zero(); self.dirty.len() * 2 * self.stride];
         self
     }
+}
+
+/// An element's blocks before its visit: the vector zeroed if occupied or dirty,
+/// the matrix block too if occupied and `matrix` or if dirty and no longer
+/// occupied, the coverage and body blocks of an element emptied since; `dirty`
+/// becomes `occupied`. The blocks of an occupied element, to fill.
+fn zero_blocks<'a, T: Scalar>(
+    occupied: bool,
+    dirty: &mut bool,
+    matrix: bool,
+    (lm, lv, lc, lb): ElementBlocks<'a, T>,
+) -> Option<ElementBlocks<'a, T>> {
+    if (occupied && matrix) || (!occupied && *dirty) {
+        lm.iter_mut().for_each(|v| *v = T::zero());
+    }
+    if occupied || *dirty {
+        lv.iter_mut().for_each(|v| *v = T::zero());
+    }
+    if !occupied && *dirty {
+        lc.iter_mut().for_each(|v| *v = T::zero());
+        lb.iter_mut().for_each(|v| *v = T::zero());
+    }
+    *dirty = occupied;
+    occupied.then_some((lm, lv, lc, lb))
 }
 
 /// Calls its argument with every `(target, source)` pair of a gather map.
@@ -362,10 +468,22 @@ pub struct Gather {
     block_column: Vec<u32>,
     /// Per function: it belongs to an element that holds a particle.
     live: Vec<bool>,
+    /// The live functions, ascending; the gathers run through this list instead
+    /// of every function when it holds fewer than [`SPARSE_SHARE`] of them.
+    live_list: Vec<u32>,
     /// Per column: its entries may be nonzero in the values last assigned by
     /// [`Gather::matrix_assign`].
     written: Vec<bool>,
+    /// The columns `written` flags, ascending, when known (after an assignment:
+    /// the live columns of that step).
+    written_list: Option<Vec<u32>>,
 }
+
+/// Below this share of live functions the gathers visit the live list (one
+/// thread) instead of every function (on the pool): a body in a mostly empty mesh.
+/// The sums are the same either way (each target's in element order), so the
+/// choice changes no bit.
+const SPARSE_SHARE: f64 = 0.125;
 
 impl Gather {
     /// The maps of `basis` with `pattern` (its element scatter maps) and local
@@ -444,26 +562,50 @@ impl Gather {
             block_column,
             // Until the first `mark_live`, every target is visited.
             live: vec![true; n],
+            live_list: (0..n as u32).collect(),
             written: vec![true; n],
+            written_list: None,
         }
     }
 
     /// Marks the functions of the elements of `bins` that hold a particle as live,
     /// the others not (once per step, after the particles are binned).
     pub fn mark_live<T: Scalar, const D: usize, B: Basis<T, D>>(&mut self, basis: &B, bins: &Bins) {
-        self.live.iter_mut().for_each(|l| *l = false);
+        if self.sparse() {
+            for &i in &self.live_list {
+                self.live[i as usize] = false;
+            }
+        } else {
+            self.live.iter_mut().for_each(|l| *l = false);
+        }
+        self.live_list.clear();
         for e in 0..basis.num_elements() {
             if bins.occupied(e) {
                 for &i in basis.element_functions(e) {
-                    self.live[i] = true;
+                    if !self.live[i] {
+                        self.live[i] = true;
+                        self.live_list.push(i as u32);
+                    }
                 }
             }
         }
+        self.live_list.sort_unstable();
+    }
+
+    /// Whether the gathers run through the live list ([`SPARSE_SHARE`]).
+    fn sparse(&self) -> bool {
+        (self.live_list.len() as f64) < SPARSE_SHARE * self.live.len() as f64
     }
 
     /// Which functions are live ([`Gather::mark_live`]).
     pub(super) fn live(&self) -> &[bool] {
         &self.live
+    }
+
+    /// The live functions, ascending, when the gathers run through them (the
+    /// values of every other function are zero), else `None`.
+    pub(super) fn live_list(&self) -> Option<&[u32]> {
+        self.sparse().then_some(&self.live_list[..])
     }
 
     /// `values_j = Σ` of the local matrix blocks' entries `j`, in element order,
@@ -474,6 +616,12 @@ impl Gather {
         local: &Local<T, D>,
         values: &mut [T],
     ) {
+        if self.sparse() {
+            if let Some(previous) = self.written_list.take() {
+                self.matrix_assign_listed(local, values, &previous);
+                return;
+            }
+        }
         let mut written = std::mem::take(&mut self.written);
         let this = &*self;
         split_columns(
@@ -498,6 +646,35 @@ impl Gather {
             },
         );
         self.written = written;
+        self.written_list = Some(self.live_list.clone());
+    }
+
+    /// [`Gather::matrix_assign`] through the live list: the columns of
+    /// `previous` (those written last) that are no longer live are zeroed, the
+    /// live ones assigned.
+    fn matrix_assign_listed<T: Scalar, const D: usize>(
+        &mut self,
+        local: &Local<T, D>,
+        values: &mut [T],
+        previous: &[u32],
+    ) {
+        for &c in previous {
+            let c = c as usize;
+            if !self.live[c] {
+                let entries = self.column_start[c] as usize..self.column_start[c + 1] as usize;
+                values[entries].iter_mut().for_each(|v| *v = T::zero());
+                self.written[c] = false;
+            }
+        }
+        for &c in &self.live_list {
+            let c = c as usize;
+            let entries = self.column_start[c] as usize..self.column_start[c + 1] as usize;
+            for j in entries {
+                values[j] = self.entry_sum(local, j);
+            }
+            self.written[c] = true;
+        }
+        self.written_list = Some(self.live_list.clone());
     }
 
     /// `values_j += Σ` of the local matrix blocks' entries `j`, in element order,
@@ -507,6 +684,15 @@ impl Gather {
         local: &Local<T, D>,
         values: &mut [T],
     ) {
+        if self.sparse() {
+            for &c in &self.live_list {
+                let c = c as usize;
+                for j in self.column_start[c] as usize..self.column_start[c + 1] as usize {
+                    values[j] += self.entry_sum(local, j);
+                }
+            }
+            return;
+        }
         split_columns(
             &self.block_column,
             &self.column_start,
@@ -554,6 +740,23 @@ impl Gather {
         volume: &mut [f64],
         count: &mut [f64],
     ) {
+        if self.sparse() {
+            // Every function that is not live sums `+0`: zeroed, then the live.
+            volume.iter_mut().for_each(|v| *v = 0.0);
+            count.iter_mut().for_each(|v| *v = 0.0);
+            for &i in &self.live_list {
+                let i = i as usize;
+                let mut sum = [0.0; 2];
+                let sources = self.function_start[i] as usize..self.function_start[i + 1] as usize;
+                for &s in &self.function_source[sources] {
+                    let s = s as usize * 2;
+                    sum[0] += local.coverage[s].to_f64();
+                    sum[1] += local.coverage[s + 1].to_f64();
+                }
+                [volume[i], count[i]] = sum;
+            }
+            return;
+        }
         (volume, count)
             .into_par_iter()
             .with_min_len(ENTRY_CHUNK)
@@ -597,6 +800,14 @@ impl Gather {
     /// `out_{k,i} += source_{k,i}` for the live functions `i` (the others are
     /// left alone, as a gather leaves them).
     pub(super) fn add_live<T: Scalar>(&self, source: &[Vec<T>], out: &mut [Vec<T>]) {
+        if self.sparse() {
+            for (out, source) in out.iter_mut().zip(source) {
+                for &i in &self.live_list {
+                    out[i as usize] += source[i as usize];
+                }
+            }
+            return;
+        }
         for (out, source) in out.iter_mut().zip(source) {
             out.par_iter_mut()
                 .with_min_len(ENTRY_CHUNK)
@@ -618,6 +829,25 @@ impl Gather {
         negate: bool,
         out: &mut [Vec<T>],
     ) {
+        if self.sparse() {
+            for (k, out) in out.iter_mut().enumerate() {
+                for &i in &self.live_list {
+                    let i = i as usize;
+                    let mut sum = T::zero();
+                    let sources =
+                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
+                    for &s in &self.function_source[sources] {
+                        sum += source[s as usize * D + k];
+                    }
+                    if negate {
+                        out[i] -= sum;
+                    } else {
+                        out[i] += sum;
+                    }
+                }
+            }
+            return;
+        }
         for (k, out) in out.iter_mut().enumerate() {
             out.par_iter_mut()
                 .with_min_len(ENTRY_CHUNK)
@@ -691,7 +921,7 @@ pub fn scatter_by_elements<T: Scalar, const D: usize, Q>(
 ) where
     Q: Fn(usize, usize) -> SVector<T, D> + Sync,
 {
-    local.par_vectors(bins).for_each(|(e, lv)| {
+    local.for_each_vector(bins, |e, lv| {
         for &p in bins.particles(e) {
             let p = p as usize;
             for (a, s) in evals.range(p).enumerate() {
@@ -731,19 +961,17 @@ mod tests {
         };
         // The odd rounds visit the vectors first, as a step's first scatter does.
         if round as usize % 2 == 1 {
-            local.par_vectors(bins).for_each(|(e, lv)| vector(e, lv));
+            local.for_each_vector(bins, |e, lv| vector(e, lv));
         }
-        local
-            .par_elements_with_coverage(bins)
-            .for_each(|(e, (lm, lv, lc, _))| {
-                for (k, v) in lm.iter_mut().enumerate() {
-                    *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
-                }
-                vector(e, lv);
-                for (k, v) in lc.iter_mut().enumerate() {
-                    *v = (e as f64 + 3.0) * 0.19 + k as f64 * 0.013 + round;
-                }
-            });
+        local.for_each_element_with_coverage(bins, |e, (lm, lv, lc, _)| {
+            for (k, v) in lm.iter_mut().enumerate() {
+                *v = (e as f64 + 1.0) * 0.37 + k as f64 * 0.011 + round;
+            }
+            vector(e, lv);
+            for (k, v) in lc.iter_mut().enumerate() {
+                *v = (e as f64 + 3.0) * 0.19 + k as f64 * 0.013 + round;
+            }
+        });
         gather.matrix_assign(local, values);
         out.iter_mut()
             .for_each(|o| o.iter_mut().for_each(|v| *v = 0.0));
@@ -768,15 +996,22 @@ mod tests {
         let mut values = vec![0.0; pattern.nnz()];
         let mut out = vec![vec![0.0; n]; 2];
         let mut coverage = [vec![0.0; n], vec![0.0; n]];
+        // Whether each round's gathers ran through the live list: both ways, and
+        // from each to the other.
+        let mut listed = Vec::new();
         for (r, elements) in [
             [0, 0, 1, 5, 5, 7],
             [5, 9, 9, 30, 31, 31],
             [40, 41, 42, 43, 44, 45],
+            [2, 20, 60, 80, 100, 140],
+            [3, 3, 3, 3, 3, 3],
         ]
         .iter()
         .enumerate()
         {
             bins.fill(elements);
+            gather.mark_live(&basis, &bins);
+            listed.push(gather.sparse());
             round(
                 &basis,
                 &mut gather,
@@ -828,6 +1063,7 @@ mod tests {
             }
             assert!(values.iter().any(|&v| v != 0.0));
         }
+        assert_eq!(listed, [true, true, true, false, true]);
         // The blocks of the elements emptied in the last round are zero.
         for e in [0, 1, 5, 7, 9, 30, 31] {
             assert!(local.coverage[e * 2 * stride..(e + 1) * 2 * stride]

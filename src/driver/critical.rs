@@ -911,7 +911,7 @@ fn stiffness_product<T: Scalar, const D: usize>(
     f: &mut [Vec<T>],
 ) {
     phases::zero(f);
-    local.par_vectors(bins).for_each(|(e, lv)| {
+    local.for_each_vector(bins, |e, lv| {
         let functions = evals.element_functions(e);
         for &p in bins.particles(e) {
             let p = p as usize;
@@ -989,7 +989,7 @@ fn consistent_mass_product<T: Scalar, const D: usize>(
     out: &mut [Vec<T>],
 ) {
     phases::zero(out);
-    local.par_vectors(bins).for_each(|(e, lv)| {
+    local.for_each_vector(bins, |e, lv| {
         let functions = evals.element_functions(e);
         for &p in bins.particles(e) {
             let p = p as usize;

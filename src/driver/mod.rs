@@ -1069,6 +1069,7 @@ where
                 } else {
                     self.gather.live()
                 },
+                live_list: None,
                 diagonal_only: self.inputs.needs.row_sums_only,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
@@ -1195,6 +1196,7 @@ where
             particle_count: &self.inputs.particle_count,
             on_wall: &self.inputs.on_wall,
             live: self.gather.live(),
+            live_list: self.gather.live_list(),
             diagonal_only: self.inputs.needs.row_sums_only,
         };
         match self.mass.factorize(&self.pattern, &self.values, context) {

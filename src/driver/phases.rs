@@ -297,29 +297,21 @@ pub fn assemble_mass_and_internal_force<T: Scalar, const D: usize>(
         coverage: sums,
         forces,
     };
-    local
-        .par_elements_with_coverage(bins)
-        .for_each(|(e, (lm, lv, lc, lb))| {
-            let inside = bins.particles(e);
-            // Every particle of an element has the element's functions; with as many
-            // as the stride (every PS and PL element) the block is summed in a
-            // fixed-size array, in the same order (the same bits).
-            let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
-            let out = (lm, lv, lc, lb);
-            match (m == stride, m) {
-                (true, 9) => {
-                    return element_block::<T, D, 9, 45>(inside, particles, evals, block, out)
-                }
-                (true, 3) => {
-                    return element_block::<T, D, 3, 6>(inside, particles, evals, block, out)
-                }
-                (true, 2) => {
-                    return element_block::<T, D, 2, 3>(inside, particles, evals, block, out)
-                }
-                _ => {}
-            }
-            element_block_any(inside, particles, evals, stride, block, out);
-        });
+    local.for_each_element_with_coverage(bins, |e, (lm, lv, lc, lb)| {
+        let inside = bins.particles(e);
+        // Every particle of an element has the element's functions; with as many
+        // as the stride (every PS and PL element) the block is summed in a
+        // fixed-size array, in the same order (the same bits).
+        let m = inside.first().map_or(0, |&p| evals.range(p as usize).len());
+        let out = (lm, lv, lc, lb);
+        match (m == stride, m) {
+            (true, 9) => return element_block::<T, D, 9, 45>(inside, particles, evals, block, out),
+            (true, 3) => return element_block::<T, D, 3, 6>(inside, particles, evals, block, out),
+            (true, 2) => return element_block::<T, D, 2, 3>(inside, particles, evals, block, out),
+            _ => {}
+        }
+        element_block_any(inside, particles, evals, stride, block, out);
+    });
     gather.matrix_assign(local, values);
     zero(force);
     gather.functions(local, true, force);
@@ -611,7 +603,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
         );
     }
     let element_affine = &*element_affine;
-    local.par_elements(bins).for_each(|(e, (lm, g))| {
+    local.for_each_element(bins, |e, (lm, g)| {
         let inside = bins.particles(e);
         if !inside.iter().any(|&p| touches_lumped(p as usize)) {
             return;

@@ -15,6 +15,9 @@ use crate::sparse::{Scalar, SymmetricPattern};
 pub struct Lumped<T: Scalar> {
     fixed: Vec<Vec<bool>>,
     diagonal: Vec<T>,
+    /// The functions whose lumped mass may be nonzero, when the last
+    /// factorisation ran through a live list (`None`: any).
+    written: Option<Vec<u32>>,
 }
 
 impl<T: Scalar> Lumped<T> {
@@ -37,6 +40,7 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
     fn prepare(&mut self, setup: &MassSetup) {
         self.fixed = setup.fixed.to_vec();
         self.diagonal = vec![T::zero(); setup.pattern.dim()];
+        self.written = None;
     }
     fn factorize(
         &mut self,
@@ -44,6 +48,31 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
         values: &[T],
         context: StepContext,
     ) -> Result<MassReport, MassError> {
+        if let (true, Some(live)) = (context.diagonal_only, context.live_list) {
+            // A body over a small part of the mesh: the masses outside the live
+            // list are zero, those of the last list are zeroed (the same masses
+            // as the pass over every function, without it).
+            match self.written.take() {
+                Some(written) => written
+                    .iter()
+                    .for_each(|&i| self.diagonal[i as usize] = T::zero()),
+                None => self.diagonal.iter_mut().for_each(|d| *d = T::zero()),
+            }
+            for &i in live {
+                self.diagonal[i as usize] = values[pattern.diagonal_position(i as usize)];
+            }
+            let active = without_roundoff_masses_of(&mut self.diagonal, live);
+            let mut written = self.written.take().unwrap_or_default();
+            written.clear();
+            written.extend_from_slice(live);
+            self.written = Some(written);
+            return Ok(MassReport {
+                active,
+                lumped_rows: active,
+                ..MassReport::default()
+            });
+        }
+        self.written = None;
         if context.diagonal_only {
             // The same sums without the pass over the whole pattern, whose other
             // entries are zero: in a mostly empty mesh that pass was a quarter
@@ -103,6 +132,24 @@ pub(super) fn without_roundoff_masses<T: Scalar>(diagonal: &mut [T]) -> usize {
     with_mass
 }
 
+/// [`without_roundoff_masses`] where only the entries `listed` may be nonzero.
+fn without_roundoff_masses_of<T: Scalar>(diagonal: &mut [T], listed: &[u32]) -> usize {
+    let largest = listed
+        .iter()
+        .fold(T::zero(), |a, &i| a.max(diagonal[i as usize]));
+    let floor = largest * T::of(ROUNDOFF_MASS);
+    let mut with_mass = 0;
+    for &i in listed {
+        let m = &mut diagonal[i as usize];
+        if *m <= floor {
+            *m = T::zero();
+        } else {
+            with_mass += 1;
+        }
+    }
+    with_mass
+}
+
 /// `max / min` of the positive entries (1 without any).
 pub(super) fn diagonal_condition<T: Scalar>(diagonal: &[T]) -> f64 {
     let (lo, hi) = diagonal
@@ -132,5 +179,12 @@ mod tests {
         assert_eq!(diagonal, vec![1.0, 0.0, 0.5, 0.0, 0.0, 1e-11]);
         let mut empty = vec![0.0f64; 3];
         assert_eq!(without_roundoff_masses(&mut empty), 0);
+        // Through a list of the entries that may be nonzero: the same.
+        let mut diagonal = vec![1.0, 1e-16, 0.5, 0.0, 5e-13, 1e-11];
+        assert_eq!(
+            without_roundoff_masses_of(&mut diagonal, &[0, 1, 2, 4, 5]),
+            3
+        );
+        assert_eq!(diagonal, vec![1.0, 0.0, 0.5, 0.0, 0.0, 1e-11]);
     }
 }

@@ -92,6 +92,7 @@ fn context(c: &Column) -> StepContext<'_> {
         particle_count: &c.particle_count,
         on_wall: &[],
         live: &[],
+        live_list: None,
         diagonal_only: false,
     }
 }
