@@ -474,9 +474,10 @@ pub struct Gather {
     /// Per column: its entries may be nonzero in the values last assigned by
     /// [`Gather::matrix_assign`].
     written: Vec<bool>,
-    /// The columns `written` flags, ascending, when known (after an assignment:
-    /// the live columns of that step).
-    written_list: Option<Vec<u32>>,
+    /// The columns `written` flags, ascending, when `written_listed` (after an
+    /// assignment: the live columns of that step).
+    written_list: Vec<u32>,
+    written_listed: bool,
 }
 
 /// Below this share of live functions the gathers visit the live list (one
@@ -564,7 +565,8 @@ impl Gather {
             live: vec![true; n],
             live_list: (0..n as u32).collect(),
             written: vec![true; n],
-            written_list: None,
+            written_list: Vec::new(),
+            written_listed: false,
         }
     }
 
@@ -616,11 +618,9 @@ impl Gather {
         local: &Local<T, D>,
         values: &mut [T],
     ) {
-        if self.sparse() {
-            if let Some(previous) = self.written_list.take() {
-                self.matrix_assign_listed(local, values, &previous);
-                return;
-            }
+        if self.sparse() && self.written_listed {
+            self.matrix_assign_listed(local, values);
+            return;
         }
         let mut written = std::mem::take(&mut self.written);
         let this = &*self;
@@ -646,19 +646,19 @@ impl Gather {
             },
         );
         self.written = written;
-        self.written_list = Some(self.live_list.clone());
+        self.written_list.clear();
+        self.written_list.extend_from_slice(&self.live_list);
+        self.written_listed = true;
     }
 
-    /// [`Gather::matrix_assign`] through the live list: the columns of
-    /// `previous` (those written last) that are no longer live are zeroed, the
-    /// live ones assigned.
+    /// [`Gather::matrix_assign`] through the live list: the columns written last
+    /// that are no longer live are zeroed, the live ones assigned.
     fn matrix_assign_listed<T: Scalar, const D: usize>(
         &mut self,
         local: &Local<T, D>,
         values: &mut [T],
-        previous: &[u32],
     ) {
-        for &c in previous {
+        for &c in &self.written_list {
             let c = c as usize;
             if !self.live[c] {
                 let entries = self.column_start[c] as usize..self.column_start[c + 1] as usize;
@@ -674,7 +674,8 @@ impl Gather {
             }
             self.written[c] = true;
         }
-        self.written_list = Some(self.live_list.clone());
+        self.written_list.clear();
+        self.written_list.extend_from_slice(&self.live_list);
     }
 
     /// `values_j += Σ` of the local matrix blocks' entries `j`, in element order,

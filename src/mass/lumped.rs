@@ -16,8 +16,11 @@ pub struct Lumped<T: Scalar> {
     fixed: Vec<Vec<bool>>,
     diagonal: Vec<T>,
     /// The functions whose lumped mass may be nonzero, when the last
-    /// factorisation ran through a live list (`None`: any).
-    written: Option<Vec<u32>>,
+    /// factorisation ran through a live list (`listed`; else any).
+    written: Vec<u32>,
+    listed: bool,
+    /// Scratch of the solve through `written`: its right-hand sides.
+    kept: Vec<T>,
 }
 
 impl<T: Scalar> Lumped<T> {
@@ -40,7 +43,7 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
     fn prepare(&mut self, setup: &MassSetup) {
         self.fixed = setup.fixed.to_vec();
         self.diagonal = vec![T::zero(); setup.pattern.dim()];
-        self.written = None;
+        self.listed = false;
     }
     fn factorize(
         &mut self,
@@ -52,27 +55,27 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
             // A body over a small part of the mesh: the masses outside the live
             // list are zero, those of the last list are zeroed (the same masses
             // as the pass over every function, without it).
-            match self.written.take() {
-                Some(written) => written
-                    .iter()
-                    .for_each(|&i| self.diagonal[i as usize] = T::zero()),
-                None => self.diagonal.iter_mut().for_each(|d| *d = T::zero()),
+            if self.listed {
+                for &i in &self.written {
+                    self.diagonal[i as usize] = T::zero();
+                }
+            } else {
+                self.diagonal.iter_mut().for_each(|d| *d = T::zero());
             }
             for &i in live {
                 self.diagonal[i as usize] = values[pattern.diagonal_position(i as usize)];
             }
             let active = without_roundoff_masses_of(&mut self.diagonal, live);
-            let mut written = self.written.take().unwrap_or_default();
-            written.clear();
-            written.extend_from_slice(live);
-            self.written = Some(written);
+            self.written.clear();
+            self.written.extend_from_slice(live);
+            self.listed = true;
             return Ok(MassReport {
                 active,
                 lumped_rows: active,
                 ..MassReport::default()
             });
         }
-        self.written = None;
+        self.listed = false;
         if context.diagonal_only {
             // The same sums without the pass over the whole pattern, whose other
             // entries are zero: in a mostly empty mesh that pass was a quarter
@@ -91,6 +94,23 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
         })
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
+        if self.listed {
+            // Every function outside the list has no mass and solves to zero:
+            // the list's right-hand sides kept, the rest zeroed at once (the same
+            // bits as the division pass over every function, which in a mostly
+            // empty mesh was a seventh of the step).
+            self.kept.clear();
+            self.kept
+                .extend(self.written.iter().map(|&i| rhs[i as usize]));
+            rhs.iter_mut().for_each(|r| *r = T::zero());
+            for (&i, &r) in self.written.iter().zip(&self.kept) {
+                let (i, m) = (i as usize, self.diagonal[i as usize]);
+                if !self.fixed[k][i] && m > T::zero() {
+                    rhs[i] = r / m;
+                }
+            }
+            return Ok(());
+        }
         for (i, r) in rhs.iter_mut().enumerate() {
             let m = self.diagonal[i];
             *r = if self.fixed[k][i] || m <= T::zero() {
