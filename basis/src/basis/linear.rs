@@ -1,7 +1,8 @@
 //! Piecewise-linear Lagrange basis on triangles (PL): one hat function per vertex.
 //!
 //! On triangle `t` with vertices `V_1, V_2, V_3`, `phi_{V_k}` is the barycentric
-//! coordinate `λ_k(x) = a_k + g_k · x`, affine with constant gradient `g_k`. The basis
+//! coordinate `λ_k(x) = λ_k(V_1) + g_k · (x − V_1)`, affine with constant gradient
+//! `g_k` (about the first corner: round-off of the element's size). The basis
 //! is C⁰ (gradients jump across edges, the source of grid-crossing noise in MPM),
 //! non-negative, a partition of unity, and reproduces linear functions with the
 //! vertices as [`function_point`](Basis::function_point)s.
@@ -23,8 +24,9 @@ use nalgebra::Vector2;
 #[derive(Debug, Clone)]
 pub struct Linear<T: Real = f64> {
     mesh: TriMesh,
-    /// Per triangle and local vertex: `(a_k, g_k)` with `λ_k(x) = a_k + g_k · x`.
-    affine: Vec<[(T, Vector2<T>); 3]>,
+    /// Per triangle its first corner `V_1` and per local vertex `(λ_k(V_1), g_k)`:
+    /// `λ_k(x) = λ_k(V_1) + g_k · (x − V_1)`.
+    affine: Vec<(Vector2<T>, [(T, Vector2<T>); 3])>,
     /// Flattened vertex → triangles map (CSR).
     support_offsets: Vec<usize>,
     support: Vec<usize>,
@@ -49,14 +51,17 @@ impl<T: Real> Linear<T> {
                 let d = (p2.x - p1.x) * (p3.y - p1.y) - (p3.x - p1.x) * (p2.y - p1.y);
                 let p = [p1, p2, p3];
                 let mut out = [(T::zero(), Vector2::zeros()); 3];
+                // λ_k(x) = [k = 0] + g_k · (x − p1): about the first corner, so
+                // that round-off is that of the element's size, not of `|x|² / d`
+                // (in global coordinates, `a_k + g_k · x` gave a particle on an
+                // edge a value of 5e-12 instead of 0 at x ≈ 7 on blocks of 0.04).
                 for k in 0..3 {
                     let (b, c) = (p[(k + 1) % 3], p[(k + 2) % 3]);
-                    // λ_k(x) = ((b − x) × (c − x)) / d, expanded to a_k + g_k · x.
                     let g = Vec2::new(b.y - c.y, c.x - b.x) / d;
-                    let a = (b.x * c.y - c.x * b.y) / d;
+                    let a = if k == 0 { 1.0 } else { 0.0 };
                     out[k] = (T::of(a), Vector2::new(T::of(g.x), T::of(g.y)));
                 }
-                out
+                (Vector2::new(T::of(p1.x), T::of(p1.y)), out)
             })
             .collect();
         let mut support_offsets = vec![0];
@@ -111,10 +116,12 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
     #[inline]
     fn eval(&self, element: usize, x: &Point<T, 2>, out: &mut BasisEval<T, 2>) {
         let tri = &self.mesh.triangles()[element];
+        let (corner, affine) = &self.affine[element];
+        let local = x - corner;
         for (k, &vertex) in tri.iter().enumerate() {
-            let (a, g) = &self.affine[element][k];
+            let (a, g) = &affine[k];
             out.index[k] = vertex;
-            out.phi[k] = *a + g.dot(x);
+            out.phi[k] = *a + g.dot(&local);
             out.grad_phi[k] = *g;
         }
         out.set_len(3);
@@ -200,10 +207,8 @@ mod tests {
         }
     }
 
-    /// PL sums affine functions stored in global coordinates, so its round-off grows
-    /// with [`check::coordinate_conditioning`] (and so do the suite's bounds, beyond
-    /// 1e-14); on these well-shaped meshes (conditioning at most 65) it stays within
-    /// 1e-14.
+    /// On these well-shaped meshes PL is a partition of unity, non-negative and
+    /// linearly precise within 1e-14.
     fn assert_within_1e_14(mesh: TriMesh) {
         let pl = Linear::<f64>::new(mesh);
         assert!(check::partition_of_unity(&pl) < 1e-14);
@@ -214,6 +219,19 @@ mod tests {
     #[test]
     fn block_and_lattice_grids_to_1e_14() {
         assert_within_1e_14(generators::block_grid(0.0, 1.0, 0.0, 1.0, 3, 2).unwrap());
+        // Far from the origin the functions keep the round-off of the sample
+        // points' positions (`|x| ε / h`, 1e-12 here): they are evaluated about each
+        // triangle's corner (in global coordinates, a value on an edge was off by
+        // `|x|² ε / area`, 4e-10 here).
+        let far = Linear::<f64>::new(
+            generators::block_grid(1e3, 1e3 + 1.0, 1e3, 1e3 + 1.0, 3, 2).unwrap(),
+        );
+        assert!(check::partition_of_unity(&far) < 1e-12);
+        assert!(
+            check::min_value(&far) > -1e-12,
+            "{:e}",
+            check::min_value(&far)
+        );
         assert_within_1e_14(generators::lattice_delaunay(5, 0.0, 1.0, 0.0, 1.0).unwrap());
     }
 
