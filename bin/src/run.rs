@@ -1105,10 +1105,15 @@ pub fn summary_text(summary: &Summary) -> String {
     }
     let p = &summary.phases;
     let total = (p.evaluate + p.assemble + p.solve + p.update).max(f64::MIN_POSITIVE);
+    if summary.steps == 0 {
+        // No time per step to give (a run that stopped in its first step).
+        out += &format!("wall time {:.2} s (no step completed)\n", summary.seconds);
+        return out;
+    }
     out += &format!(
         "wall time {:.2} s ({:.1} µs/step): evaluate {:.0} % · assemble {:.0} % · solve {:.0} % · update {:.0} %\n",
         summary.seconds,
-        1e6 * summary.seconds / summary.steps.max(1) as f64,
+        1e6 * summary.seconds / summary.steps as f64,
         100.0 * p.evaluate / total,
         100.0 * p.assemble / total,
         100.0 * p.solve / total,
