@@ -834,17 +834,7 @@ impl Gather {
             for (k, out) in out.iter_mut().enumerate() {
                 for &i in &self.live_list {
                     let i = i as usize;
-                    let mut sum = T::zero();
-                    let sources =
-                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
-                    for &s in &self.function_source[sources] {
-                        sum += source[s as usize * D + k];
-                    }
-                    if negate {
-                        out[i] -= sum;
-                    } else {
-                        out[i] += sum;
-                    }
+                    add_signed(&mut out[i], self.function_sum::<T, D>(source, i, k), negate);
                 }
             }
             return;
@@ -855,22 +845,33 @@ impl Gather {
                 .enumerate()
                 .for_each(|(i, o)| {
                     // A function that is not live would add `+0`.
-                    if !self.live[i] {
-                        return;
-                    }
-                    let mut sum = T::zero();
-                    let sources =
-                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
-                    for &s in &self.function_source[sources] {
-                        sum += source[s as usize * D + k];
-                    }
-                    if negate {
-                        *o -= sum;
-                    } else {
-                        *o += sum;
+                    if self.live[i] {
+                        add_signed(o, self.function_sum::<T, D>(source, i, k), negate);
                     }
                 });
         }
+    }
+
+    /// `Σ` of component `k` of the local coefficients `source` of function `i`, in
+    /// element order.
+    #[inline]
+    fn function_sum<T: Scalar, const D: usize>(&self, source: &[T], i: usize, k: usize) -> T {
+        let mut sum = T::zero();
+        let sources = self.function_start[i] as usize..self.function_start[i + 1] as usize;
+        for &s in &self.function_source[sources] {
+            sum += source[s as usize * D + k];
+        }
+        sum
+    }
+}
+
+/// `out ± sum`.
+#[inline]
+fn add_signed<T: Scalar>(out: &mut T, sum: T, negate: bool) {
+    if negate {
+        *out -= sum;
+    } else {
+        *out += sum;
     }
 }
 
