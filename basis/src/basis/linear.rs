@@ -20,13 +20,16 @@ use crate::mesh::{MirrorAxis, TriMesh, Vec2};
 use crate::scalar::Real;
 use nalgebra::Vector2;
 
+/// A triangle's first corner `V_1` and per local vertex `(λ_k(V_1), g_k)`.
+type AboutCorner<T> = (Vector2<T>, [(T, Vector2<T>); 3]);
+
 /// The piecewise-linear Lagrange basis on a [`TriMesh`].
 #[derive(Debug, Clone)]
 pub struct Linear<T: Real = f64> {
     mesh: TriMesh,
     /// Per triangle its first corner `V_1` and per local vertex `(λ_k(V_1), g_k)`:
     /// `λ_k(x) = λ_k(V_1) + g_k · (x − V_1)`.
-    affine: Vec<(Vector2<T>, [(T, Vector2<T>); 3])>,
+    affine: Vec<AboutCorner<T>>,
     /// Flattened vertex → triangles map (CSR).
     support_offsets: Vec<usize>,
     support: Vec<usize>,
