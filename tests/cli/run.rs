@@ -2408,6 +2408,41 @@ t_end = 0.01
         let dt = summary["dt"].as_f64().unwrap();
         assert!(dt > 1e-4, "{mass}: dt {dt}\n{stderr}");
     }
+    // Far from the origin (a user's block on the diagonals of 250 × 250 blocks of
+    // 0.04, at x ≈ 5, y ≈ 7): PL evaluated in global coordinates gave the functions
+    // the particles bound masses of 3e-12 to 1e-11 of the largest, and the run was
+    // refused at a critical step of 7.3e-9 for its Δt of 2e-4.
+    let far = SceneFile::new(
+        "roundoff-mass-far",
+        r#"name = "block-on-diagonals"
+dim = 2
+basis = "pl"
+mass = "lumped"
+[mesh]
+kind = "blocks"
+x = [0.0, 10.0]
+y = [0.0, 10.0]
+blocks = [250, 250]
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [4.8, 7.0]
+max = [5.2, 7.4]
+spacing = [0.05, 0.05]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+dt = 2e-4
+t_end = 0.002
+"#,
+    );
+    let (stdout, stderr) = succeeds(&["run", far.arg(), "--diag-every", "0", "--format", "json"]);
+    let summary: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let critical = summary["dt_critical"].as_f64().unwrap();
+    assert!(critical > 1e-3, "critical step {critical}\n{stderr}");
 }
 
 /// Deactivation's threshold is absolute (the thesis's 1e-2, for its columns'
