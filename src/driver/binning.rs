@@ -747,14 +747,7 @@ impl Gather {
             count.iter_mut().for_each(|v| *v = 0.0);
             for &i in &self.live_list {
                 let i = i as usize;
-                let mut sum = [0.0; 2];
-                let sources = self.function_start[i] as usize..self.function_start[i + 1] as usize;
-                for &s in &self.function_source[sources] {
-                    let s = s as usize * 2;
-                    sum[0] += local.coverage[s].to_f64();
-                    sum[1] += local.coverage[s + 1].to_f64();
-                }
-                [volume[i], count[i]] = sum;
+                [volume[i], count[i]] = self.coverage_sum(local, i);
             }
             return;
         }
@@ -764,18 +757,25 @@ impl Gather {
             .enumerate()
             .for_each(|(i, (volume, count))| {
                 // A function that is not live sums `+0`.
-                let mut sum = [0.0; 2];
-                if self.live[i] {
-                    let sources =
-                        self.function_start[i] as usize..self.function_start[i + 1] as usize;
-                    for &s in &self.function_source[sources] {
-                        let s = s as usize * 2;
-                        sum[0] += local.coverage[s].to_f64();
-                        sum[1] += local.coverage[s + 1].to_f64();
-                    }
-                }
-                [*volume, *count] = sum;
+                [*volume, *count] = if self.live[i] {
+                    self.coverage_sum(local, i)
+                } else {
+                    [0.0; 2]
+                };
             });
+    }
+
+    /// The particle volume and count of function `i` ([`Gather::coverage`]).
+    #[inline]
+    fn coverage_sum<T: Scalar, const D: usize>(&self, local: &Local<T, D>, i: usize) -> [f64; 2] {
+        let mut sum = [0.0; 2];
+        let sources = self.function_start[i] as usize..self.function_start[i + 1] as usize;
+        for &s in &self.function_source[sources] {
+            let s = s as usize * 2;
+            sum[0] += local.coverage[s].to_f64();
+            sum[1] += local.coverage[s + 1].to_f64();
+        }
+        sum
     }
 
     /// `out_{k,i} += sign · Σ` of the local coefficients of function `i`, in

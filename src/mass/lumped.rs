@@ -139,30 +139,25 @@ pub const ROUNDOFF_MASS: f64 = 1e-12;
 /// functions without mass, which the solves leave at zero. Returns the number of
 /// functions with mass left.
 pub(super) fn without_roundoff_masses<T: Scalar>(diagonal: &mut [T]) -> usize {
-    let largest = diagonal.iter().fold(T::zero(), |a, &m| a.max(m));
-    let floor = largest * T::of(ROUNDOFF_MASS);
-    let mut with_mass = 0;
-    for m in diagonal.iter_mut() {
-        if *m <= floor {
-            *m = T::zero();
-        } else {
-            with_mass += 1;
-        }
-    }
-    with_mass
+    without_roundoff_masses_in(diagonal, 0..diagonal.len())
 }
 
 /// [`without_roundoff_masses`] where only the entries `listed` may be nonzero.
 fn without_roundoff_masses_of<T: Scalar>(diagonal: &mut [T], listed: &[u32]) -> usize {
-    let largest = listed
-        .iter()
-        .fold(T::zero(), |a, &i| a.max(diagonal[i as usize]));
+    without_roundoff_masses_in(diagonal, listed.iter().map(|&i| i as usize))
+}
+
+/// [`without_roundoff_masses`] over the entries `entries` (the others zero).
+fn without_roundoff_masses_in<T: Scalar>(
+    diagonal: &mut [T],
+    entries: impl Iterator<Item = usize> + Clone,
+) -> usize {
+    let largest = entries.clone().fold(T::zero(), |a, i| a.max(diagonal[i]));
     let floor = largest * T::of(ROUNDOFF_MASS);
     let mut with_mass = 0;
-    for &i in listed {
-        let m = &mut diagonal[i as usize];
-        if *m <= floor {
-            *m = T::zero();
+    for i in entries {
+        if diagonal[i] <= floor {
+            diagonal[i] = T::zero();
         } else {
             with_mass += 1;
         }

@@ -43,7 +43,7 @@ pub struct SupportFacts {
 
 impl SupportFacts {
     /// The integrals and neighbours of `basis`; with `polynomials`, also the
-    /// polynomial coefficients (one sparse Cholesky of the Gram matrix).
+    /// polynomial coefficients.
     ///
     /// The coefficients are the basis's closed forms ([`Basis::dual_value`]) where
     /// it has them (every basis of psmpm-basis), else an L² projection: on a PS
