@@ -478,6 +478,10 @@ pub struct Gather {
     /// assignment: the live columns of that step).
     written_list: Vec<u32>,
     written_listed: bool,
+    /// The functions whose coverage sums [`Gather::coverage`] last wrote (the live
+    /// ones of that call), when `coverage_listed`: the others are zero.
+    coverage_written: Vec<u32>,
+    coverage_listed: bool,
 }
 
 /// Below this share of live functions the gathers visit the live list (one
@@ -567,6 +571,8 @@ impl Gather {
             written: vec![true; n],
             written_list: Vec::new(),
             written_listed: false,
+            coverage_written: Vec::with_capacity(n),
+            coverage_listed: false,
         }
     }
 
@@ -734,17 +740,39 @@ impl Gather {
 
     /// `volume_i = Σ` of the local particle volumes of function `i` and
     /// `count_i` likewise of the particle counts ([`Local::with_coverage`]), in
-    /// element order, in `f64`; `0` for a function that is not live.
+    /// element order, in `f64`; `0` for a function that is not live. `volume` and
+    /// `count` are the same buffers at every call (through the live list, only
+    /// the functions the last call wrote are zeroed).
     pub(super) fn coverage<T: Scalar, const D: usize>(
+        &mut self,
+        local: &Local<T, D>,
+        volume: &mut [f64],
+        count: &mut [f64],
+    ) {
+        self.coverage_sums(local, volume, count);
+        self.coverage_written.clone_from(&self.live_list);
+        self.coverage_listed = true;
+    }
+
+    /// [`Gather::coverage`]'s sums.
+    fn coverage_sums<T: Scalar, const D: usize>(
         &self,
         local: &Local<T, D>,
         volume: &mut [f64],
         count: &mut [f64],
     ) {
         if self.sparse() {
-            // Every function that is not live sums `+0`: zeroed, then the live.
-            volume.iter_mut().for_each(|v| *v = 0.0);
-            count.iter_mut().for_each(|v| *v = 0.0);
+            // Every function that is not live sums `+0`: those the last call
+            // wrote zeroed, then the live assigned.
+            if self.coverage_listed {
+                for &i in &self.coverage_written {
+                    volume[i as usize] = 0.0;
+                    count[i as usize] = 0.0;
+                }
+            } else {
+                volume.iter_mut().for_each(|v| *v = 0.0);
+                count.iter_mut().for_each(|v| *v = 0.0);
+            }
             for &i in &self.live_list {
                 let i = i as usize;
                 [volume[i], count[i]] = self.coverage_sum(local, i);

@@ -98,6 +98,10 @@ struct StrategyInputs {
     /// `live[i]`: an element holding a particle, or with one on its closure, has
     /// function `i` (with `touching`; else the gather's live functions serve).
     live: Vec<bool>,
+    /// The true entries of `live`, ascending, when the gather runs through its
+    /// live list (`live_listed`).
+    live_list: Vec<u32>,
+    live_listed: bool,
     /// Scratch of [`phases::add_affine_lumping`], one per element.
     element_affine: Vec<bool>,
     /// Scratch of [`phases::add_affine_lumping`], one per function.
@@ -119,6 +123,12 @@ impl StrategyInputs {
         }
         self.live.clear();
         self.live.extend_from_slice(gather.live());
+        let listed = gather.live_list();
+        self.live_listed = listed.is_some();
+        if let Some(list) = listed {
+            self.live_list.clear();
+            self.live_list.extend_from_slice(list);
+        }
         // Every element holds a particle: nothing more is live, nothing empty.
         if (0..basis.num_elements()).all(|e| bins.occupied(e)) {
             return;
@@ -131,10 +141,22 @@ impl StrategyInputs {
         for e in 0..basis.num_elements() {
             if !bins.occupied(e) && touching.occupied(bins, e) {
                 for &i in basis.element_functions(e) {
+                    if !self.live[i] && self.live_listed {
+                        self.live_list.push(i as u32);
+                    }
                     self.live[i] = true;
                 }
             }
         }
+        if self.live_listed {
+            self.live_list.sort_unstable();
+        }
+    }
+
+    /// The true entries of `live`, ascending, when the gather runs through its
+    /// live list.
+    fn live_list(&self) -> Option<&[u32]> {
+        self.live_listed.then_some(&self.live_list[..])
     }
 
     /// Fills `touching` for this step's particles, unless it holds them already
@@ -380,6 +402,8 @@ where
                 .then(phases::Touching::default),
             touching_current: false,
             live: Vec::new(),
+            live_list: Vec::new(),
+            live_listed: false,
             element_affine: if needs.correction == Correction::InMass {
                 vec![false; basis.num_elements()]
             } else {
@@ -1069,7 +1093,11 @@ where
                 } else {
                     self.gather.live()
                 },
-                live_list: None,
+                live_list: if self.inputs.touching.is_some() {
+                    self.inputs.live_list()
+                } else {
+                    self.gather.live_list()
+                },
                 diagonal_only: self.inputs.needs.row_sums_only,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {

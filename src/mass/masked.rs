@@ -143,11 +143,13 @@ impl<T: Scalar> Compact<T> {
         self.solver.factorize(&self.values)
     }
 
-    /// Solves for the kept rows of `rhs` (its other rows are zero, and stay so).
+    /// Solves for the kept rows of `rhs` and sets its other rows to zero (what
+    /// the masked system gives them).
     fn solve(&mut self, rhs: &mut [T]) {
         for (v, &i) in self.rhs.iter_mut().zip(&self.rows) {
             *v = rhs[i];
         }
+        rhs.iter_mut().for_each(|v| *v = T::zero());
         self.solver.solve_in_place(&mut self.rhs, 1);
         for (v, &i) in self.rhs.iter().zip(&self.rows) {
             rhs[i] = *v;
@@ -225,6 +227,11 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     /// Function → compact index, `usize::MAX` between uses; kept rows of a set.
     slot: Vec<usize>,
     kept: Vec<usize>,
+    /// The functions the last [`factorize_listed`](Self::factorize_listed)
+    /// marked, when its marks still hold: every other row is inactive and not
+    /// lumped.
+    marked: Vec<u32>,
+    marks_listed: bool,
 }
 
 impl<T: Scalar> MaskedCholesky<T> {
@@ -250,17 +257,25 @@ impl<T: Scalar> MaskedCholesky<T> {
         self.compact = self.fixed.iter().map(|_| None).collect();
         self.slot = vec![usize::MAX; n];
         self.kept = Vec::with_capacity(n);
+        self.marked = Vec::with_capacity(n);
+        self.marks_listed = false;
     }
 
     /// For each fixed set, whether its kept rows are few enough to be factorised
-    /// alone, and (re)builds their compact pattern when they changed.
-    fn choose_compact(&mut self, pattern: &SymmetricPattern) {
+    /// alone, and (re)builds their compact pattern when they changed. `listed`:
+    /// the only rows that may be kept, ascending (else every row may).
+    fn choose_compact(&mut self, pattern: &SymmetricPattern, listed: Option<&[u32]>) {
         let n = pattern.dim();
         for s in 0..self.fixed.len() {
             let fixed = &self.fixed[s];
             self.kept.clear();
-            self.kept
-                .extend((0..n).filter(|&i| !(fixed[i] || self.inactive[i])));
+            let kept = |&i: &usize| !(fixed[i] || self.inactive[i]);
+            match listed {
+                Some(list) => self
+                    .kept
+                    .extend(list.iter().map(|&i| i as usize).filter(kept)),
+                None => self.kept.extend((0..n).filter(kept)),
+            }
             if (self.kept.len() as f64) >= COMPACT_BELOW * n as f64 {
                 self.compact[s] = None;
             } else if self.compact[s].as_ref().is_none_or(|c| c.rows != self.kept) {
@@ -272,15 +287,62 @@ impl<T: Scalar> MaskedCholesky<T> {
     /// Factorises `M'` for the current [`inactive`](Self::inactive) and
     /// [`lumped`](Self::lumped) marks.
     pub fn factorize(&mut self, pattern: &SymmetricPattern, values: &[T]) -> Result<(), MassError> {
+        self.marks_listed = false;
+        self.factorize_marked(pattern, values, None)
+    }
+
+    /// [`factorize`](Self::factorize) for a body over a small part of the mesh:
+    /// every function outside `list` (ascending) has no mass and is marked
+    /// inactive, a listed one where `inactive(i)`; no row is lumped. The marks
+    /// and sums pass through the list (and the last call's), not every function;
+    /// the factor is the same.
+    pub fn factorize_listed(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        list: &[u32],
+        inactive: impl Fn(usize) -> bool,
+    ) -> Result<(), MassError> {
+        if self.marks_listed {
+            for &i in &self.marked {
+                self.inactive[i as usize] = true;
+                self.lumped[i as usize] = false;
+            }
+        } else {
+            self.inactive.iter_mut().for_each(|m| *m = true);
+            self.lumped.iter_mut().for_each(|m| *m = false);
+        }
+        for &i in list {
+            self.inactive[i as usize] = inactive(i as usize);
+        }
+        self.marked.clear();
+        self.marked.extend_from_slice(list);
+        self.marks_listed = true;
+        self.factorize_marked(pattern, values, Some(list))
+    }
+
+    /// The factorisation for the marks; `listed`: the rows outside it are inactive.
+    fn factorize_marked(
+        &mut self,
+        pattern: &SymmetricPattern,
+        values: &[T],
+        listed: Option<&[u32]>,
+    ) -> Result<(), MassError> {
         let n = pattern.dim();
-        self.choose_compact(pattern);
+        self.choose_compact(pattern, listed);
         // Masked rows get the mean active diagonal: the value does not matter for the
         // solution (their right-hand side is zero) but keeps the condition estimate
         // about the active system.
         let (mut scale, mut count) = (T::zero(), 0usize);
-        for i in (0..n).filter(|&i| !self.inactive[i]) {
-            scale += values[pattern.diagonal_position(i)];
-            count += 1;
+        let mut add = |i: usize| {
+            if !self.inactive[i] {
+                scale += values[pattern.diagonal_position(i)];
+                count += 1;
+            }
+        };
+        match listed {
+            Some(list) => list.iter().for_each(|&i| add(i as usize)),
+            None => (0..n).for_each(add),
         }
         let scale = if count > 0 {
             scale / T::of(count as f64)
@@ -328,8 +390,10 @@ impl<T: Scalar> MaskedCholesky<T> {
     }
 
     pub fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
-        self.mask(k, rhs);
         let s = self.solver_of[k];
+        if self.compact[s].is_none() {
+            self.mask(k, rhs);
+        }
         solve_one(&mut self.solvers[s], &mut self.compact[s], rhs);
         Ok(())
     }
@@ -347,8 +411,11 @@ impl<T: Scalar> MaskedCholesky<T> {
     /// [`solve`](Self::solve) for every component; two components with different
     /// fixed sets (two factorisations) are solved side by side on the pool.
     pub fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
+        // A compact system zeroes the rows it does not keep itself.
         for (k, r) in rhs.iter_mut().enumerate() {
-            self.mask(k, r);
+            if self.compact[self.solver_of[k]].is_none() {
+                self.mask(k, r);
+            }
         }
         match (rhs, self.solver_of.as_slice()) {
             ([r0, r1], &[a, b]) if a != b => {

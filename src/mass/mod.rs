@@ -457,9 +457,10 @@ pub struct StepContext<'a> {
     /// `live[i]`: an element holding a particle has function `i` (empty when not
     /// measured).
     pub live: &'a [bool],
-    /// The live functions, ascending, when the step's gathers ran through them
-    /// (a body over a small part of the mesh): every function outside the list
-    /// has only zero entries in the values. `None`: any function may have mass.
+    /// The true entries of `live`, ascending, when the step's gathers ran through
+    /// the live functions (a body over a small part of the mesh): every function
+    /// outside the list has only zero entries in the values. `None`: any function
+    /// may have mass.
     pub live_list: Option<&'a [u32]>,
     /// The values hold the row sums on the diagonal and zero elsewhere (the
     /// driver assembled only those, as [`Needs::row_sums_only`] asked).

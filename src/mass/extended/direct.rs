@@ -74,8 +74,8 @@ pub(super) struct Direct<T: Scalar> {
     slot: Vec<usize>,
     /// The free functions, ascending (compact index → function).
     free: Vec<usize>,
-    /// Columns of `E` (the transpose of its rows): for function `i`, the extended
-    /// functions `r` with `E_ri ≠ 0` and the weight.
+    /// Columns of `E` (the transpose of its rows): for the free function of
+    /// compact index `q`, the extended functions `r` with `E_ri ≠ 0` and the weight.
     by_column_ptr: Vec<usize>,
     by_column: Vec<(usize, T)>,
     cursor: Vec<usize>,
@@ -103,7 +103,7 @@ impl<T: Scalar> Direct<T> {
     pub(super) fn new(n: usize) -> Self {
         Direct {
             slot: vec![usize::MAX; n],
-            by_column_ptr: vec![0; n + 1],
+            by_column_ptr: Vec::with_capacity(n + 1),
             y: vec![T::zero(); n],
             y_mark: vec![false; n],
             acc: vec![T::zero(); n],
@@ -121,36 +121,39 @@ impl<T: Scalar> Direct<T> {
         full: &FullPattern,
     ) -> Result<(), NotPositiveDefinite> {
         self.ready = false;
-        let n = self.slot.len();
-        self.free.clear();
-        for i in 0..n {
+        // `slot` is `usize::MAX` off the last step's free functions.
+        for &i in &self.free {
             self.slot[i] = usize::MAX;
         }
+        self.free.clear();
         for &i in op.active {
             if op.free(i) {
                 self.slot[i] = self.free.len();
                 self.free.push(i);
             }
         }
-        // Columns of E restricted to the extended rows (the solved rows are the identity).
-        self.by_column_ptr.iter_mut().for_each(|v| *v = 0);
+        let m = self.free.len();
+        // Columns of E restricted to the extended rows (the solved rows are the
+        // identity), by compact index of the free function.
+        self.by_column_ptr.clear();
+        self.by_column_ptr.resize(m + 1, 0);
         for &r in op.extended {
             if op.fixed[r] {
                 continue;
             }
             for t in op.ext_ptr[r]..op.ext_ptr[r + 1] {
                 if op.free(op.ext_idx[t]) {
-                    self.by_column_ptr[op.ext_idx[t] + 1] += 1;
+                    self.by_column_ptr[self.slot[op.ext_idx[t]] + 1] += 1;
                 }
             }
         }
-        for i in 0..n {
-            self.by_column_ptr[i + 1] += self.by_column_ptr[i];
+        for q in 0..m {
+            self.by_column_ptr[q + 1] += self.by_column_ptr[q];
         }
         self.by_column.clear();
-        self.by_column.resize(self.by_column_ptr[n], (0, T::zero()));
+        self.by_column.resize(self.by_column_ptr[m], (0, T::zero()));
         self.cursor.clear();
-        self.cursor.extend_from_slice(&self.by_column_ptr[..n]);
+        self.cursor.extend_from_slice(&self.by_column_ptr[..m]);
         for &r in op.extended {
             if op.fixed[r] {
                 continue;
@@ -158,8 +161,9 @@ impl<T: Scalar> Direct<T> {
             for t in op.ext_ptr[r]..op.ext_ptr[r + 1] {
                 let i = op.ext_idx[t];
                 if op.free(i) {
-                    self.by_column[self.cursor[i]] = (r, op.ext_w[t]);
-                    self.cursor[i] += 1;
+                    let q = self.slot[i];
+                    self.by_column[self.cursor[q]] = (r, op.ext_w[t]);
+                    self.cursor[q] += 1;
                 }
             }
         }
@@ -171,7 +175,7 @@ impl<T: Scalar> Direct<T> {
             let j = self.free[q];
             // y = M (E e_j): E e_j is e_j plus the extended rows that use j.
             self.add_mass_column(op, full, j, T::one());
-            for t in self.by_column_ptr[j]..self.by_column_ptr[j + 1] {
+            for t in self.by_column_ptr[q]..self.by_column_ptr[q + 1] {
                 let (r, w) = self.by_column[t];
                 self.add_mass_column(op, full, r, w);
             }
@@ -275,12 +279,15 @@ impl<T: Scalar> Direct<T> {
             let factor = self.factor.as_mut().expect("solve after factorize");
             factor.solve_in_place(&mut self.b[..m], 1);
         }
-        x.iter_mut().for_each(|v| *v = T::zero());
+        // `x` is zero between solves: the free entries set, then restored.
         for q in 0..m {
             x[self.free[q]] = self.b[q];
         }
         // `E x` is zero off the active functions: a fill, then the active rows.
         rhs.iter_mut().for_each(|v| *v = T::zero());
         op.expand(x, rhs);
+        for &i in &self.free {
+            x[i] = T::zero();
+        }
     }
 }

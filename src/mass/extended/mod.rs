@@ -138,6 +138,11 @@ pub struct Extended<T: Scalar> {
     row_idx: Arc<[usize]>,
     values: Vec<T>,
     role: Vec<Role>,
+    /// The functions the last classification visited, ascending, unless
+    /// `visited_all`: every function outside them is [`Role::Inactive`], without
+    /// a lumped row or a sampling mark.
+    visited: Vec<u32>,
+    visited_all: bool,
     active: Vec<usize>,
     extended: Vec<usize>,
     /// The [`Role::Ghost`] functions, ascending.
@@ -215,6 +220,8 @@ impl<T: Scalar> Extended<T> {
             row_idx: Arc::from([]),
             values: Vec::new(),
             role: Vec::new(),
+            visited: Vec::new(),
+            visited_all: true,
             active: Vec::new(),
             extended: Vec::new(),
             ghosts: Vec::new(),
@@ -258,6 +265,13 @@ impl<T: Scalar> Extended<T> {
 impl<T: Scalar> Extended<T> {
     /// The roles of the step's functions from their coverage (inactive, solved,
     /// extended with their rows of `E`) and the lumped rows of the hybrid.
+    ///
+    /// With a live list (`StepContext::live_list`: a body over a small part of the
+    /// mesh) only the listed functions are classified: every other one has no
+    /// mass and is not live, so the pass over every function would make it
+    /// [`Role::Inactive`] without a lumped or sampling mark, which is what it
+    /// holds once the functions classified last step and no longer listed are
+    /// reset. The same roles, rows of `E` and report either way.
     fn classify_functions(
         &mut self,
         pattern: &SymmetricPattern,
@@ -265,60 +279,39 @@ impl<T: Scalar> Extended<T> {
         context: StepContext,
     ) -> MassReport {
         let n = pattern.dim();
+        if let Some(list) = context.live_list {
+            let live = |i: usize| context.live.get(i).copied().unwrap_or(false);
+            if self.visited_all {
+                (0..n).filter(|&i| !live(i)).for_each(|i| self.reset(i));
+            } else {
+                for t in 0..self.visited.len() {
+                    let i = self.visited[t] as usize;
+                    if !live(i) {
+                        self.reset(i);
+                    }
+                }
+            }
+            self.visited.clear();
+            self.visited.extend_from_slice(list);
+            self.visited_all = false;
+        } else {
+            self.visited_all = true;
+        }
+        let listed = std::mem::take(&mut self.visited);
         let mut report = MassReport::default();
-        for i in 0..n {
-            let d = values[pattern.diagonal_position(i)];
-            if d <= T::zero() {
-                let live = context.live.get(i).copied().unwrap_or(false);
-                // A wall's function stays at zero: a value given to it would have
-                // to satisfy the wall's constraints, which the projection imposes
-                // on the functions with mass.
-                let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
-                self.role[i] = if live && !on_wall && !self.support.coefficients.is_empty() {
-                    Role::Ghost
-                } else {
-                    Role::Inactive
-                };
-                self.lumped[i] = false;
-                self.sparse[i] = false;
-                continue;
-            }
-            report.active += 1;
-            let coverage =
-                SupportFacts::coverage_of(context.particle_volume[i], self.support.volume[i]);
-            // A wall's function extended rather than lumped (`with_walls`).
-            let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
-            let threshold = if on_wall && self.lump > self.coverage {
-                self.coverage.max(self.walls)
-            } else {
-                self.coverage
-            };
-            self.role[i] = if coverage < threshold && !self.support.coefficients.is_empty() {
-                Role::Extended
-            } else {
-                Role::Solved
-            };
-            // The worst-covered function the system solves for (the extended ones
-            // are out of it): what the system's conditioning depends on.
-            if self.role[i] == Role::Solved
-                && report.worst_coverage.is_none_or(|(_, w)| coverage < w)
-            {
-                report.worst_coverage = Some((i, coverage));
-            }
-            let sampled_by = if self.sparse[i] {
-                RESTORE_PARTICLE_COUNT
-            } else {
-                MIN_PARTICLE_COUNT
-            };
-            let sparse = context.particle_count[i] < sampled_by;
-            self.lumped[i] = self.role[i] == Role::Solved
-                && self.lump > self.coverage
-                && (coverage < self.lump || sparse);
-            self.sparse[i] = self.lumped[i] && sparse;
+        for i in each_function(self.visited_all, &listed, n) {
+            self.classify_one(
+                i,
+                values[pattern.diagonal_position(i)],
+                context,
+                &mut report,
+            );
         }
         self.ext_idx.clear();
         self.ext_w.clear();
-        for j in 0..n {
+        // Row `j` of `E` is `ext_ptr[j]..ext_ptr[j + 1]`, read only for the
+        // extended and ghost functions.
+        for j in each_function(self.visited_all, &listed, n) {
             self.ext_ptr[j] = self.ext_idx.len();
             if self.role[j] == Role::Extended {
                 if self.extend(j) {
@@ -331,9 +324,72 @@ impl<T: Scalar> Extended<T> {
             } else if self.role[j] == Role::Ghost && !self.extend(j) {
                 self.role[j] = Role::Inactive;
             }
+            self.ext_ptr[j + 1] = self.ext_idx.len();
         }
-        self.ext_ptr[n] = self.ext_idx.len();
+        self.visited = listed;
         report
+    }
+
+    /// A function outside the step's live list: no role, no lumped row, no mark.
+    fn reset(&mut self, i: usize) {
+        self.role[i] = Role::Inactive;
+        self.lumped[i] = false;
+        self.sparse[i] = false;
+    }
+
+    /// The role of function `i` of diagonal mass `d`, and its lumped row.
+    fn classify_one(&mut self, i: usize, d: T, context: StepContext, report: &mut MassReport) {
+        if d <= T::zero() {
+            let live = context.live.get(i).copied().unwrap_or(false);
+            // A wall's function stays at zero: a value given to it would have
+            // to satisfy the wall's constraints, which the projection imposes
+            // on the functions with mass.
+            let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
+            self.role[i] = if live && !on_wall && !self.support.coefficients.is_empty() {
+                Role::Ghost
+            } else {
+                Role::Inactive
+            };
+            self.lumped[i] = false;
+            self.sparse[i] = false;
+            return;
+        }
+        report.active += 1;
+        let coverage =
+            SupportFacts::coverage_of(context.particle_volume[i], self.support.volume[i]);
+        // A wall's function extended rather than lumped (`with_walls`).
+        let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
+        let threshold = if on_wall && self.lump > self.coverage {
+            self.coverage.max(self.walls)
+        } else {
+            self.coverage
+        };
+        self.role[i] = if coverage < threshold && !self.support.coefficients.is_empty() {
+            Role::Extended
+        } else {
+            Role::Solved
+        };
+        // The worst-covered function the system solves for (the extended ones
+        // are out of it): what the system's conditioning depends on.
+        if self.role[i] == Role::Solved && report.worst_coverage.is_none_or(|(_, w)| coverage < w) {
+            report.worst_coverage = Some((i, coverage));
+        }
+        let sampled_by = if self.sparse[i] {
+            RESTORE_PARTICLE_COUNT
+        } else {
+            MIN_PARTICLE_COUNT
+        };
+        let sparse = context.particle_count[i] < sampled_by;
+        self.lumped[i] = self.role[i] == Role::Solved
+            && self.lump > self.coverage
+            && (coverage < self.lump || sparse);
+        self.sparse[i] = self.lumped[i] && sparse;
+    }
+
+    /// Whether some row is lumped (only classified functions can be).
+    fn any_lumped_row(&self) -> bool {
+        let n = self.lumped.len();
+        each_function(self.visited_all, &self.visited, n).any(|i| self.lumped[i])
     }
 
     /// The reduced system `Eᵀ M E` of component `k`: its factorisation, else the
@@ -356,6 +412,10 @@ impl<T: Scalar> Extended<T> {
             let result = conjugate_gradients(&op, &self.precond[s], &b, &mut scratch);
             rhs.iter_mut().for_each(|v| *v = T::zero());
             op.expand(&scratch.x, rhs);
+            // `x` is zero between solves (`Direct::solve` relies on it).
+            for &i in op.active {
+                scratch.x[i] = T::zero();
+            }
             result
         };
         self.rhs = b;
@@ -378,6 +438,12 @@ impl<T: Scalar> Extended<T> {
             rhs[j] = value;
         }
     }
+}
+
+/// The functions `0..n` when `all`, else those of `list` (ascending).
+fn each_function(all: bool, list: &[u32], n: usize) -> impl Iterator<Item = usize> + '_ {
+    let (range, list) = if all { (0..n, &[][..]) } else { (0..0, list) };
+    range.chain(list.iter().map(|&i| i as usize))
 }
 
 impl<T: Scalar> MassStrategy<T> for Extended<T> {
@@ -428,6 +494,8 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         (self.col_ptr, self.row_idx) = pattern.shared_structure();
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
+        self.visited = Vec::with_capacity(n);
+        self.visited_all = true;
         self.lumped = vec![false; n];
         self.sparse = vec![false; n];
         self.diagonal_add = vec![T::zero(); n];
@@ -462,7 +530,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             return None;
         }
         self.classified = Some(self.classify_functions(pattern, values, context));
-        self.lumped.iter().any(|&l| l).then_some(&self.lumped[..])
+        self.any_lumped_row().then_some(&self.lumped[..])
     }
     fn factorize(
         &mut self,
@@ -482,7 +550,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 let report = self.classify_functions(pattern, values, context);
                 // Lumped rows: every off-diagonal entry of a lumped row moves onto
                 // both diagonals (row sums kept, `M' ⪰ M`).
-                if self.lumped.iter().any(|&l| l) {
+                if self.any_lumped_row() {
                     super::masked::modify_rows(
                         pattern,
                         values,
@@ -497,12 +565,15 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 report
             }
         };
-        report.lumped_rows = self.lumped.iter().filter(|&&l| l).count();
+        let listed = std::mem::take(&mut self.visited);
+        report.lumped_rows = each_function(self.visited_all, &listed, n)
+            .filter(|&i| self.lumped[i])
+            .count();
         self.any_lumped = report.lumped_rows > 0;
         self.active.clear();
         self.extended.clear();
         self.ghosts.clear();
-        for i in 0..n {
+        for i in each_function(self.visited_all, &listed, n) {
             match self.role[i] {
                 Role::Inactive => {}
                 Role::Ghost => self.ghosts.push(i),
@@ -517,33 +588,35 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         // consistent strategy solves it (bit for bit).
         self.direct = false;
         if self.extended.is_empty() {
-            for i in 0..n {
-                self.cholesky.inactive[i] = matches!(self.role[i], Role::Inactive | Role::Ghost);
-                self.cholesky.lumped[i] = false;
-            }
             let solved = if copied { &self.values[..] } else { values };
-            self.direct = self.cholesky.factorize(pattern, solved).is_ok();
+            let factorised = if self.visited_all {
+                for i in 0..n {
+                    self.cholesky.inactive[i] =
+                        matches!(self.role[i], Role::Inactive | Role::Ghost);
+                    self.cholesky.lumped[i] = false;
+                }
+                self.cholesky.factorize(pattern, solved)
+            } else {
+                let role = &self.role;
+                self.cholesky
+                    .factorize_listed(pattern, solved, &listed, |i| {
+                        matches!(role[i], Role::Inactive | Role::Ghost)
+                    })
+            };
+            self.direct = factorised.is_ok();
         }
+        self.visited = listed;
         // `Eᵀ M E` factorised per fixed set; where that fails (a pivot lost to
         // rounding), the conjugate gradients with the Jacobi preconditioner
         // `M_ii + Σ_j e_ji² M_jj`.
         if !self.direct {
             if !copied {
-                self.values.copy_from_slice(values);
-            }
-            // The solves touch only the active entries; the others stay zero.
-            let s = &mut self.scratch;
-            for v in [
-                &mut s.x,
-                &mut s.r,
-                &mut s.z,
-                &mut s.p,
-                &mut s.q,
-                &mut s.u,
-                &mut s.w,
-                &mut self.rhs,
-            ] {
-                v.iter_mut().for_each(|a| *a = T::zero());
+                // The reduced system reads the entries between active functions
+                // only, each in the column of the later one.
+                for &c in &self.active {
+                    let entries = self.col_ptr[c]..self.col_ptr[c + 1];
+                    self.values[entries.clone()].copy_from_slice(&values[entries]);
+                }
             }
             for s in 0..self.fixed.len() {
                 let mut factor = std::mem::take(&mut self.reduced_factor[s]);
@@ -553,6 +626,20 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 self.reduced_factor[s] = factor;
                 if factorised {
                     continue;
+                }
+                // The conjugate gradients touch only the active entries; the
+                // others stay zero.
+                let scratch = &mut self.scratch;
+                for v in [
+                    &mut scratch.x,
+                    &mut scratch.r,
+                    &mut scratch.z,
+                    &mut scratch.p,
+                    &mut scratch.q,
+                    &mut scratch.u,
+                    &mut scratch.w,
+                ] {
+                    v.iter_mut().for_each(|a| *a = T::zero());
                 }
                 let mut precond = std::mem::take(&mut self.precond[s]);
                 {
