@@ -208,6 +208,22 @@ pub struct NotPositiveDefinite {
 /// and the supernodal scratch costs 4 MB more.
 pub const SUPERNODAL_FROM: usize = 4096;
 
+/// A pattern of at most this many upper entries per column on average is a band
+/// (1D: three for the quadratic B-spline, two for PL1D) and is factorised as faer
+/// chooses (simplicial) at any size: its factor has no fill and no dense blocks,
+/// and a supernodal factorisation pays a dense kernel call per column of width 3.
+pub const BAND_ENTRIES_PER_COLUMN: f64 = 3.0;
+
+/// The supernodal choice for an `n × n` pattern of `nnz` upper entries
+/// ([`SUPERNODAL_FROM`], [`BAND_ENTRIES_PER_COLUMN`]).
+fn supernodal_threshold(n: usize, nnz: usize) -> SupernodalThreshold {
+    if n >= SUPERNODAL_FROM && nnz as f64 > BAND_ENTRIES_PER_COLUMN * n as f64 {
+        SupernodalThreshold::FORCE_SUPERNODAL
+    } else {
+        SupernodalThreshold::AUTO
+    }
+}
+
 /// Sparse Cholesky `A = L Lᵀ` of a symmetric positive definite matrix with a fixed
 /// [`SymmetricPattern`]: symbolic analysis once, numeric factorisation per call.
 ///
@@ -273,11 +289,7 @@ impl<T: Scalar> SparseCholesky<T> {
         let n = col_ptr.len() - 1;
         let nnz = row_idx.len();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let threshold = if n >= SUPERNODAL_FROM {
-            SupernodalThreshold::FORCE_SUPERNODAL
-        } else {
-            SupernodalThreshold::AUTO
-        };
+        let threshold = supernodal_threshold(n, nnz);
         let ordered = factorize_symbolic_cholesky(
             sym,
             Side::Upper,
@@ -500,11 +512,7 @@ mod tests {
             Side::Upper,
             SymmetricOrdering::Amd,
             CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: if n >= SUPERNODAL_FROM {
-                    SupernodalThreshold::FORCE_SUPERNODAL
-                } else {
-                    SupernodalThreshold::AUTO
-                },
+                supernodal_flop_ratio_threshold: supernodal_threshold(n, row_idx.len()),
                 ..Default::default()
             },
         )
