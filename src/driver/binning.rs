@@ -249,6 +249,26 @@ pub struct Local<T: Scalar, const D: usize> {
 /// its own sums either way, so the choice changes no bit.
 const SPARSE_ELEMENTS: f64 = 0.125;
 
+/// Tests: every pass through a list of live functions or occupied elements
+/// switched off, to compare a run against the passes over everything (the same
+/// bits are the claim, so a test running beside it is only slower).
+#[cfg(test)]
+pub(crate) static LISTS_OFF: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Whether the passes may run through lists ([`SPARSE_SHARE`], [`SPARSE_ELEMENTS`]).
+#[inline]
+pub(super) fn lists_allowed() -> bool {
+    #[cfg(test)]
+    {
+        !LISTS_OFF.load(std::sync::atomic::Ordering::Relaxed)
+    }
+    #[cfg(not(test))]
+    {
+        true
+    }
+}
+
 /// The next `len` entries of `rest` from entry `e · len` on (`consumed`: the
 /// entries already split off the front), without `unsafe`.
 fn carve<'a, T>(rest: &mut &'a mut [T], consumed: &mut usize, e: usize, len: usize) -> &'a mut [T] {
@@ -306,7 +326,9 @@ impl<T: Scalar, const D: usize> Local<T, D> {
     ) {
         let elements = self.dirty.len();
         let occupied = bins.occupied_elements();
-        if ((occupied.len() + self.dirty_list.len()) as f64) < SPARSE_ELEMENTS * elements as f64 {
+        if lists_allowed()
+            && ((occupied.len() + self.dirty_list.len()) as f64) < SPARSE_ELEMENTS * elements as f64
+        {
             self.visit.clear();
             self.visit.extend_from_slice(occupied);
             self.visit.extend_from_slice(&self.dirty_list);
@@ -602,7 +624,7 @@ impl Gather {
 
     /// Whether the gathers run through the live list ([`SPARSE_SHARE`]).
     fn sparse(&self) -> bool {
-        (self.live_list.len() as f64) < SPARSE_SHARE * self.live.len() as f64
+        lists_allowed() && (self.live_list.len() as f64) < SPARSE_SHARE * self.live.len() as f64
     }
 
     /// Which functions are live ([`Gather::mark_live`]).

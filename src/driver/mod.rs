@@ -103,7 +103,7 @@ struct StrategyInputs {
     live_list: Vec<u32>,
     live_listed: bool,
     /// Scratch of [`phases::add_affine_lumping`], one per element.
-    element_affine: Vec<bool>,
+    element_affine: phases::AffineMarks,
     /// Scratch of [`phases::add_affine_lumping`], one per function.
     function_pinned: Vec<bool>,
 }
@@ -405,9 +405,9 @@ where
             live_list: Vec::new(),
             live_listed: false,
             element_affine: if needs.correction == Correction::InMass {
-                vec![false; basis.num_elements()]
+                phases::AffineMarks::new(basis.num_elements())
             } else {
-                Vec::new()
+                phases::AffineMarks::default()
             },
             function_pinned: if needs.correction == Correction::InMass {
                 vec![false; basis.num_functions()]

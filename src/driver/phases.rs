@@ -528,13 +528,13 @@ pub enum MassMatrix {
 /// estimated, energy growth 0.19) while every element "passed" by its particles'
 /// positions. A particle on an edge or vertex keeps the whole correction only
 /// where every element around it passes ([`Touching`]), so that the choice
-/// location made among them does not matter (`element_affine`: scratch, one per
-/// element).
+/// location made among them does not matter (`marks`: one per element, visited
+/// through the occupied elements alone for a body in a mostly empty mesh).
 ///
 /// An element that does not pass but shares functions with one that does is
 /// pinned by it, and keeps the whole correction too when those shared functions'
 /// points `ξ` span an affine field (the same spread test, `pinned_by_neighbours`;
-/// `function_pinned`: scratch, one per function). Each particle of a passing
+/// `function_pinned`: scratch, one per function, false between calls). Each particle of a passing
 /// element `f` with a lumped function `i` makes every field in the null space of
 /// `M_A` affine on `f` (`gᵀc = 0` for the pairs `(i, j)`) and vanish at the
 /// particle: with `D + 1` particles not on a line, zero on all of `f`'s functions.
@@ -565,7 +565,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
     bins: &Bins,
     touching: &Touching,
-    element_affine: &mut [bool],
+    marks: &mut AffineMarks,
     function_pinned: &mut [bool],
     gather: &Gather,
     local: &mut Local<T, D>,
@@ -581,28 +581,46 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
     let theta = T::of(PLAIN_SHARE);
     let touches_lumped = |p: usize| evals.functions(p).iter().any(|&i| lumped[i as usize]);
     if !functions_affine {
-        element_affine
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(e, affine)| {
-                // The particles of the element but those on a vertex of the mesh
-                // (on the closure of two or more other elements).
-                let inside = bins.particles(e).iter();
-                let off_vertices =
-                    inside.filter(|&&p| touching.elements_of(p as usize).nth(1).is_none());
-                *affine = determines_affine(off_vertices, mass, x, element_scale[e]);
-            });
+        // The particles of element `e` but those on a vertex of the mesh (on the
+        // closure of two or more other elements) determine an affine field.
+        let own = |e: usize| {
+            let inside = bins.particles(e).iter();
+            let off_vertices =
+                inside.filter(|&&p| touching.elements_of(p as usize).nth(1).is_none());
+            determines_affine(off_vertices, mass, x, element_scale[e])
+        };
+        let occupied = bins.occupied_elements();
+        let listed = super::binning::lists_allowed()
+            && (occupied.len() as f64) < AFFINE_LISTED_BELOW * marks.affine.len() as f64;
+        if listed {
+            // An element without particles is never affine: only the occupied
+            // ones are visited, and the marks of the last step cleared.
+            marks.clear();
+            for &e in occupied {
+                if own(e as usize) {
+                    marks.set(e as usize);
+                }
+            }
+        } else {
+            marks.listed = false;
+            marks
+                .affine
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(e, affine)| *affine = own(e));
+        }
         pinned_by_neighbours(
             evals,
             bins,
-            element_affine,
+            marks,
+            listed,
             function_pinned,
             points,
             element_scale,
             lumped,
         );
     }
-    let element_affine = &*element_affine;
+    let element_affine = &marks.affine[..];
     local.for_each_element(bins, |e, (lm, g)| {
         let inside = bins.particles(e);
         if !inside.iter().any(|&p| touches_lumped(p as usize)) {
@@ -682,6 +700,54 @@ pub const AFFINE_SPREAD: f64 = 0.01;
 /// whose particles do not determine an affine field ([`add_affine_lumping`]).
 pub const PLAIN_SHARE: f64 = 0.1;
 
+/// Below this share of the elements holding particles, [`add_affine_lumping`]
+/// visits the occupied elements only (a body in a mostly empty mesh).
+const AFFINE_LISTED_BELOW: f64 = 0.125;
+
+/// [`add_affine_lumping`]'s per-element marks: the elements whose particles (or
+/// pinning neighbours) determine an affine field. A step over a few occupied
+/// elements clears only the marks the last one set.
+#[derive(Debug, Default)]
+pub struct AffineMarks {
+    affine: Vec<bool>,
+    /// The elements marked, when `listed` (else any may be).
+    marked: Vec<u32>,
+    listed: bool,
+    /// Scratch: the elements passing by their own particles.
+    passing: Vec<u32>,
+}
+
+impl AffineMarks {
+    /// Marks for `elements` elements, none set.
+    pub fn new(elements: usize) -> Self {
+        AffineMarks {
+            affine: vec![false; elements],
+            marked: Vec::with_capacity(elements),
+            listed: true,
+            passing: Vec::with_capacity(elements),
+        }
+    }
+
+    /// Every mark cleared.
+    fn clear(&mut self) {
+        if self.listed {
+            for &e in &self.marked {
+                self.affine[e as usize] = false;
+            }
+        } else {
+            self.affine.iter_mut().for_each(|a| *a = false);
+        }
+        self.marked.clear();
+        self.listed = true;
+    }
+
+    /// Element `e` marked affine (after [`AffineMarks::clear`]).
+    fn set(&mut self, e: usize) {
+        self.affine[e] = true;
+        self.marked.push(e as u32);
+    }
+}
+
 /// Whether the particles `inside` one element determine an affine field
 /// ([`add_affine_lumping`]).
 fn determines_affine<'a, T: Scalar, const D: usize>(
@@ -712,55 +778,97 @@ fn determines_affine<'a, T: Scalar, const D: usize>(
 
 /// The elements that hold particles but do not determine an affine field
 /// themselves and are pinned by a neighbour that does ([`add_affine_lumping`]):
-/// `element_affine[e]` is set for those whose functions shared with a passing
+/// the mark of element `e` is set for those whose functions shared with a passing
 /// element (one whose particles see a lumped function) have points `ξ` that pass
 /// the spread test of [`determines_affine`] (equal weights). Only the elements
 /// that passed by their own particles pin (one ring, no chain). Nothing is done
-/// in a step where every element holding particles passes.
+/// in a step where every element holding particles passes. `listed`: only the
+/// occupied elements are visited (their marks were set through `marks.set`).
+#[allow(clippy::too_many_arguments)]
 fn pinned_by_neighbours<T: Scalar, const D: usize>(
     evals: &Evaluations<T, D>,
     bins: &Bins,
-    element_affine: &mut [bool],
+    marks: &mut AffineMarks,
+    listed: bool,
     function_pinned: &mut [bool],
     points: &[SVector<T, D>],
     element_scale: &[T],
     lumped: &[bool],
 ) {
     let first = |e: usize| bins.particles(e).first().map(|&p| p as usize);
-    let degenerate = element_affine
-        .par_iter()
-        .enumerate()
-        .any(|(e, &affine)| !affine && first(e).is_some());
+    let occupied = bins.occupied_elements();
+    let degenerate = if listed {
+        occupied.iter().any(|&e| !marks.affine[e as usize])
+    } else {
+        marks
+            .affine
+            .par_iter()
+            .enumerate()
+            .any(|(e, &affine)| !affine && first(e).is_some())
+    };
     if !degenerate {
         return;
     }
-    function_pinned.iter_mut().for_each(|f| *f = false);
-    for (e, _) in element_affine.iter().enumerate().filter(|(_, &a)| a) {
-        let Some(p) = first(e) else { continue };
+    // The functions of the passing elements whose particles see a lumped function
+    // are set to pinned, and cleared again at the end (`function_pinned` is false
+    // between calls, so that a step over a few elements touches only theirs).
+    let mut passing = std::mem::take(&mut marks.passing);
+    passing.clear();
+    if listed {
+        passing.extend(occupied.iter().filter(|&&e| marks.affine[e as usize]));
+    } else {
+        passing.extend((0..marks.affine.len() as u32).filter(|&e| marks.affine[e as usize]));
+    }
+    let pins = |e: u32| {
+        let p = first(e as usize)?;
         let functions = evals.functions(p);
-        if functions.iter().any(|&i| lumped[i as usize]) {
-            for &i in functions {
-                function_pinned[i as usize] = true;
-            }
+        functions
+            .iter()
+            .any(|&i| lumped[i as usize])
+            .then_some(functions)
+    };
+    for functions in passing.iter().filter_map(|&e| pins(e)) {
+        for &i in functions {
+            function_pinned[i as usize] = true;
         }
     }
-    let function_pinned = &*function_pinned;
-    element_affine
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(e, affine)| {
-            if *affine {
-                return;
-            }
-            let Some(p) = first(e) else { return };
+    {
+        let function_pinned = &*function_pinned;
+        let pinned = |e: usize| {
+            let Some(p) = first(e) else { return false };
             let shared = evals
                 .functions(p)
                 .iter()
                 .map(|&i| i as usize)
                 .filter(|&i| function_pinned[i])
                 .map(|i| points[i]);
-            *affine = spans_affine(shared, element_scale[e]);
-        });
+            spans_affine(shared, element_scale[e])
+        };
+        if listed {
+            for &e in occupied {
+                let e = e as usize;
+                if !marks.affine[e] && pinned(e) {
+                    marks.set(e);
+                }
+            }
+        } else {
+            marks
+                .affine
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(e, affine)| {
+                    if !*affine {
+                        *affine = pinned(e);
+                    }
+                });
+        }
+    }
+    for functions in passing.iter().filter_map(|&e| pins(e)) {
+        for &i in functions {
+            function_pinned[i as usize] = false;
+        }
+    }
+    marks.passing = passing;
 }
 
 /// The points `ξ` (equal weights) pass the spread test of [`determines_affine`]:

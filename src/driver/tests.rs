@@ -284,3 +284,84 @@ fn a_body_sampled_on_the_mesh_edges_keeps_the_default_system_definite() {
     let condition = driver.mass.condition_estimate(&driver.pattern);
     assert!(condition < 1e4, "condition {condition:e}");
 }
+
+/// A small body crossing elements of a mostly empty mesh, with the default mass
+/// (extension, lumped rows, the affine-preserving term), runs through the lists of
+/// live functions and occupied elements; the same run with every list switched
+/// off passes over every function and element. The state after every step is the
+/// same to the last bit.
+#[test]
+fn a_small_body_runs_the_same_through_the_lists_as_over_the_whole_mesh() {
+    use super::binning::LISTS_OFF;
+    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
+    use std::sync::atomic::Ordering;
+    let run = |lists: bool| {
+        let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 4.0, 0.0, 4.0, 40, 40).unwrap();
+        let basis = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+        let (n, h) = (12usize, 0.035);
+        let x: Vec<_> = (0..n * n)
+            .map(|p| {
+                nalgebra::Vector2::new(
+                    1.93 + ((p % n) as f64 + 0.5) * h,
+                    2.02 + ((p / n) as f64 + 0.5) * h,
+                )
+            })
+            .collect();
+        let constants = Elastic::new(1e4, 0.3, 1e3).unwrap();
+        let mut particles = crate::particles::Particles::new(x, vec![h * h; n * n], 1e3);
+        let centre = nalgebra::Vector2::new(2.14, 2.23);
+        for p in 0..n * n {
+            let r = particles.x[p] - centre;
+            particles.v[p] = nalgebra::Vector2::new(2.0 - 3.0 * r.y, -1.0 + 3.0 * r.x);
+        }
+        let strategy = crate::mass::MassKind::default().build();
+        let mut driver = super::Driver::new(
+            basis,
+            particles,
+            NeoHookean::new(constants, 2),
+            strategy,
+            &[],
+            Vec::new(),
+            1e-3,
+        )
+        .unwrap();
+        LISTS_OFF.store(!lists, Ordering::SeqCst);
+        let mut states = Vec::new();
+        let mut listed_steps = 0;
+        for _ in 0..60 {
+            let report = driver.step().unwrap();
+            listed_steps += driver.gather.live_list().is_some() as usize;
+            let p = &driver.particles;
+            let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+            let flat = |m: &[nalgebra::Matrix2<f64>]| {
+                bits(&m.iter().flat_map(|a| a.iter().copied()).collect::<Vec<_>>())
+            };
+            let vec2 = |m: &[nalgebra::Vector2<f64>]| {
+                bits(&m.iter().flat_map(|a| a.iter().copied()).collect::<Vec<_>>())
+            };
+            states.push((
+                vec2(&p.x),
+                vec2(&p.v),
+                flat(&p.f),
+                format!("{:?}", (report.total_energy(), report.substeps)),
+            ));
+        }
+        LISTS_OFF.store(false, Ordering::SeqCst);
+        (
+            states,
+            listed_steps,
+            driver.last_report.lumped_rows + driver.last_report.extended,
+        )
+    };
+    let (listed, listed_steps, treated) = run(true);
+    let (whole, whole_steps, _) = run(false);
+    assert_eq!(
+        listed_steps, 60,
+        "the small body's steps ran through the lists"
+    );
+    assert_eq!(whole_steps, 0, "the lists were switched off");
+    assert!(treated > 0, "the default treated no function");
+    for (step, (a, b)) in listed.iter().zip(&whole).enumerate() {
+        assert!(a == b, "step {}: the states differ", step + 1);
+    }
+}
