@@ -53,17 +53,21 @@ fn hybrid_block_with(
     v: impl Fn(nalgebra::Vector2<f64>) -> nalgebra::Vector2<f64>,
     extra: &[nalgebra::Vector2<f64>],
 ) -> HybridDriver {
-    let (n, h) = (10usize, 0.05);
-    let x: Vec<_> = (0..n * n)
-        .map(|p| {
-            nalgebra::Vector2::new(
-                0.25 + ((p % n) as f64 + 0.5) * h,
-                0.25 + ((p / n) as f64 + 0.5) * h,
-            )
-        })
+    let h = 0.05;
+    let x: Vec<_> = lattice(10, h, (0.25, 0.25))
         .chain(extra.iter().copied())
         .collect();
     ps_driver(1.0, 4, x, h * h, 1e3, mass, v)
+}
+
+/// An `n × n` lattice of spacing `h`, its cells' centres, from `corner`.
+fn lattice(n: usize, h: f64, corner: (f64, f64)) -> impl Iterator<Item = nalgebra::Vector2<f64>> {
+    (0..n * n).map(move |p| {
+        nalgebra::Vector2::new(
+            corner.0 + ((p % n) as f64 + 0.5) * h,
+            corner.1 + ((p / n) as f64 + 0.5) * h,
+        )
+    })
 }
 
 /// A PS driver on `[0, extent]²` in `blocks × blocks` blocks, neo-Hookean
@@ -293,38 +297,17 @@ fn a_body_sampled_on_the_mesh_edges_keeps_the_default_system_definite() {
 #[test]
 fn a_small_body_runs_the_same_through_the_lists_as_over_the_whole_mesh() {
     use super::binning::LISTS_OFF;
-    use psmpm_basis::basis::powell_sabin::{PowellSabin, SplitPoint};
     use std::sync::atomic::Ordering;
     let run = |lists: bool| {
-        let mesh = psmpm_basis::mesh::generators::block_grid(0.0, 4.0, 0.0, 4.0, 40, 40).unwrap();
-        let basis = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
-        let (n, h) = (12usize, 0.035);
-        let x: Vec<_> = (0..n * n)
-            .map(|p| {
-                nalgebra::Vector2::new(
-                    1.93 + ((p % n) as f64 + 0.5) * h,
-                    2.02 + ((p / n) as f64 + 0.5) * h,
-                )
-            })
-            .collect();
-        let constants = Elastic::new(1e4, 0.3, 1e3).unwrap();
-        let mut particles = crate::particles::Particles::new(x, vec![h * h; n * n], 1e3);
+        let h = 0.035;
         let centre = nalgebra::Vector2::new(2.14, 2.23);
-        for p in 0..n * n {
-            let r = particles.x[p] - centre;
-            particles.v[p] = nalgebra::Vector2::new(2.0 - 3.0 * r.y, -1.0 + 3.0 * r.x);
-        }
-        let strategy = crate::mass::MassKind::default().build();
-        let mut driver = super::Driver::new(
-            basis,
-            particles,
-            NeoHookean::new(constants, 2),
-            strategy,
-            &[],
-            Vec::new(),
-            1e-3,
-        )
-        .unwrap();
+        let spin = |x: nalgebra::Vector2<f64>| {
+            let r = x - centre;
+            nalgebra::Vector2::new(2.0 - 3.0 * r.y, -1.0 + 3.0 * r.x)
+        };
+        let x = lattice(12, h, (1.93, 2.02)).collect();
+        let mut driver = ps_driver(4.0, 40, x, h * h, 1e3, "default", spin);
+        driver.set_dt(1e-3);
         LISTS_OFF.store(!lists, Ordering::SeqCst);
         let mut states = Vec::new();
         let mut listed_steps = 0;
