@@ -67,6 +67,7 @@ pub mod contact;
 pub mod diagnostics;
 pub mod driver;
 pub mod effect;
+mod last_written;
 pub mod mass;
 pub mod material;
 pub mod materials;

@@ -5,6 +5,7 @@
 //! [`super::phases`]; see its module doc for why.
 
 use super::phases::{Evaluations, CHUNK};
+use crate::last_written::LastWritten;
 use crate::sparse::{Scalar, SymmetricPattern};
 use nalgebra::SVector;
 use psmpm_basis::Basis;
@@ -496,14 +497,12 @@ pub struct Gather {
     /// Per column: its entries may be nonzero in the values last assigned by
     /// [`Gather::matrix_assign`].
     written: Vec<bool>,
-    /// The columns `written` flags, ascending, when `written_listed` (after an
-    /// assignment: the live columns of that step).
-    written_list: Vec<u32>,
-    written_listed: bool,
+    /// The columns `written` flags (after an assignment: the live columns of
+    /// that step).
+    written_list: LastWritten,
     /// The functions whose coverage sums [`Gather::coverage`] last wrote (the live
-    /// ones of that call), when `coverage_listed`: the others are zero.
-    coverage_written: Vec<u32>,
-    coverage_listed: bool,
+    /// ones of that call): the others are zero.
+    coverage_written: LastWritten,
 }
 
 /// Below this share of live functions the gathers visit the live list (one
@@ -591,10 +590,8 @@ impl Gather {
             live: vec![true; n],
             live_list: (0..n as u32).collect(),
             written: vec![true; n],
-            written_list: Vec::new(),
-            written_listed: false,
-            coverage_written: Vec::with_capacity(n),
-            coverage_listed: false,
+            written_list: LastWritten::with_capacity(n),
+            coverage_written: LastWritten::with_capacity(n),
         }
     }
 
@@ -646,7 +643,7 @@ impl Gather {
         local: &Local<T, D>,
         values: &mut [T],
     ) {
-        if self.sparse() && self.written_listed {
+        if self.sparse() && self.written_list.listed().is_some() {
             self.matrix_assign_listed(local, values);
             return;
         }
@@ -674,9 +671,7 @@ impl Gather {
             },
         );
         self.written = written;
-        self.written_list.clear();
-        self.written_list.extend_from_slice(&self.live_list);
-        self.written_listed = true;
+        self.written_list.record(&self.live_list);
     }
 
     /// [`Gather::matrix_assign`] through the live list: the columns written last
@@ -686,8 +681,7 @@ impl Gather {
         local: &Local<T, D>,
         values: &mut [T],
     ) {
-        for &c in &self.written_list {
-            let c = c as usize;
+        for c in self.written_list.each(self.live.len()) {
             if !self.live[c] {
                 let entries = self.column_start[c] as usize..self.column_start[c + 1] as usize;
                 values[entries].iter_mut().for_each(|v| *v = T::zero());
@@ -702,8 +696,7 @@ impl Gather {
             }
             self.written[c] = true;
         }
-        self.written_list.clear();
-        self.written_list.extend_from_slice(&self.live_list);
+        self.written_list.record(&self.live_list);
     }
 
     /// `values_j += Σ` of the local matrix blocks' entries `j`, in element order,
@@ -772,8 +765,7 @@ impl Gather {
         count: &mut [f64],
     ) {
         self.coverage_sums(local, volume, count);
-        self.coverage_written.clone_from(&self.live_list);
-        self.coverage_listed = true;
+        self.coverage_written.record(&self.live_list);
     }
 
     /// [`Gather::coverage`]'s sums.
@@ -786,14 +778,9 @@ impl Gather {
         if self.sparse() {
             // Every function that is not live sums `+0`: those the last call
             // wrote zeroed, then the live assigned.
-            if self.coverage_listed {
-                for &i in &self.coverage_written {
-                    volume[i as usize] = 0.0;
-                    count[i as usize] = 0.0;
-                }
-            } else {
-                volume.iter_mut().for_each(|v| *v = 0.0);
-                count.iter_mut().for_each(|v| *v = 0.0);
+            for i in self.coverage_written.each(volume.len()) {
+                volume[i] = 0.0;
+                count[i] = 0.0;
             }
             for &i in &self.live_list {
                 let i = i as usize;

@@ -20,6 +20,7 @@
 //! ([`Gather`]). Every sum therefore has one fixed order, whatever the threads.
 //! The binning and the gathers are in `driver/binning.rs`.
 
+use crate::last_written::LastWritten;
 use crate::material::det;
 use crate::materials::ParticleMaterials;
 use crate::particles::Particles;
@@ -602,7 +603,7 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
                 }
             }
         } else {
-            marks.listed = false;
+            marks.marked.record_all();
             marks
                 .affine
                 .par_iter_mut()
@@ -710,9 +711,8 @@ const AFFINE_LISTED_BELOW: f64 = 0.125;
 #[derive(Debug, Default)]
 pub struct AffineMarks {
     affine: Vec<bool>,
-    /// The elements marked, when `listed` (else any may be).
-    marked: Vec<u32>,
-    listed: bool,
+    /// The elements marked by the last pass through the occupied ones.
+    marked: LastWritten,
     /// Scratch: the elements passing by their own particles.
     passing: Vec<u32>,
 }
@@ -722,29 +722,23 @@ impl AffineMarks {
     pub fn new(elements: usize) -> Self {
         AffineMarks {
             affine: vec![false; elements],
-            marked: Vec::with_capacity(elements),
-            listed: true,
+            marked: LastWritten::with_capacity(elements),
             passing: Vec::with_capacity(elements),
         }
     }
 
-    /// Every mark cleared.
+    /// Every mark cleared, for a pass that sets them through [`AffineMarks::set`].
     fn clear(&mut self) {
-        if self.listed {
-            for &e in &self.marked {
-                self.affine[e as usize] = false;
-            }
-        } else {
-            self.affine.iter_mut().for_each(|a| *a = false);
+        for e in self.marked.each(self.affine.len()) {
+            self.affine[e] = false;
         }
-        self.marked.clear();
-        self.listed = true;
+        self.marked.begin();
     }
 
     /// Element `e` marked affine (after [`AffineMarks::clear`]).
     fn set(&mut self, e: usize) {
         self.affine[e] = true;
-        self.marked.push(e as u32);
+        self.marked.push(e);
     }
 }
 

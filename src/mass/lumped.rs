@@ -8,6 +8,7 @@
 //! `docs/stability.md`, "Round-off masses").
 
 use super::{MassError, MassReport, MassSetup, MassStrategy, Needs, StepContext};
+use crate::last_written::LastWritten;
 use crate::sparse::{Scalar, SymmetricPattern};
 
 /// Row-sum lumping: a diagonal solve.
@@ -15,10 +16,9 @@ use crate::sparse::{Scalar, SymmetricPattern};
 pub struct Lumped<T: Scalar> {
     fixed: Vec<Vec<bool>>,
     diagonal: Vec<T>,
-    /// The functions whose lumped mass may be nonzero, when the last
-    /// factorisation ran through a live list (`listed`; else any).
-    written: Vec<u32>,
-    listed: bool,
+    /// The functions whose lumped mass may be nonzero: the last factorisation's
+    /// live list, when it ran through one.
+    written: LastWritten,
     /// Scratch of the solve through `written`: its right-hand sides.
     kept: Vec<T>,
 }
@@ -43,7 +43,7 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
     fn prepare(&mut self, setup: &MassSetup) {
         self.fixed = setup.fixed.to_vec();
         self.diagonal = vec![T::zero(); setup.pattern.dim()];
-        self.listed = false;
+        self.written = LastWritten::with_capacity(setup.pattern.dim());
     }
     fn factorize(
         &mut self,
@@ -55,27 +55,21 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
             // A body over a small part of the mesh: the masses outside the live
             // list are zero, those of the last list are zeroed (the same masses
             // as the pass over every function, without it).
-            if self.listed {
-                for &i in &self.written {
-                    self.diagonal[i as usize] = T::zero();
-                }
-            } else {
-                self.diagonal.iter_mut().for_each(|d| *d = T::zero());
+            for i in self.written.each(self.diagonal.len()) {
+                self.diagonal[i] = T::zero();
             }
             for &i in live {
                 self.diagonal[i as usize] = values[pattern.diagonal_position(i as usize)];
             }
             let active = without_roundoff_masses_of(&mut self.diagonal, live);
-            self.written.clear();
-            self.written.extend_from_slice(live);
-            self.listed = true;
+            self.written.record(live);
             return Ok(MassReport {
                 active,
                 lumped_rows: active,
                 ..MassReport::default()
             });
         }
-        self.listed = false;
+        self.written.record_all();
         if context.diagonal_only {
             // The same sums without the pass over the whole pattern, whose other
             // entries are zero: in a mostly empty mesh that pass was a quarter
@@ -94,16 +88,15 @@ impl<T: Scalar> MassStrategy<T> for Lumped<T> {
         })
     }
     fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
-        if self.listed {
+        if let Some(written) = self.written.listed() {
             // Every function outside the list has no mass and solves to zero:
             // the list's right-hand sides kept, the rest zeroed at once (the same
             // bits as the division pass over every function, which in a mostly
             // empty mesh was a seventh of the step).
             self.kept.clear();
-            self.kept
-                .extend(self.written.iter().map(|&i| rhs[i as usize]));
+            self.kept.extend(written.iter().map(|&i| rhs[i as usize]));
             rhs.iter_mut().for_each(|r| *r = T::zero());
-            for (&i, &r) in self.written.iter().zip(&self.kept) {
+            for (&i, &r) in written.iter().zip(&self.kept) {
                 let (i, m) = (i as usize, self.diagonal[i as usize]);
                 if !self.fixed[k][i] && m > T::zero() {
                     rhs[i] = r / m;

@@ -7,6 +7,7 @@
 
 use super::condition::{estimate, Operator};
 use super::{distinct_fixed_sets, MassError, MassSetup};
+use crate::last_written::LastWritten;
 use crate::sparse::{mul_upper, NotPositiveDefinite, Scalar, SparseCholesky, SymmetricPattern};
 use rayon::prelude::*;
 
@@ -228,10 +229,9 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     slot: Vec<usize>,
     kept: Vec<usize>,
     /// The functions the last [`factorize_listed`](Self::factorize_listed)
-    /// marked, when its marks still hold: every other row is inactive and not
-    /// lumped.
-    marked: Vec<u32>,
-    marks_listed: bool,
+    /// marked, while its marks hold: every other row is inactive and not lumped
+    /// (any row may be marked after [`factorize`](Self::factorize)).
+    marked: LastWritten,
 }
 
 impl<T: Scalar> MaskedCholesky<T> {
@@ -257,8 +257,7 @@ impl<T: Scalar> MaskedCholesky<T> {
         self.compact = self.fixed.iter().map(|_| None).collect();
         self.slot = vec![usize::MAX; n];
         self.kept = Vec::with_capacity(n);
-        self.marked = Vec::with_capacity(n);
-        self.marks_listed = false;
+        self.marked = LastWritten::with_capacity(n);
     }
 
     /// For each fixed set, whether its kept rows are few enough to be factorised
@@ -287,7 +286,7 @@ impl<T: Scalar> MaskedCholesky<T> {
     /// Factorises `M'` for the current [`inactive`](Self::inactive) and
     /// [`lumped`](Self::lumped) marks.
     pub fn factorize(&mut self, pattern: &SymmetricPattern, values: &[T]) -> Result<(), MassError> {
-        self.marks_listed = false;
+        self.marked.record_all();
         self.factorize_marked(pattern, values, None)
     }
 
@@ -303,21 +302,14 @@ impl<T: Scalar> MaskedCholesky<T> {
         list: &[u32],
         inactive: impl Fn(usize) -> bool,
     ) -> Result<(), MassError> {
-        if self.marks_listed {
-            for &i in &self.marked {
-                self.inactive[i as usize] = true;
-                self.lumped[i as usize] = false;
-            }
-        } else {
-            self.inactive.iter_mut().for_each(|m| *m = true);
-            self.lumped.iter_mut().for_each(|m| *m = false);
+        for i in self.marked.each(self.inactive.len()) {
+            self.inactive[i] = true;
+            self.lumped[i] = false;
         }
         for &i in list {
             self.inactive[i as usize] = inactive(i as usize);
         }
-        self.marked.clear();
-        self.marked.extend_from_slice(list);
-        self.marks_listed = true;
+        self.marked.record(list);
         self.factorize_marked(pattern, values, Some(list))
     }
 

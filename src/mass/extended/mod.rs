@@ -45,6 +45,7 @@ use super::{
     distinct_fixed_sets, Correction, MassError, MassReport, MassSetup, MassStrategy, Needs,
     StepContext, SupportFacts,
 };
+use crate::last_written::LastWritten;
 use crate::sparse::{Scalar, SymmetricPattern};
 use direct::{Direct, FullPattern};
 use solve::{conjugate_gradients, Reduced, Scratch};
@@ -138,11 +139,10 @@ pub struct Extended<T: Scalar> {
     row_idx: Arc<[usize]>,
     values: Vec<T>,
     role: Vec<Role>,
-    /// The functions the last classification visited, ascending, unless
-    /// `visited_all`: every function outside them is [`Role::Inactive`], without
-    /// a lumped row or a sampling mark.
-    visited: Vec<u32>,
-    visited_all: bool,
+    /// The functions the last classification visited (its live list, ascending,
+    /// when it had one): every function outside them is [`Role::Inactive`],
+    /// without a lumped row or a sampling mark.
+    visited: LastWritten,
     active: Vec<usize>,
     extended: Vec<usize>,
     /// The [`Role::Ghost`] functions, ascending.
@@ -220,8 +220,7 @@ impl<T: Scalar> Extended<T> {
             row_idx: Arc::from([]),
             values: Vec::new(),
             role: Vec::new(),
-            visited: Vec::new(),
-            visited_all: true,
+            visited: LastWritten::default(),
             active: Vec::new(),
             extended: Vec::new(),
             ghosts: Vec::new(),
@@ -279,27 +278,18 @@ impl<T: Scalar> Extended<T> {
         context: StepContext,
     ) -> MassReport {
         let n = pattern.dim();
+        let mut visited = std::mem::take(&mut self.visited);
         if let Some(list) = context.live_list {
             let live = |i: usize| context.live.get(i).copied().unwrap_or(false);
-            if self.visited_all {
-                (0..n).filter(|&i| !live(i)).for_each(|i| self.reset(i));
-            } else {
-                for t in 0..self.visited.len() {
-                    let i = self.visited[t] as usize;
-                    if !live(i) {
-                        self.reset(i);
-                    }
-                }
+            for i in visited.each(n).filter(|&i| !live(i)) {
+                self.reset(i);
             }
-            self.visited.clear();
-            self.visited.extend_from_slice(list);
-            self.visited_all = false;
+            visited.record(list);
         } else {
-            self.visited_all = true;
+            visited.record_all();
         }
-        let listed = std::mem::take(&mut self.visited);
         let mut report = MassReport::default();
-        for i in each_function(self.visited_all, &listed, n) {
+        for i in visited.each(n) {
             self.classify_one(
                 i,
                 values[pattern.diagonal_position(i)],
@@ -311,7 +301,7 @@ impl<T: Scalar> Extended<T> {
         self.ext_w.clear();
         // Row `j` of `E` is `ext_ptr[j]..ext_ptr[j + 1]`, read only for the
         // extended and ghost functions.
-        for j in each_function(self.visited_all, &listed, n) {
+        for j in visited.each(n) {
             self.ext_ptr[j] = self.ext_idx.len();
             if self.role[j] == Role::Extended {
                 if self.extend(j) {
@@ -326,7 +316,7 @@ impl<T: Scalar> Extended<T> {
             }
             self.ext_ptr[j + 1] = self.ext_idx.len();
         }
-        self.visited = listed;
+        self.visited = visited;
         report
     }
 
@@ -388,8 +378,7 @@ impl<T: Scalar> Extended<T> {
 
     /// Whether some row is lumped (only classified functions can be).
     fn any_lumped_row(&self) -> bool {
-        let n = self.lumped.len();
-        each_function(self.visited_all, &self.visited, n).any(|i| self.lumped[i])
+        self.visited.each(self.lumped.len()).any(|i| self.lumped[i])
     }
 
     /// The reduced system `Eᵀ M E` of component `k`: its factorisation, else the
@@ -440,12 +429,6 @@ impl<T: Scalar> Extended<T> {
     }
 }
 
-/// The functions `0..n` when `all`, else those of `list` (ascending).
-fn each_function(all: bool, list: &[u32], n: usize) -> impl Iterator<Item = usize> + '_ {
-    let (range, list) = if all { (0..n, &[][..]) } else { (0..0, list) };
-    range.chain(list.iter().map(|&i| i as usize))
-}
-
 impl<T: Scalar> MassStrategy<T> for Extended<T> {
     fn spec(&self) -> String {
         let hybrid = self.correction.hybrid_name();
@@ -494,8 +477,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         (self.col_ptr, self.row_idx) = pattern.shared_structure();
         self.values = vec![T::zero(); pattern.nnz()];
         self.role = vec![Role::Inactive; n];
-        self.visited = Vec::with_capacity(n);
-        self.visited_all = true;
+        self.visited = LastWritten::with_capacity(n);
         self.lumped = vec![false; n];
         self.sparse = vec![false; n];
         self.diagonal_add = vec![T::zero(); n];
@@ -565,15 +547,13 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
                 report
             }
         };
-        let listed = std::mem::take(&mut self.visited);
-        report.lumped_rows = each_function(self.visited_all, &listed, n)
-            .filter(|&i| self.lumped[i])
-            .count();
+        let visited = std::mem::take(&mut self.visited);
+        report.lumped_rows = visited.each(n).filter(|&i| self.lumped[i]).count();
         self.any_lumped = report.lumped_rows > 0;
         self.active.clear();
         self.extended.clear();
         self.ghosts.clear();
-        for i in each_function(self.visited_all, &listed, n) {
+        for i in visited.each(n) {
             match self.role[i] {
                 Role::Inactive => {}
                 Role::Ghost => self.ghosts.push(i),
@@ -589,23 +569,25 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.direct = false;
         if self.extended.is_empty() {
             let solved = if copied { &self.values[..] } else { values };
-            let factorised = if self.visited_all {
-                for i in 0..n {
-                    self.cholesky.inactive[i] =
-                        matches!(self.role[i], Role::Inactive | Role::Ghost);
-                    self.cholesky.lumped[i] = false;
-                }
-                self.cholesky.factorize(pattern, solved)
-            } else {
-                let role = &self.role;
-                self.cholesky
-                    .factorize_listed(pattern, solved, &listed, |i| {
+            let factorised = match visited.listed() {
+                Some(list) => {
+                    let role = &self.role;
+                    self.cholesky.factorize_listed(pattern, solved, list, |i| {
                         matches!(role[i], Role::Inactive | Role::Ghost)
                     })
+                }
+                None => {
+                    for i in 0..n {
+                        self.cholesky.inactive[i] =
+                            matches!(self.role[i], Role::Inactive | Role::Ghost);
+                        self.cholesky.lumped[i] = false;
+                    }
+                    self.cholesky.factorize(pattern, solved)
+                }
             };
             self.direct = factorised.is_ok();
         }
-        self.visited = listed;
+        self.visited = visited;
         // `Eᵀ M E` factorised per fixed set; where that fails (a pivot lost to
         // rounding), the conjugate gradients with the Jacobi preconditioner
         // `M_ii + Σ_j e_ji² M_jj`.
