@@ -247,8 +247,9 @@ pub struct Local<T: Scalar, const D: usize> {
 /// Below this share of elements occupied (now or at the last visit) the element
 /// loops go through the lists of those elements, on one thread, instead of every
 /// element on the pool: a body in a mostly empty mesh. Each element's blocks are
-/// its own sums either way, so the choice changes no bit.
-const SPARSE_ELEMENTS: f64 = 0.125;
+/// its own sums either way, so the choice changes no bit. The affine-preserving
+/// lumping's tests of the occupied elements take the same choice.
+pub(super) const SPARSE_ELEMENTS: f64 = 0.125;
 
 /// Tests: every pass through a list of live functions or occupied elements
 /// switched off, to compare a run against the passes over everything (the same

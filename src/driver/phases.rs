@@ -592,7 +592,8 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
         };
         let occupied = bins.occupied_elements();
         let listed = super::binning::lists_allowed()
-            && (occupied.len() as f64) < AFFINE_LISTED_BELOW * marks.affine.len() as f64;
+            && (occupied.len() as f64)
+                < super::binning::SPARSE_ELEMENTS * marks.affine.len() as f64;
         if listed {
             // An element without particles is never affine: only the occupied
             // ones are visited, and the marks of the last step cleared.
@@ -700,10 +701,6 @@ pub const AFFINE_SPREAD: f64 = 0.01;
 /// The share `θ` of the plain pair term `(e_i − e_j)(e_i − e_j)ᵀ` in the elements
 /// whose particles do not determine an affine field ([`add_affine_lumping`]).
 pub const PLAIN_SHARE: f64 = 0.1;
-
-/// Below this share of the elements holding particles, [`add_affine_lumping`]
-/// visits the occupied elements only (a body in a mostly empty mesh).
-const AFFINE_LISTED_BELOW: f64 = 0.125;
 
 /// [`add_affine_lumping`]'s per-element marks: the elements whose particles (or
 /// pinning neighbours) determine an affine field. A step over a few occupied
