@@ -153,6 +153,9 @@ impl<T: Real, const D: usize, B: Basis<T, D>> Basis<T, D> for PerBody<B> {
     fn max_functions_per_element(&self) -> usize {
         self.base.max_functions_per_element()
     }
+    fn element_cache_len(&self) -> usize {
+        self.base.element_cache_len()
+    }
     fn locate(&self, x: &Point<T, D>, hint: Option<usize>) -> Option<usize> {
         let offset = hint.map_or(0, |h| h / self.elements * self.elements);
         self.base

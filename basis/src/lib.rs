@@ -50,6 +50,6 @@ pub mod refinement;
 pub mod rng;
 pub mod scalar;
 
-pub use basis::{Basis, BasisError, BasisEval, Constraint, Point, Quadratic};
+pub use basis::{Basis, BasisError, BasisEval, Constraint, ElementCache, Point, Quadratic};
 pub use mesh::{Mesh1d, MeshError, TriMesh, Vec2};
 pub use scalar::Real;

@@ -37,6 +37,9 @@ pub struct BasisEval<T: Real, const D: usize> {
     pub phi: Vec<T>,
     /// Gradients `grad phi_i(x)`.
     pub grad_phi: Vec<Point<T, D>>,
+    /// What the basis keeps between evaluations in one element
+    /// ([`Basis::element_cache_len`]).
+    pub cache: ElementCache<T>,
 }
 
 impl<T: Real, const D: usize> BasisEval<T, D> {
@@ -47,11 +50,14 @@ impl<T: Real, const D: usize> BasisEval<T, D> {
             index: vec![0; capacity],
             phi: vec![T::zero(); capacity],
             grad_phi: vec![Point::<T, D>::zeros(); capacity],
+            cache: ElementCache::default(),
         }
     }
-    /// A buffer sized for `basis`.
+    /// A buffer sized for `basis`, with room for its [`ElementCache`].
     pub fn for_basis<B: Basis<T, D> + ?Sized>(basis: &B) -> Self {
-        Self::with_capacity(basis.max_functions_per_element())
+        let mut eval = Self::with_capacity(basis.max_functions_per_element());
+        eval.cache = ElementCache::with_len(basis.element_cache_len());
+        eval
     }
     /// Number of valid entries.
     #[inline]
@@ -76,6 +82,69 @@ impl<T: Real, const D: usize> BasisEval<T, D> {
     #[inline]
     pub fn iter(&self) -> impl Iterator<Item = (usize, T, &Point<T, D>)> + '_ {
         (0..self.len).map(move |k| (self.index[k], self.phi[k], &self.grad_phi[k]))
+    }
+}
+
+/// Data a basis derives from its stored element data once per element and reuses
+/// for the next points of the same element (the PS pieces' monomials, derived from
+/// the Bézier ordinates): the driver evaluates the particles element by element, so
+/// the data is derived once for all of an element's particles. Held in parts
+/// (the PS sub-triangles), each derived on first use; the key is the basis (an id
+/// its constructor draws, [`ElementCache::new_owner`]) and the element. Empty
+/// (no room) for a buffer made by [`BasisEval::with_capacity`]: the basis then
+/// derives what it needs at every point, with the same result.
+#[derive(Debug, Clone, Default)]
+pub struct ElementCache<T> {
+    owner: u64,
+    element: usize,
+    ready: u64,
+    data: Vec<T>,
+}
+
+impl<T: Real> ElementCache<T> {
+    /// Room for `len` values.
+    pub fn with_len(len: usize) -> Self {
+        ElementCache {
+            owner: 0,
+            element: usize::MAX,
+            ready: 0,
+            data: vec![T::zero(); len],
+        }
+    }
+
+    /// A fresh owner id for a basis's cached data (never 0, never repeated in a
+    /// process), so that a buffer used with two bases never mixes their data.
+    pub fn new_owner() -> u64 {
+        use std::sync::atomic::{AtomicU64, Ordering};
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    }
+
+    /// Part `part` (`len` values, `part < 64`) of the data of `owner`'s `element`:
+    /// written by `derive` on first use since the buffer last held another element;
+    /// `None` when the buffer has no room for it.
+    #[inline]
+    pub fn part(
+        &mut self,
+        owner: u64,
+        element: usize,
+        part: usize,
+        len: usize,
+        derive: impl FnOnce(&mut [T]),
+    ) -> Option<&[T]> {
+        let range = part * len..(part + 1) * len;
+        if range.end > self.data.len() || part >= 64 {
+            return None;
+        }
+        if self.owner != owner || self.element != element {
+            (self.owner, self.element, self.ready) = (owner, element, 0);
+        }
+        let data = &mut self.data[range];
+        if self.ready & (1 << part) == 0 {
+            derive(data);
+            self.ready |= 1 << part;
+        }
+        Some(data)
     }
 }
 
@@ -145,6 +214,8 @@ pub enum BasisError {
     SliverSplit { t1: usize, t2: usize },
     #[error("no control triangle found for vertex {vertex}")]
     NoControlTriangle { vertex: usize },
+    #[error("the Powell–Sabin functions of triangle {triangle} are not finite: its geometry or a control triangle of its vertices is degenerate (a triangle of almost no area); remesh without it, or use the `pl` basis")]
+    NonFiniteElement { triangle: usize },
     #[error("invalid basis parameter: {0}")]
     InvalidParameter(String),
 }
@@ -166,6 +237,11 @@ pub trait Basis<T: Real, const D: usize>: Sync {
     fn num_elements(&self) -> usize;
     /// Largest number of functions non-zero on one element (the [`BasisEval`] capacity).
     fn max_functions_per_element(&self) -> usize;
+    /// Values the basis keeps in an [`ElementCache`] between evaluations in one
+    /// element (0: none).
+    fn element_cache_len(&self) -> usize {
+        0
+    }
     /// The element containing `x`, starting the search at `hint` (e.g. a particle's
     /// previous element). `None` when `x` lies outside the mesh.
     fn locate(&self, x: &Point<T, D>, hint: Option<usize>) -> Option<usize>;

@@ -70,6 +70,79 @@ pub fn hermite_ordinates(tri: &MainTriangle, f: [f64; 3], g: [Vec2; 3]) -> [[f64
     out
 }
 
+/// The ordinates of a function of vertex `V_k` that can be non-zero, of the 19 of
+/// its Hermite interpolant: the function's value and gradient vanish at the other
+/// two vertices, so its ordinates at them, at their `M` and `S` points, and at the
+/// `R` and `T` points of the edge between them are exactly zero (`+0.0`, 10 of
+/// the 19). The nine kept: `[b(V_k), b(S_k), b(M_k), b(M'_k), b(R_k), b(R_{k−1}),
+/// b(T_k), b(T_{k−1}), b(Z)]`, with `M_k` the `M` point of edge `k` (from `V_k`)
+/// and `M'_k` that of edge `k − 1` (into `V_k`). A ninth of the storage of the
+/// sub-triangles' 36 monomials per function, and [`expand`] gives back the
+/// sub-triangles' ordinates bit for bit ([`compact`]).
+pub type VertexOrdinates = [f64; 9];
+
+/// Marks an ordinate that is exactly zero in [`PLACES`].
+const ZERO: u8 = 9;
+
+/// `PLACES[k][s][j]`: where ordinate `j` (in [`BERNSTEIN_ORDER`]) of sub-triangle
+/// `s` of a function of vertex `k` is kept in its [`VertexOrdinates`], or `ZERO`;
+/// the layout of [`hermite_ordinates`].
+const PLACES: [[[u8; 6]; 6]; 3] = [places(0), places(1), places(2)];
+
+const fn places(k: usize) -> [[u8; 6]; 6] {
+    const fn pick(here: bool, place: u8) -> u8 {
+        if here {
+            place
+        } else {
+            ZERO
+        }
+    }
+    let before = (k + 2) % 3;
+    let mut out = [[ZERO; 6]; 6];
+    let mut m = 0;
+    while m < 3 {
+        let n = (m + 1) % 3;
+        let r = if m == k { 4 } else { pick(m == before, 5) };
+        let t = if m == k { 6 } else { pick(m == before, 7) };
+        // (V_m, R_m, Z): [f_m, r_m, z, m_near_m, t_m, s_m].
+        out[2 * m] = [pick(m == k, 0), r, 8, pick(m == k, 2), t, pick(m == k, 1)];
+        // (R_m, V_n, Z): [r_m, f_n, z, m_far_m, s_n, t_m].
+        out[2 * m + 1] = [r, pick(n == k, 0), 8, pick(n == k, 3), pick(n == k, 1), t];
+        m += 1;
+    }
+    out
+}
+
+/// The [`VertexOrdinates`] of the sub-triangles' ordinates `b` of a function of
+/// vertex `k` ([`hermite_ordinates`] with Hermite data at `V_k` only). `None` if
+/// an ordinate taken as zero is not `+0.0` or two copies of one differ (Hermite
+/// data at another vertex).
+pub fn compact(b: &[[f64; 6]; 6], k: usize) -> Option<VertexOrdinates> {
+    let mut kept = [f64::NAN; 9];
+    for (s, places) in PLACES[k].iter().enumerate() {
+        for (j, &place) in places.iter().enumerate() {
+            match place {
+                ZERO if b[s][j].to_bits() != 0 => return None,
+                ZERO => {}
+                _ => kept[place as usize] = b[s][j],
+            }
+        }
+    }
+    (0..6)
+        .all(|s| expand(&kept, k, s).map(f64::to_bits) == b[s].map(f64::to_bits))
+        .then_some(kept)
+}
+
+/// The ordinates of sub-triangle `s` (in [`BERNSTEIN_ORDER`]) of a function of
+/// vertex `k` kept as `kept`: [`hermite_ordinates`]' `b[s]`, bit for bit.
+#[inline(always)]
+pub fn expand(kept: &VertexOrdinates, k: usize, s: usize) -> [f64; 6] {
+    PLACES[k][s].map(|place| match place {
+        ZERO => 0.0,
+        _ => kept[place as usize],
+    })
+}
+
 /// The six quadratic Bernstein polynomials at barycentric `tau`, in [`BERNSTEIN_ORDER`],
 /// and their derivatives with respect to `tau_0, tau_1, tau_2`.
 #[inline]
@@ -102,6 +175,32 @@ mod tests {
     use super::*;
     use crate::mesh::barycentric;
     use crate::rng::SplitMix64;
+
+    /// The kept ordinates give back every sub-triangle's ordinates bit for bit, for
+    /// Hermite data at each vertex alone, and refuse data at two vertices.
+    #[test]
+    fn kept_ordinates_expand_to_the_hermite_ordinates_bit_for_bit() {
+        let mut rng = SplitMix64(11);
+        for _ in 0..200 {
+            let tri = random_geometry(&mut rng);
+            for k in 0..3 {
+                let mut f = [0.0; 3];
+                let mut g = [Vec2::zeros(); 3];
+                f[k] = rng.next_f64() - 0.3;
+                g[k] = Vec2::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5) * 4.0;
+                let b = hermite_ordinates(&tri, f, g);
+                let kept = compact(&b, k).expect("data at one vertex is kept");
+                for (s, b) in b.iter().enumerate() {
+                    assert_eq!(expand(&kept, k, s).map(f64::to_bits), b.map(f64::to_bits));
+                }
+                // 16 of the 36 sub-triangle ordinates are the 10 zero ones.
+                let zeros = b.iter().flatten().filter(|v| v.to_bits() == 0).count();
+                assert!(zeros >= 16, "{zeros} zero ordinates");
+                f[(k + 1) % 3] = 0.5;
+                assert!(compact(&hermite_ordinates(&tri, f, g), k).is_none());
+            }
+        }
+    }
 
     /// Value and gradient at `x` of the quadratic with ordinates `b` on the triangle
     /// `p` (extended outside it).

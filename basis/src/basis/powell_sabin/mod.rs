@@ -16,9 +16,13 @@
 //!
 //! Evaluation ([`Basis::eval`]) locates the sub-triangle by three sign tests
 //! ([`Refinement::sub_triangle_of`]) and evaluates the nine functions' quadratics
-//! on it, each converted once from its Bézier ordinates to monomials in
-//! `x − P_0` (`P_0` a corner of the sub-triangle, [`monomials`]): nine flops for a
-//! value and gradient, no allocation, no search.
+//! on it as monomials in the sub-triangle's barycentric coordinates
+//! ([`monomials`]): nine flops for a value and gradient, no allocation, no search.
+//! Each element keeps only the nine Bézier ordinates of each function that can be
+//! non-zero ([`bezier::VertexOrdinates`], 648 bytes per triangle instead of 2 592
+//! for the 6 × 9 × 6 monomials); a sub-triangle's monomials are derived when a
+//! point first falls in it and kept in the caller's [`ElementCache`] for the next
+//! points of the element (the driver evaluates element by element).
 //!
 //! Function `3 i + q` belongs to vertex `i` and control point `Q_i^{q+1}`. The basis
 //! is a partition of unity, non-negative (every ordinate is a barycentric coordinate
@@ -36,14 +40,14 @@
 pub mod bezier;
 pub mod control_triangle;
 
-use super::{Basis, BasisError, BasisEval, Constraint, Point, Quadratic};
+use super::{Basis, BasisError, BasisEval, Constraint, ElementCache, Point, Quadratic};
 use crate::mesh::{TriMesh, Vec2};
 use crate::refinement::Refinement;
 pub use crate::refinement::SplitPoint;
 use crate::scalar::Real;
 #[cfg(doc)]
 use bezier::bernstein;
-use bezier::{hermite_ordinates, MainTriangle};
+use bezier::{hermite_ordinates, MainTriangle, VertexOrdinates};
 pub use control_triangle::MirrorAxis;
 use control_triangle::{control_triangle_with, HalfPlane, VertexKind};
 use nalgebra::Vector2;
@@ -142,11 +146,13 @@ struct ElementData<T: Real> {
     r_lambda: [T; 3],
     /// Sub-triangle barycentric coordinates.
     tau: [LocalCoordinates<T>; 6],
-    /// `poly[s][f]`: local function `f` on sub-triangle `s` as the monomial
-    /// coefficients in the sub-triangle's `τ_1, τ_2` ([`monomials`] of its Bézier
-    /// ordinates).
-    poly: [[[T; 6]; 9]; 6],
+    /// `ordinates[f]`: the Bézier ordinates of local function `f` (of vertex
+    /// `f / 3`) that can be non-zero ([`bezier::expand`] gives each sub-triangle's).
+    ordinates: [VertexOrdinates; 9],
 }
+
+/// Values of one sub-triangle's monomials in the [`ElementCache`]: 6 per function.
+const PIECE_LEN: usize = 6 * 9;
 
 /// The quadratic `Σ_{|ijk|=2} b_ijk B_ijk(τ)` of a triangle in its barycentric
 /// coordinates `τ_1, τ_2` (`τ_0 = 1 − τ_1 − τ_2`), as the monomial coefficients
@@ -187,6 +193,8 @@ pub struct PowellSabin<T: Real = f64> {
     elements: Vec<ElementData<T>>,
     support_offsets: Vec<usize>,
     support: Vec<usize>,
+    /// This basis's key in the callers' [`ElementCache`]s.
+    cache_owner: u64,
 }
 
 impl<T: Real> PowellSabin<T> {
@@ -194,7 +202,8 @@ impl<T: Real> PowellSabin<T> {
     ///
     /// Errors: [`BasisError::InvalidSplitPoint`] for centroids on a mesh where they
     /// are not valid; [`BasisError::NoControlTriangle`] if no control triangle can be
-    /// found (not expected on a valid mesh).
+    /// found (not expected on a valid mesh); [`BasisError::NonFiniteElement`] for a
+    /// triangle whose functions are not finite (degenerate geometry).
     pub fn new(mesh: TriMesh, split: SplitPoint) -> Result<Self, BasisError> {
         Self::with_mirror(mesh, split, MirrorAxis::Vertical)
     }
@@ -240,7 +249,7 @@ impl<T: Real> PowellSabin<T> {
                 r_lambda: std::array::from_fn(|m| refinement.local_edge_lambdas(&mesh, t, m).0),
             };
             let subs = refinement.sub_triangles(&mesh, t);
-            let mut poly = [[[T::zero(); 6]; 9]; 6];
+            let mut ordinates = [[0.0; 9]; 9];
             for k in 0..3 {
                 let tr = &triplets[tri[k]];
                 for q in 0..3 {
@@ -249,9 +258,10 @@ impl<T: Real> PowellSabin<T> {
                     f[k] = tr.alpha[q];
                     g[k] = Vec2::new(tr.beta[q], tr.gamma[q]);
                     let b = hermite_ordinates(&geometry, f, g);
-                    for s in 0..6 {
-                        poly[s][3 * k + q] = monomials(b[s]).map(T::of);
-                    }
+                    // Hermite data at V_k alone: the other ordinates are +0.0 (not
+                    // where the geometry is not finite: 0 · ∞).
+                    ordinates[3 * k + q] = bezier::compact(&b, k)
+                        .ok_or(BasisError::NonFiniteElement { triangle: t })?;
                 }
             }
             elements.push(ElementData {
@@ -259,7 +269,7 @@ impl<T: Real> PowellSabin<T> {
                 z_bary: geometry.z_bary.map(T::of),
                 r_lambda: geometry.r_lambda.map(T::of),
                 tau: std::array::from_fn(|s| LocalCoordinates::new(subs[s])),
-                poly,
+                ordinates,
             });
         }
         let mut support_offsets = vec![0];
@@ -279,6 +289,7 @@ impl<T: Real> PowellSabin<T> {
             elements,
             support_offsets,
             support,
+            cache_owner: ElementCache::<T>::new_owner(),
         })
     }
 
@@ -369,9 +380,10 @@ impl<T: Real> PowellSabin<T> {
     /// Evaluates the nine functions of `element` at `x` with the quadratic polynomial
     /// of sub-triangle `piece` (numbered as in [`crate::refinement`]), also where `x`
     /// lies outside that sub-triangle (the polynomial is extended). With `τ_1, τ_2`
-    /// the barycentric coordinates of `x` in the sub-triangle and `a_f` the stored
-    /// [`monomials`] of function `f` (its Bézier ordinates `b_f,ijk` converted once,
-    /// so that `φ_f(x) = Σ_{|ijk|=2} b_f,ijk B_ijk(τ)`):
+    /// the barycentric coordinates of `x` in the sub-triangle and `a_f` the
+    /// [`monomials`] of function `f` on it (its Bézier ordinates `b_f,ijk`
+    /// converted, so that `φ_f(x) = Σ_{|ijk|=2} b_f,ijk B_ijk(τ)`; derived once per
+    /// element and piece into `out`'s [`ElementCache`], [`PowellSabin::piece_monomials`]):
     ///
     /// `φ_f = a_0 + τ_1 (a_1 + a_3 τ_1 + a_4 τ_2) + τ_2 (a_2 + a_5 τ_2)`,
     /// `∇φ_f = (a_1 + 2 a_3 τ_1 + a_4 τ_2) ∇τ_1 + (a_2 + a_4 τ_1 + 2 a_5 τ_2) ∇τ_2`.
@@ -386,21 +398,49 @@ impl<T: Real> PowellSabin<T> {
         x: &Point<T, 2>,
         out: &mut BasisEval<T, 2>,
     ) {
-        let e = &self.elements[element];
-        let tau = &e.tau[piece];
+        let tau = &self.elements[element].tau[piece];
         let [_, t1, t2] = tau.at(x);
-        let poly = &e.poly[piece];
         let functions = &self.element_functions[element];
-        for f in 0..9 {
-            let a = &poly[f];
-            let h1 = a[1] + a[3] * t1 + a[4] * t2;
-            let h2 = a[2] + a[5] * t2;
-            out.index[f] = functions[f];
-            out.phi[f] = a[0] + t1 * h1 + t2 * h2;
-            let (d1, d2) = (h1 + a[3] * t1, h2 + a[4] * t1 + a[5] * t2);
-            out.grad_phi[f] = tau.g1 * d1 + tau.g2 * d2;
+        let BasisEval {
+            index,
+            phi,
+            grad_phi,
+            cache,
+            ..
+        } = out;
+        let derive = |poly: &mut [T]| self.piece_monomials(element, piece, poly);
+        let mut evaluate = |poly: &[T]| {
+            for (f, a) in poly.chunks_exact(6).enumerate() {
+                let h1 = a[1] + a[3] * t1 + a[4] * t2;
+                let h2 = a[2] + a[5] * t2;
+                index[f] = functions[f];
+                phi[f] = a[0] + t1 * h1 + t2 * h2;
+                let (d1, d2) = (h1 + a[3] * t1, h2 + a[4] * t1 + a[5] * t2);
+                grad_phi[f] = tau.g1 * d1 + tau.g2 * d2;
+            }
+        };
+        match cache.part(self.cache_owner, element, piece, PIECE_LEN, derive) {
+            Some(poly) => evaluate(poly),
+            None => {
+                let mut own = [T::zero(); PIECE_LEN];
+                self.piece_monomials(element, piece, &mut own);
+                evaluate(&own);
+            }
         }
         out.set_len(9);
+    }
+
+    /// The [`monomials`] of the nine functions of `element` on sub-triangle `piece`
+    /// (`out[6 f .. 6 f + 6]` for function `f`), from the kept ordinates
+    /// ([`bezier::expand`]); in `f64`, then stored in `T`.
+    pub fn piece_monomials(&self, element: usize, piece: usize, out: &mut [T]) {
+        let ordinates = &self.elements[element].ordinates;
+        for (f, a) in out.chunks_exact_mut(6).enumerate().take(9) {
+            let b = bezier::expand(&ordinates[f], f / 3, piece);
+            for (a, m) in a.iter_mut().zip(monomials(b)) {
+                *a = T::of(m);
+            }
+        }
     }
 }
 
@@ -478,6 +518,9 @@ impl<T: Real> Basis<T, 2> for PowellSabin<T> {
     }
     fn max_functions_per_element(&self) -> usize {
         9
+    }
+    fn element_cache_len(&self) -> usize {
+        6 * PIECE_LEN
     }
     fn locate(&self, x: &Point<T, 2>, hint: Option<usize>) -> Option<usize> {
         self.mesh
@@ -860,6 +903,47 @@ mod tests {
                     assert!(constraints
                         .iter()
                         .any(|c| c.terms == vec![(3 * corner + q, 1.0)]));
+                }
+            }
+        }
+    }
+
+    /// The element cache changes no bit: one buffer used for two bases of the same
+    /// element count, each point of one basis's element followed by a point of the
+    /// other's element of the same number and by another of the first, gives what a
+    /// buffer without room for a cache (every piece derived at every point) gives.
+    #[test]
+    fn the_element_cache_gives_the_same_bits_and_never_mixes_bases() {
+        use crate::mesh::generators::jittered_lattice_delaunay;
+        let mesh = |seed| jittered_lattice_delaunay(5, 5, (0.0, 1.0, 0.0, 1.0), 0.3, seed);
+        let a = PowellSabin::<f64>::new(mesh(1).unwrap(), SplitPoint::Incentre).unwrap();
+        let b = PowellSabin::<f64>::new(mesh(2).unwrap(), SplitPoint::Incentre).unwrap();
+        assert_eq!(a.num_elements(), b.num_elements());
+        let mut cached = BasisEval::for_basis(&a);
+        let mut plain = BasisEval::with_capacity(9);
+        let mut rng = crate::rng::SplitMix64(5);
+        let mut point_in = |ps: &PowellSabin<f64>, e: usize| {
+            let [p, q, r] = ps.mesh().triangle_points(e);
+            let (s, t) = (rng.next_f64(), rng.next_f64());
+            let (s, t) = if s + t > 1.0 {
+                (1.0 - s, 1.0 - t)
+            } else {
+                (s, t)
+            };
+            let x = p + (q - p) * s + (r - p) * t;
+            Vector2::new(x.x, x.y)
+        };
+        for e in 0..a.num_elements() {
+            for ps in [&a, &b, &a, &a] {
+                let x = point_in(ps, e);
+                ps.eval(e, &x, &mut cached);
+                ps.eval(e, &x, &mut plain);
+                assert_eq!(cached.len(), 9);
+                for k in 0..9 {
+                    assert_eq!(cached.index[k], plain.index[k]);
+                    assert_eq!(cached.phi[k].to_bits(), plain.phi[k].to_bits());
+                    let bits = |g: &Vector2<f64>| [g.x.to_bits(), g.y.to_bits()];
+                    assert_eq!(bits(&cached.grad_phi[k]), bits(&plain.grad_phi[k]));
                 }
             }
         }
