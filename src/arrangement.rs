@@ -62,12 +62,13 @@ pub fn principal_stretch<const D: usize>(f: &SMatrix<f64, D, D>) -> f64 {
 
 /// The particles near each particle: a grid of cells of the largest reach
 /// (`distance` times the largest particle's spacing `√V⁰_p`, `V⁰_p` in 1D) over
-/// `positions`, and the 3^D cells around each particle. The occupied cells are
-/// kept sorted, each with its particles in index order (a counting of the
-/// particles by cell: 4 bytes per particle and about 5 per occupied cell, where a
-/// hash map of cells took about 40 per particle at the end of a run, its peak).
-/// Deterministic: the neighbours of a particle come in the order of the cells and,
-/// within a cell, of the particles.
+/// `positions`, and the 3^D cells around each particle. The particles are counted
+/// by cell (4 bytes per particle, in index order within a cell) over the cells of
+/// their bounding box, or, where that box holds more than [`DENSE_CELLS`] cells
+/// per particle (particles flung far apart), over their occupied cells kept sorted;
+/// a hash map of cells took about 40 bytes per particle at the end of a run, its
+/// peak. Deterministic: the neighbours of a particle come in the order of the
+/// cells and, within a cell, of the particles.
 struct NeighbourGrid<'a, const D: usize> {
     positions: &'a [SVector<f64, D>],
     volume0: &'a [f64],
@@ -80,12 +81,24 @@ struct NeighbourGrid<'a, const D: usize> {
     stretch: &'a [f64],
     distance: f64,
     reach: f64,
-    /// The occupied cells, sorted.
-    cells: Vec<[i64; D]>,
-    /// The particles of `cells[c]` are `members[starts[c]..starts[c + 1]]`.
+    cells: Cells<D>,
+    /// The particles of cell `c` (numbered by [`Cells`]) are
+    /// `members[starts[c]..starts[c + 1]]`.
     starts: Vec<u32>,
     /// The particles, by cell and, within a cell, by index.
     members: Vec<u32>,
+}
+
+/// At most this many cells of the bounding box per particle for [`Cells::Box`].
+const DENSE_CELLS: u64 = 2;
+
+/// How [`NeighbourGrid`] numbers its cells.
+enum Cells<const D: usize> {
+    /// Every cell of the box from `low` with `size` cells per axis, the first
+    /// axis fastest.
+    Box { low: [i64; D], size: [u64; D] },
+    /// The occupied cells, sorted.
+    Sorted(Vec<[i64; D]>),
 }
 
 impl<'a, const D: usize> NeighbourGrid<'a, D> {
@@ -97,8 +110,21 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
         positions: &'a [SVector<f64, D>],
         volume0: &'a [f64],
         f: &'a [SMatrix<f64, D, D>],
+        bodies: (&'a [u32], &'a [f64]),
+        distance: f64,
+    ) -> Option<Self> {
+        Self::with_box_limit(positions, volume0, f, bodies, distance, DENSE_CELLS)
+    }
+
+    /// [`NeighbourGrid::new`] with at most `box_limit` cells of the bounding box
+    /// per particle for [`Cells::Box`].
+    fn with_box_limit(
+        positions: &'a [SVector<f64, D>],
+        volume0: &'a [f64],
+        f: &'a [SMatrix<f64, D, D>],
         (body, stretch): (&'a [u32], &'a [f64]),
         distance: f64,
+        box_limit: u64,
     ) -> Option<Self> {
         let reach = volume0
             .iter()
@@ -118,29 +144,88 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
             stretch,
             distance,
             reach,
-            cells: Vec::new(),
+            cells: Cells::Sorted(Vec::new()),
             starts: Vec::new(),
-            members: (0..positions.len() as u32).collect(),
+            members: Vec::new(),
         };
-        let mut members = std::mem::take(&mut grid.members);
-        members.sort_unstable_by_key(|&p| (grid.cell(p as usize), p));
-        for (k, &p) in members.iter().enumerate() {
-            let cell = grid.cell(p as usize);
-            if grid.cells.last() != Some(&cell) {
-                grid.cells.push(cell);
-                grid.starts.push(k as u32);
+        let n = positions.len();
+        let (mut low, mut high) = ([i64::MAX; D], [i64::MIN; D]);
+        for p in 0..n {
+            let c = grid.cell(p);
+            for k in 0..D {
+                (low[k], high[k]) = (low[k].min(c[k]), high[k].max(c[k]));
             }
         }
-        grid.starts.push(members.len() as u32);
-        grid.members = members;
+        // Cells per axis (none for no particles, or a span past 2⁶⁴ where a
+        // position is not finite).
+        let span = |k: usize| u64::try_from(high[k] as i128 - low[k] as i128 + 1).ok();
+        let size: [u64; D] = std::array::from_fn(|k| span(k).unwrap_or(0));
+        let cells = (0..D).try_fold(1u64, |a, k| a.checked_mul(span(k)?));
+        match cells {
+            Some(cells) if n > 0 && cells <= box_limit.saturating_mul(n as u64) + 64 => {
+                grid.cells = Cells::Box { low, size };
+                // Counting sort: counts, their prefix sums, then the particles in
+                // index order.
+                let mut starts = vec![0u32; cells as usize + 1];
+                for p in 0..n {
+                    starts[grid.number(&grid.cell(p)).expect("in the box") + 1] += 1;
+                }
+                for c in 0..cells as usize {
+                    starts[c + 1] += starts[c];
+                }
+                let mut members = vec![0u32; n];
+                for p in 0..n {
+                    let c = grid.number(&grid.cell(p)).expect("in the box");
+                    members[starts[c] as usize] = p as u32;
+                    starts[c] += 1;
+                }
+                // Each start has moved to the next cell's: shift back.
+                starts.copy_within(0..cells as usize, 1);
+                starts[0] = 0;
+                (grid.starts, grid.members) = (starts, members);
+            }
+            _ => {
+                let mut members: Vec<u32> = (0..n as u32).collect();
+                members.sort_unstable_by_key(|&p| (grid.cell(p as usize), p));
+                let (mut cells, mut starts) = (Vec::new(), Vec::new());
+                for (k, &p) in members.iter().enumerate() {
+                    let cell = grid.cell(p as usize);
+                    if cells.last() != Some(&cell) {
+                        cells.push(cell);
+                        starts.push(k as u32);
+                    }
+                }
+                starts.push(n as u32);
+                (grid.cells, grid.starts, grid.members) = (Cells::Sorted(cells), starts, members);
+            }
+        }
         Some(grid)
+    }
+
+    /// The number of cell `key`, `None` for a cell that holds no particle for sure
+    /// (outside the box, or not among the sorted cells).
+    fn number(&self, key: &[i64; D]) -> Option<usize> {
+        match &self.cells {
+            Cells::Box { low, size } => {
+                let mut number = 0u64;
+                for k in (0..D).rev() {
+                    let offset = key[k].checked_sub(low[k])?;
+                    if offset < 0 || offset as u64 >= size[k] {
+                        return None;
+                    }
+                    number = number * size[k] + offset as u64;
+                }
+                Some(number as usize)
+            }
+            Cells::Sorted(cells) => cells.binary_search(key).ok(),
+        }
     }
 
     /// The particles of cell `key` (none when it is empty).
     fn members_of(&self, key: &[i64; D]) -> &[u32] {
-        match self.cells.binary_search(key) {
-            Ok(c) => &self.members[self.starts[c] as usize..self.starts[c + 1] as usize],
-            Err(_) => &[],
+        match self.number(key) {
+            Some(c) => &self.members[self.starts[c] as usize..self.starts[c + 1] as usize],
+            None => &[],
         }
     }
 
@@ -166,8 +251,9 @@ impl<'a, const D: usize> NeighbourGrid<'a, D> {
     fn each(&self, p: usize, mut near: impl FnMut(usize)) {
         let (c, r) = (self.cell(p), self.distance * self.spacing(p));
         for n in 0..3usize.pow(D as u32) {
-            let key: [i64; D] =
-                std::array::from_fn(|k| c[k] + ((n / 3usize.pow(k as u32)) % 3) as i64 - 1);
+            let key: [i64; D] = std::array::from_fn(|k| {
+                c[k].saturating_add(((n / 3usize.pow(k as u32)) % 3) as i64 - 1)
+            });
             for &q in self.members_of(&key) {
                 let q = q as usize;
                 if q != p && (self.positions[q] - self.positions[p]).norm() <= r {
@@ -505,6 +591,54 @@ pub fn irregularity_warning(
 mod tests {
     use super::*;
     use nalgebra::Vector2;
+
+    /// The grid's neighbours are those within reach (against every pair), in the
+    /// same order whether the cells are those of the bounding box or the sorted
+    /// occupied ones, for a jittered lattice with and without particles flung far.
+    #[test]
+    fn the_neighbour_grid_finds_every_pair_within_reach_in_one_order() {
+        let mut rng = psmpm_basis::rng::SplitMix64(3);
+        for flung in [0usize, 5] {
+            let x: Vec<Vector2<f64>> = (0..400)
+                .map(|i| {
+                    let (a, b) = ((i % 20) as f64, (i / 20) as f64);
+                    let far = if i < flung {
+                        10.0 * (i as f64 + 1.0)
+                    } else {
+                        0.0
+                    };
+                    Vector2::new(0.1 * a + 0.04 * rng.next_f64() + far, 0.1 * b - far)
+                })
+                .collect();
+            let volume = vec![0.01; x.len()];
+            let f = vec![SMatrix::<f64, 2, 2>::identity(); x.len()];
+            let walk = |limit| {
+                let grid = NeighbourGrid::with_box_limit(&x, &volume, &f, (&[], &[]), 2.0, limit)
+                    .expect("a size to measure by");
+                let boxed = matches!(grid.cells, Cells::Box { .. });
+                let mut all = Vec::new();
+                for p in 0..x.len() {
+                    let mut near = Vec::new();
+                    grid.each(p, |q| near.push(q));
+                    all.push(near);
+                }
+                (boxed, all)
+            };
+            let (boxed, in_box) = walk(u64::MAX / 1024);
+            let (sorted_is_box, in_sorted) = walk(0);
+            assert!(boxed && !sorted_is_box);
+            assert_eq!(in_box, in_sorted);
+            assert_eq!(walk(DENSE_CELLS).0, flung == 0);
+            for (p, near) in in_box.iter().enumerate() {
+                let mut near = near.clone();
+                near.sort_unstable();
+                let every: Vec<usize> = (0..x.len())
+                    .filter(|&q| q != p && (x[q] - x[p]).norm() <= 2.0 * 0.01f64.powf(0.5))
+                    .collect();
+                assert_eq!(near, every, "particle {p}");
+            }
+        }
+    }
 
     /// A 10 × 10 lattice of spacing 0.1 has no stray particle, jittered by up to a
     /// third of its spacing neither; a particle flung 0.25 away from it is stray,
