@@ -35,8 +35,9 @@ use crate::scene::{BodyShape, ErrorKind, MeshSpec, Scene, SceneError};
 pub(crate) struct Footprint {
     /// Bytes per particle: state, basis values and gradients, the step's buffers.
     pub per_particle: f64,
-    /// Bytes per element of the mesh and the basis (PS: the Bézier ordinates of the
-    /// twelve sub-triangles), allocated before the particles are placed.
+    /// Bytes per element of the mesh and the basis (PS: the refinement, the
+    /// sub-triangles' coordinates and the Bézier ordinates kept per function),
+    /// allocated before the particles are placed.
     pub basis_per_element: f64,
     /// Bytes per element the driver allocates: the mass pattern, the factorisation
     /// and the per-function buffers.
@@ -49,7 +50,7 @@ impl Footprint {
     pub fn of(basis: BasisKind, mass: MassKind) -> Footprint {
         let lumped = mass == MassKind::Lumped;
         let (per_particle, basis_per_element, driver_per_element) = match basis {
-            BasisKind::Ps => (450.0, 4_000.0, if lumped { 700.0 } else { 3_200.0 }),
+            BasisKind::Ps => (450.0, 2_100.0, if lumped { 700.0 } else { 3_200.0 }),
             BasisKind::Pl => (330.0, 500.0, if lumped { 150.0 } else { 600.0 }),
             BasisKind::Bspline | BasisKind::Pl1d => {
                 (240.0, 150.0, if lumped { 260.0 } else { 900.0 })
