@@ -426,7 +426,7 @@ t_end = 1e-4
         };
         let e = check_against(&scene, &many_particles, room(1.5e9)).unwrap_err();
         assert_eq!(e.field, "body[0].per_block");
-        assert!(e.message.contains("about 4.9 GB ("), "{}", e.message);
+        assert!(e.message.contains("about 4.8 GB ("), "{}", e.message);
         assert!(
             e.message
                 .contains("1.5 GB this process may still use by a test's limit"),

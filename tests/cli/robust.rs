@@ -1112,7 +1112,7 @@ t_end = 1.0
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
-        "huge.toml:17:13: body[0].per_block: the run would need about 4.9 GB (9048064 particles",
+        "huge.toml:17:13: body[0].per_block: the run would need about 4.8 GB (9048064 particles",
         "this process may still use by its address-space limit (`ulimit -v`)",
         "give fewer particles",
     ] {
