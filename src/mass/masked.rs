@@ -194,13 +194,16 @@ fn off_diagonal<T: Scalar>(
 
 /// Solves one fixed set's system: on its kept rows when it has a compact one.
 fn solve_one<T: Scalar>(
-    solver: &mut SparseCholesky<T>,
+    solver: &mut Option<SparseCholesky<T>>,
     compact: &mut Option<Compact<T>>,
     rhs: &mut [T],
 ) {
     match compact {
         Some(c) => c.solve(rhs),
-        None => solver.solve_in_place(rhs, 1),
+        None => solver
+            .as_mut()
+            .expect("solve before a successful factorisation")
+            .solve_in_place(rhs, 1),
     }
 }
 
@@ -210,8 +213,13 @@ pub(super) struct MaskedCholesky<T: Scalar> {
     fixed: Vec<Vec<bool>>,
     /// `solver_of[k]`: index of the factorisation used by component `k`.
     solver_of: Vec<usize>,
-    solvers: Vec<SparseCholesky<T>>,
-    /// Modified values per distinct fixed set.
+    /// Per distinct fixed set, the factorisation of the whole pattern, made when
+    /// the set is first factorised whole: a body over a small part of the mesh
+    /// factorises only its compact system (below [`COMPACT_BELOW`] of the
+    /// functions) and never needs it (its symbolic analysis of every function was
+    /// a tenth of the set-up of a small body in a 200² block mesh).
+    solvers: Vec<Option<SparseCholesky<T>>>,
+    /// Modified values per distinct fixed set (allocated with its solver).
     modified: Vec<Vec<T>>,
     /// Rows held at zero in every component (no particle, or deactivated).
     pub inactive: Vec<bool>,
@@ -239,14 +247,8 @@ impl<T: Scalar> MaskedCholesky<T> {
         let pattern = setup.pattern;
         let (distinct, solver_of) = distinct_fixed_sets(setup.fixed);
         let n = pattern.dim();
-        self.solvers = distinct
-            .iter()
-            .map(|_| SparseCholesky::new(pattern, 1))
-            .collect();
-        self.modified = distinct
-            .iter()
-            .map(|_| vec![T::zero(); pattern.nnz()])
-            .collect();
+        self.solvers = distinct.iter().map(|_| None).collect();
+        self.modified = distinct.iter().map(|_| Vec::new()).collect();
         self.fixed = distinct;
         self.solver_of = solver_of;
         self.inactive = vec![false; n];
@@ -363,6 +365,10 @@ impl<T: Scalar> MaskedCholesky<T> {
                             .err();
                         return;
                     }
+                    let solver = solver.get_or_insert_with(|| SparseCholesky::new(pattern, 1));
+                    if modified.len() != pattern.nnz() {
+                        *modified = vec![T::zero(); pattern.nnz()];
+                    }
                     modify_rows(
                         pattern,
                         values,
@@ -444,7 +450,10 @@ impl<T: Scalar> MaskedCholesky<T> {
                 worst = worst.max(compact.condition_estimate());
                 continue;
             }
-            let (values, solver) = (&self.modified[s], &mut self.solvers[s]);
+            // Not factorised whole yet: nothing to estimate.
+            let (values, Some(solver)) = (&self.modified[s], self.solvers[s].as_mut()) else {
+                continue;
+            };
             let mut op = Operator {
                 apply: &mut |x: &[T], y: &mut [T]| pattern.mul_vec(values, x, y),
                 solve: &mut |y: &mut [T]| {
