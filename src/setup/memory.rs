@@ -42,6 +42,22 @@ pub(crate) struct Footprint {
     /// Bytes per element the driver allocates: the mass pattern, the factorisation
     /// and the per-function buffers.
     pub driver_per_element: f64,
+    /// [`Footprint::driver_per_element`] for a body too small to factorise the
+    /// whole pattern ([`certainly_compact`]): the masked strategies then factorise
+    /// only the rows the body covers (`mass::masked`).
+    pub compact_driver_per_element: f64,
+}
+
+/// Whether `particles` on a mesh of `elements` elements certainly cover fewer
+/// rows than the masked mass systems factorise alone (`mass::masked`, a quarter
+/// of the functions), wherever they go, so that no factorisation of the whole
+/// pattern is made: a particle touches at most the functions of the elements
+/// around one vertex (about 21 for PS and 7 for PL, on the usual 6 triangles
+/// there), against about 1.5 functions per triangle (PS; 0.5 for PL), so the
+/// rows a body covers are at most 14 times its particles over the elements, as a
+/// share.
+pub(crate) fn certainly_compact(particles: f64, elements: f64) -> bool {
+    14.0 * particles < 0.25 * elements
 }
 
 impl Footprint {
@@ -49,24 +65,31 @@ impl Footprint {
     /// elements cost less).
     pub fn of(basis: BasisKind, mass: MassKind) -> Footprint {
         let lumped = mass == MassKind::Lumped;
-        let (per_particle, basis_per_element, driver_per_element) = match basis {
-            BasisKind::Ps => (450.0, 2_100.0, if lumped { 700.0 } else { 3_200.0 }),
-            BasisKind::Pl => (330.0, 500.0, if lumped { 150.0 } else { 600.0 }),
-            BasisKind::Bspline | BasisKind::Pl1d => {
-                (240.0, 150.0, if lumped { 260.0 } else { 900.0 })
-            }
+        // (per particle, basis per element, driver per element: lumped, the
+        // whole pattern factorised, a compact system only.)
+        let (per_particle, basis_per_element, (lumped_driver, whole, compact)) = match basis {
+            BasisKind::Ps => (450.0, 2_100.0, (700.0, 3_200.0, 1_800.0)),
+            BasisKind::Pl => (330.0, 500.0, (150.0, 600.0, 450.0)),
+            BasisKind::Bspline | BasisKind::Pl1d => (240.0, 150.0, (260.0, 900.0, 900.0)),
         };
         Footprint {
             per_particle,
             basis_per_element,
-            driver_per_element,
+            driver_per_element: if lumped { lumped_driver } else { whole },
+            compact_driver_per_element: if lumped { lumped_driver } else { compact },
         }
     }
 
     /// Bytes per element still to allocate: all of them before the basis is built,
-    /// the driver's after.
-    pub fn per_element(&self, basis_built: bool) -> f64 {
-        self.driver_per_element
+    /// the driver's after; `compact`: the body certainly factorises no whole
+    /// pattern ([`certainly_compact`]).
+    pub fn per_element(&self, basis_built: bool, compact: bool) -> f64 {
+        let driver = if compact {
+            self.compact_driver_per_element
+        } else {
+            self.driver_per_element
+        };
+        driver
             + if basis_built {
                 0.0
             } else {
@@ -272,7 +295,9 @@ pub(crate) fn check_against(
     footprint.per_particle += output;
     // (`+ 0.0`: the sum of no body is −0, which would print as "-0 particles".)
     let particles: f64 = counts.bodies.iter().map(|b| b.1).sum::<f64>() + 0.0;
-    let per_element = footprint.per_element(counts.basis_built);
+    // Bodies placed later (`partial`) may cover more.
+    let compact = !counts.partial && certainly_compact(particles, counts.elements);
+    let per_element = footprint.per_element(counts.basis_built, compact);
     let element_bytes = counts.elements * per_element;
     let need =
         (particles * footprint.per_particle + element_bytes) * (1.0 + HEADROOM) + HEADROOM_BYTES;
@@ -450,6 +475,31 @@ t_end = 1e-4
             "{}",
             e.message
         );
+        // A small body on that mesh factorises no whole pattern: the compact
+        // figure, unless bodies placed later may cover more.
+        let small_body = Counts {
+            bodies: vec![("body[0].per_block".into(), 144.0)],
+            elements: 4e5,
+            partial: false,
+            basis_built: true,
+        };
+        let compact = check_against(&scene, &small_body, room(5e8)).unwrap_err();
+        assert!(
+            compact.message.contains("at 1800 B each"),
+            "{}",
+            compact.message
+        );
+        let later = Counts {
+            partial: true,
+            ..small_body
+        };
+        let whole = check_against(&scene, &later, room(5e8)).unwrap_err();
+        assert!(
+            whole.message.contains("at 3200 B each"),
+            "{}",
+            whole.message
+        );
+        assert!(certainly_compact(144.0, 4e5) && !certainly_compact(144.0, 2500.0));
         // No body placed yet (a disk, placed after the mesh): 0 particles, not −0.
         let no_body = Counts {
             bodies: Vec::new(),
