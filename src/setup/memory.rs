@@ -295,8 +295,11 @@ pub(crate) fn check_against(
     footprint.per_particle += output;
     // (`+ 0.0`: the sum of no body is −0, which would print as "-0 particles".)
     let particles: f64 = counts.bodies.iter().map(|b| b.1).sum::<f64>() + 0.0;
-    // Bodies placed later (`partial`) may cover more.
-    let compact = !counts.partial && certainly_compact(particles, counts.elements);
+    // Until every body is placed (`partial`), the driver counts as for a compact
+    // system (the bodies to come may be small): the check once they are, before
+    // the driver allocates, counts what the bodies need; the mesh and basis are
+    // counted whole at every check.
+    let compact = counts.partial || certainly_compact(particles, counts.elements);
     let per_element = footprint.per_element(counts.basis_built, compact);
     let element_bytes = counts.elements * per_element;
     let need =
@@ -332,12 +335,13 @@ pub(crate) fn check_against(
     } else {
         "triangles"
     };
+    let (need_text, room_text) = two_amounts(need, room.bytes.max(0.0));
     Err(SceneError::new(
         field,
         ErrorKind::Value,
         format!(
             "the run would need about {}{} ({} particles at {} B each{}, {} {element} at {} B each, `{}` basis, `{}` mass{}; and {} % more, and 64 MB, that the allocator and threads reserve), more than the {} this process may still use by {}: {fix}, or run where more memory is allowed",
-            bytes(need),
+            need_text,
             if counts.basis_built { " besides its mesh and basis" } else { "" },
             echo_number(particles),
             footprint.per_particle,
@@ -356,19 +360,30 @@ pub(crate) fn check_against(
                 ""
             },
             HEADROOM * 100.0,
-            bytes(room.bytes.max(0.0)),
+            room_text,
             room.limit,
         ),
     ))
 }
 
-/// Bytes in the unit a reader takes in at a glance.
-fn bytes(b: f64) -> String {
+/// Bytes in the unit a reader takes in at a glance, with `extra` more digits.
+fn bytes(b: f64, extra: usize) -> String {
     if b >= 1e9 {
-        format!("{:.1} GB", b / 1e9)
+        format!("{:.*} GB", 1 + extra, b / 1e9)
     } else {
-        format!("{:.0} MB", b / 1e6)
+        format!("{:.*} MB", extra, b / 1e6)
     }
+}
+
+/// The need and the room in [`bytes`], with as many more digits (up to 3) as it
+/// takes for a need above the room not to print as the same amount ("about 1.0
+/// GB …, more than the 1.0 GB").
+fn two_amounts(need: f64, room: f64) -> (String, String) {
+    let mut extra = 0;
+    while extra < 3 && bytes(need, extra) == bytes(room, extra) {
+        extra += 1;
+    }
+    (bytes(need, extra), bytes(room, extra))
 }
 
 #[cfg(test)]
@@ -489,17 +504,42 @@ t_end = 1e-4
             "{}",
             compact.message
         );
-        let later = Counts {
-            partial: true,
+        // A body large enough to make it: the whole factorisation; until every
+        // body is placed, the compact figure (the last check counts them all).
+        let large_body = Counts {
+            bodies: vec![("body[0].per_block".into(), 1e5)],
             ..small_body
         };
-        let whole = check_against(&scene, &later, room(5e8)).unwrap_err();
+        let whole = check_against(&scene, &large_body, room(5e8)).unwrap_err();
         assert!(
             whole.message.contains("at 3200 B each"),
             "{}",
             whole.message
         );
+        let later = Counts {
+            partial: true,
+            ..large_body
+        };
+        let early = check_against(&scene, &later, room(5e8)).unwrap_err();
+        assert!(
+            early.message.contains("at 1800 B each"),
+            "{}",
+            early.message
+        );
         assert!(certainly_compact(144.0, 4e5) && !certainly_compact(144.0, 2500.0));
+        // A need just above the room prints with the digits that tell them apart.
+        assert_eq!(
+            two_amounts(1.04e9, 1.01e9),
+            ("1.04 GB".to_string(), "1.01 GB".to_string())
+        );
+        assert_eq!(
+            two_amounts(4.9e9, 1.4e9),
+            ("4.9 GB".to_string(), "1.4 GB".to_string())
+        );
+        assert_eq!(
+            two_amounts(7.2e8, 6.9e8),
+            ("720 MB".to_string(), "690 MB".to_string())
+        );
         // No body placed yet (a disk, placed after the mesh): 0 particles, not −0.
         let no_body = Counts {
             bodies: Vec::new(),
