@@ -1168,3 +1168,49 @@ t_end = 0.8
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A critical step a million times below the elements' wave crossing comes from a
+/// row of the mass strategy's system with almost no particle mass (a user's
+/// `partial` on a disk of 28 particles over 700 triangles), not from the units:
+/// the error says so and points to the default mass strategy, where it said to
+/// check `young` and `density`.
+#[test]
+fn a_critical_step_set_by_the_mass_strategy_is_named_so_not_the_units() {
+    let file = SceneFile::new(
+        "sparse-disk",
+        r#"name = "sparse-disk"
+dim = 2
+basis = "ps"
+mass = "partial"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [50, 50]
+[material]
+model = "neo-hookean"
+young = 2e3
+poisson = 0.3
+density = 1.0
+[[body]]
+shape = "disk"
+centre = [2.0, 0.4]
+radius = 0.15
+count = [6, 6]
+[time]
+courant = 0.5
+t_end = 1e6
+"#,
+    );
+    let out = cli().args(["run", file.arg()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    for part in [
+        "time.t_end: t_end = 1000000 with courant = 0.5",
+        "a row of the `partial` mass strategy's system with almost no particle mass sets it",
+        "use the default mass strategy",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+    assert!(!stderr.contains("system of units"), "{stderr}");
+}
