@@ -868,12 +868,16 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
                 .into());
             }
             if ratio.is_nan() || ratio > MAX_STEPS as f64 {
-                // `dt / c`: the time a P-wave takes to cross the smallest element.
-                let cause = match dt_critical {
-                    Some(critical) if critical < STRATEGY_SET_STEP * (dt / c) => {
-                        strategy_step_hint(scene, critical, dt / c)
-                    }
-                    _ => wave_speed_hint(scene),
+                // A nearly singular mass system makes the step small (what
+                // `above_critical` names for a fixed `dt`), else the waves do.
+                let lumped = dt_critical.and_then(|_| driver.lumped_critical_time_step().ok());
+                let cause = match driver
+                    .singular_mass_cause_with(dt_critical.zip(lumped))
+                {
+                    Some(why) => format!(
+                        "The critical step is that small because the mass matrix is nearly singular: {why}"
+                    ),
+                    None => wave_speed_hint(scene),
                 };
                 return Err(SceneError::new(
                     "time.t_end",
@@ -1032,27 +1036,6 @@ fn wave_speed_hint(scene: &Scene) -> String {
     format!(
         "The critical step is the time the fastest wave takes to cross the basis's smallest spacing, and here the materials' fastest P-wave speed √((λ + 2μ)/ρ) is {:.2e}: check that `young` and `density` are in one system of units (in SI, Pa and kg/m³: about 6e3 m/s for steel, 50 for rubber); if they are, shorten `t_end` or coarsen the mesh",
         scene.wave_speed()
-    )
-}
-
-/// A critical step below this fraction of the time a P-wave takes to cross the
-/// smallest element is set by the mass strategy's solved system (a row with
-/// almost no particle mass), not by the waves: PS and PL with every strategy give
-/// 0.1 to 1 of that time where the particles sample the elements.
-pub const STRATEGY_SET_STEP: f64 = 1e-3;
-
-/// What sets a critical step far below the elements' (`critical` against
-/// `crossing`, the time a P-wave takes to cross the smallest element): a row of
-/// the mass strategy's system with almost no particle mass (a user's `partial` on
-/// a disk sampled by 0.64 particles per triangle: 1.6e-10 s against 4e-4 s), and
-/// the strategies that remove such rows.
-fn strategy_step_hint(scene: &Scene, critical: f64, crossing: f64) -> String {
-    format!(
-        "The critical step at the start, {}, is {:.1e} times the time a P-wave takes to cross the smallest element ({}): a row of the `{}` mass strategy's system with almost no particle mass sets it (a function barely reached by the particles at the edge of a body sampled by fewer than 3 particles per element), not the material or its units; use the default mass strategy (no `mass`, or `--mass default`), which takes such functions out of the system, or `lumped`, or give more particles per element",
-        crate::scene::limits::echo_significant(critical, 3),
-        critical / crossing,
-        crate::scene::limits::echo_significant(crossing, 3),
-        scene.mass.spec(),
     )
 }
 
