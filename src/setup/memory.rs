@@ -203,6 +203,8 @@ pub(crate) struct Counts {
     pub bodies: Vec<(String, f64)>,
     /// Elements of the mesh (triangles in 2D).
     pub elements: f64,
+    /// `elements` is the fewest a mesher can make, counted before it runs.
+    pub elements_at_least: bool,
     /// Whether the bodies not counted yet (placed later) exist.
     pub partial: bool,
     /// Whether the mesh and the basis are built (their memory is in use, not to
@@ -229,6 +231,7 @@ impl Counts {
         Counts {
             bodies,
             elements: elements as f64,
+            elements_at_least: false,
             partial,
             basis_built: false,
         }
@@ -246,6 +249,7 @@ impl Counts {
                 .map(|(b, (body, &n))| (count_field(b, body), n as f64))
                 .collect(),
             elements: elements as f64,
+            elements_at_least: false,
             partial: false,
             basis_built: true,
         }
@@ -340,7 +344,7 @@ pub(crate) fn check_against(
         field,
         ErrorKind::Value,
         format!(
-            "the run would need about {}{} ({} particles at {} B each{}, {} {element} at {} B each, `{}` basis, `{}` mass{}; and {} % more, and 64 MB, that the allocator and threads reserve), more than the {} this process may still use by {}: {fix}, or run where more memory is allowed",
+            "the run would need about {}{} ({} particles at {} B each{}, {}{} {element}{} at {} B each, `{}` basis, `{}` mass{}; and {} % more, and 64 MB, that the allocator and threads reserve), more than the {} this process may still use by {}: {fix}, or run where more memory is allowed",
             need_text,
             if counts.basis_built { " besides its mesh and basis" } else { "" },
             echo_number(particles),
@@ -350,7 +354,13 @@ pub(crate) fn check_against(
             } else {
                 String::new()
             },
+            if counts.elements_at_least { "at least " } else { "" },
             echo_number(counts.elements),
+            if counts.elements_at_least {
+                " (the domain's area over the largest triangle the mesher leaves, √3/4 · edge_length²; counted before meshing)"
+            } else {
+                ""
+            },
             per_element,
             scene.basis.name(),
             scene.mass.spec(),
@@ -461,6 +471,7 @@ t_end = 1e-4
         let many_particles = Counts {
             bodies: vec![("body[0].per_block".into(), 9e6)],
             elements: 16384.0,
+            elements_at_least: false,
             partial: false,
             basis_built: false,
         };
@@ -479,6 +490,7 @@ t_end = 1e-4
         let big_mesh = Counts {
             bodies: vec![("body[0].per_block".into(), 65536.0)],
             elements: 1e6,
+            elements_at_least: false,
             partial: true,
             basis_built: false,
         };
@@ -495,6 +507,7 @@ t_end = 1e-4
         let small_body = Counts {
             bodies: vec![("body[0].per_block".into(), 144.0)],
             elements: 4e5,
+            elements_at_least: false,
             partial: false,
             basis_built: true,
         };

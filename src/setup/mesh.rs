@@ -6,7 +6,9 @@ use super::Domain;
 use crate::bases::BasisKind;
 use crate::contact::WallGeometry;
 use crate::scene::limits::echo_significant;
-use crate::scene::{BlockLayout, Component, EffectSpec, ErrorKind, MeshSpec, Scene, SceneError};
+use crate::scene::{
+    BlockLayout, Component, EffectSpec, ErrorKind, Hole, MeshSpec, Scene, SceneError,
+};
 use crate::simulation::RunError;
 use psmpm_basis::basis::bspline1d::QuadraticBSpline;
 use psmpm_basis::basis::linear::Linear;
@@ -44,6 +46,10 @@ pub(crate) fn domain_2d(scene: &Scene) -> Result<Domain<Basis2d>, RunError> {
     }
     if let Some(elements) = super::memory::generated_elements(scene) {
         super::memory::check(scene, &super::memory::Counts::from_scene(scene, elements))?;
+    } else if let Some(fewest) = fewest_polygon_triangles(scene) {
+        let mut counts = super::memory::Counts::from_scene(scene, fewest);
+        counts.elements_at_least = true;
+        super::memory::check(scene, &counts)?;
     }
     let mesh = triangulation(scene)?;
     // The basis is the larger part of a mesh's memory: checked before it is built.
@@ -139,19 +145,7 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
             holes,
             edge_length,
         } => {
-            let points = |o: &[[f64; 2]]| o.iter().map(|p| Vec2::new(p[0], p[1])).collect();
-            let domain = PolygonDomain {
-                outer: points(outline),
-                outer_tags: if tags.is_empty() {
-                    vec!["boundary".to_string(); outline.len()]
-                } else {
-                    tags.clone()
-                },
-                holes: holes
-                    .iter()
-                    .map(|h| (points(&h.outline), h.tag.clone()))
-                    .collect(),
-            };
+            let domain = polygon_domain(outline, tags, holes);
             // The domain's faults name the part at fault (a hole's outline, a tag).
             domain.check().map_err(|f| {
                 let field = match f.part {
@@ -174,6 +168,42 @@ pub fn triangulation(scene: &Scene) -> Result<TriMesh, RunError> {
         }
     };
     Ok(mesh)
+}
+
+/// The domain of a `polygon` mesh (untagged outer segments are `boundary`).
+fn polygon_domain(outline: &[[f64; 2]], tags: &[String], holes: &[Hole]) -> PolygonDomain {
+    let points = |o: &[[f64; 2]]| o.iter().map(|p| Vec2::new(p[0], p[1])).collect();
+    PolygonDomain {
+        outer: points(outline),
+        outer_tags: if tags.is_empty() {
+            vec!["boundary".to_string(); outline.len()]
+        } else {
+            tags.to_vec()
+        },
+        holes: holes
+            .iter()
+            .map(|h| (points(&h.outline), h.tag.clone()))
+            .collect(),
+    }
+}
+
+/// The fewest triangles the mesher can make of a `polygon` scene, known before
+/// it runs (`None` for another mesh, or where the mesher will refuse the domain
+/// or the edge length and name the fault): what the memory check counts before
+/// meshing, so that a mesh too large for the memory allowed is refused before the
+/// mesher allocates it.
+fn fewest_polygon_triangles(scene: &Scene) -> Option<usize> {
+    let MeshSpec::Polygon {
+        outline,
+        tags,
+        holes,
+        edge_length,
+    } = &scene.mesh
+    else {
+        return None;
+    };
+    generators::fewest_polygon_triangles(&polygon_domain(outline, tags, holes), *edge_length)
+        .map(|n| n as usize)
 }
 
 /// The message for a tag `tag` the mesh (of tags `tags`) does not have, with the

@@ -1169,6 +1169,60 @@ t_end = 0.8
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A `polygon` mesh too large for the memory allowed is refused before the mesher
+/// runs, from the fewest triangles it can make (the domain's area over the largest
+/// triangle it leaves): under `ulimit -v 150000` this scene aborted inside the
+/// mesher ("memory allocation of … bytes failed", status 134; a user found it at
+/// 0.8 × a run's peak), since the memory check counted a polygon mesh only once
+/// built.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_polygon_mesh_too_large_for_the_memory_allowed_is_refused_before_meshing() {
+    let file = SceneFile::new(
+        "fine-polygon",
+        r#"name = "fine-polygon"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "polygon"
+outline = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]
+tags = ["floor", "right", "top", "left"]
+edge_length = 0.04
+[material]
+young = 1e4
+poisson = 0.3
+density = 1.0
+[[body]]
+min = [4.0, 4.0]
+max = [4.5, 4.5]
+count = [12, 12]
+[time]
+courant = 0.5
+t_end = 0.01
+"#,
+    );
+    let out = std::process::Command::new("sh")
+        .args([
+            "-c",
+            "ulimit -v 150000 && exec \"$0\" \"$@\"",
+            assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
+            "run",
+            file.arg(),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    for part in [
+        "fine-polygon.toml:8:15: mesh.edge_length: the run would need about 711 MB (144 particles",
+        "at least 144337 triangles (the domain's area over the largest triangle the mesher leaves",
+        "counted before meshing",
+        "give a coarser mesh",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+}
+
 /// A critical step far below the lumped mass's comes from a row of the mass
 /// strategy's system with almost no particle mass (a user's `partial` on a disk of
 /// 28 particles over 700 triangles), not from the units: the error too many steps

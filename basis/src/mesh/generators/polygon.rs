@@ -42,6 +42,23 @@ impl PolygonDomain {
         inside_polygon(p, &self.outer) && !self.holes.iter().any(|(h, _)| inside_polygon(p, h))
     }
 
+    /// The area inside the outer polygon and outside the holes (shoelace formula;
+    /// meaningful for a domain [`PolygonDomain::validate`] accepts, whose holes lie
+    /// inside the outer polygon and apart).
+    pub fn area(&self) -> f64 {
+        let enclosed = |poly: &[Vec2]| {
+            let n = poly.len();
+            let twice: f64 = (0..n)
+                .map(|i| {
+                    let (a, b) = (poly[i], poly[(i + 1) % n]);
+                    a.x * b.y - b.x * a.y
+                })
+                .sum();
+            0.5 * twice.abs()
+        };
+        enclosed(&self.outer) - self.holes.iter().map(|(h, _)| enclosed(h)).sum::<f64>()
+    }
+
     /// All segments with their tags.
     fn segments(&self) -> Vec<(Vec2, Vec2, &str)> {
         let mut s = Vec::new();
@@ -327,6 +344,24 @@ impl PolygonDomain {
     }
 }
 
+/// The largest triangle [`polygon_mesh`] leaves at `target_edge_length` `h`: the
+/// equilateral triangle of side `h`, of area `√3/4 · h²`.
+pub fn largest_triangle_area(target_edge_length: f64) -> f64 {
+    3f64.sqrt() / 4.0 * target_edge_length * target_edge_length
+}
+
+/// The fewest triangles [`polygon_mesh`] can make of `domain` at
+/// `target_edge_length`, known before it runs: every triangle is smaller than
+/// [`largest_triangle_area`], so there are at least the domain's area over that
+/// (the refinement's minimum angle and boundary splits make about 1.5 times as
+/// many). For a memory check before meshing; `None` where [`polygon_mesh`] would
+/// refuse the domain or the edge length (it names the fault).
+pub fn fewest_polygon_triangles(domain: &PolygonDomain, target_edge_length: f64) -> Option<f64> {
+    let size = domain.check().ok()?;
+    (target_edge_length.is_finite() && target_edge_length >= size * 1e-4)
+        .then(|| (domain.area() / largest_triangle_area(target_edge_length)).floor())
+}
+
 /// An unstructured quality mesh of a polygon with holes: the constrained Delaunay
 /// triangulation of the boundary, refined by spade (Delaunay refinement, boundary
 /// segments split where needed) until every triangle has an area below that of the
@@ -372,7 +407,7 @@ pub fn polygon_mesh(domain: &PolygonDomain, target_edge_length: f64) -> Result<T
             cdt.add_constraint(a, b);
         }
     }
-    let max_area = 3f64.sqrt() / 4.0 * target_edge_length * target_edge_length;
+    let max_area = largest_triangle_area(target_edge_length);
     let params = RefinementParameters::<f64>::new()
         .with_max_allowed_area(max_area)
         .with_angle_limit(AngleLimit::from_deg(MIN_ANGLE_DEG))
@@ -474,6 +509,51 @@ mod tests {
             }
         }
         min
+    }
+
+    /// The count known before meshing is a lower bound of the mesh's, and not a
+    /// loose one (a memory check before the mesher relies on both): on a square,
+    /// an L-shape with a round hole and a thin strip, at several edge lengths.
+    #[test]
+    fn the_fewest_triangles_bound_the_mesh_from_below_and_closely() {
+        let mut l_shape = PolygonDomain::rectangle(0.0, 2.0, 0.0, 2.0);
+        l_shape.outer = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ]
+        .map(|(x, y)| Vec2::new(x, y))
+        .to_vec();
+        l_shape.outer_tags = vec!["wall".into(); 6];
+        l_shape.holes = vec![(circle(Vec2::new(0.5, 0.5), 0.2, 24), "hole".into())];
+        for (domain, h) in [
+            (PolygonDomain::rectangle(0.0, 1.0, 0.0, 1.0), 0.1),
+            (PolygonDomain::rectangle(0.0, 1.0, 0.0, 1.0), 0.03),
+            (l_shape.clone(), 0.15),
+            (l_shape, 0.05),
+            (PolygonDomain::rectangle(0.0, 4.0, 0.0, 0.1), 0.05),
+        ] {
+            let fewest = fewest_polygon_triangles(&domain, h).unwrap();
+            let mesh = polygon_mesh(&domain, h).unwrap();
+            assert!((total_area(&mesh) - domain.area()).abs() < 1e-2 * domain.area());
+            let made = mesh.num_triangles() as f64;
+            assert!(
+                fewest <= made && made < 4.0 * fewest,
+                "{fewest} against {made} at h = {h}"
+            );
+        }
+        // Refused where the mesher refuses: an edge length below 1e-4 of the size,
+        // a domain of two corners.
+        let square = PolygonDomain::rectangle(0.0, 1.0, 0.0, 1.0);
+        assert_eq!(fewest_polygon_triangles(&square, 1e-5), None);
+        assert_eq!(fewest_polygon_triangles(&square, f64::NAN), None);
+        let mut segment = square;
+        segment.outer.truncate(2);
+        segment.outer_tags.truncate(2);
+        assert_eq!(fewest_polygon_triangles(&segment, 0.1), None);
     }
 
     fn circle(centre: Vec2, r: f64, n: usize) -> Vec<Vec2> {
