@@ -94,9 +94,12 @@ pub(crate) fn domain_1d(scene: &Scene) -> Result<Domain<Basis1d>, RunError> {
     let MeshSpec::Interval { x, elements } = scene.mesh else {
         return Err(conflict("mesh.kind", "a 1D scene needs an `interval` mesh").into());
     };
+    let h = (x[1] - x[0]) / elements as f64;
+    if let Some(error) = super::far_above_critical_1d(scene, h) {
+        return Err(error.into());
+    }
     super::memory::check(scene, &super::memory::Counts::from_scene(scene, elements))?;
     let mesh = Mesh1d::uniform(x[0], x[1], elements).map_err(|e| value("mesh", e))?;
-    let h = (x[1] - x[0]) / elements as f64;
     // In 1D the normal of a wall is the axis.
     check_tags(scene, &mesh.tags().map(String::from))?;
     let walls: Vec<(String, [f64; 2])> = scene

@@ -1039,6 +1039,38 @@ fn wave_speed_hint(scene: &Scene) -> String {
     )
 }
 
+/// The most a 1D critical step reaches in element crossings `h / c` of the
+/// fastest P-wave, over the 1D bases and mass strategies: measured 1.43 (`bspline`
+/// with `lumped`; 0.59–1.02 for the others, on a bar filled and half filled,
+/// `docs/stability.md`, "The critical time step"), with a margin.
+pub(crate) const MOST_CROSSINGS_1D: f64 = 4.0;
+
+/// Before a 1D mesh of spacing `h` and its basis are built: a fixed `dt` so far
+/// above the critical step that no basis or mass strategy can take it
+/// ([`MOST_CROSSINGS_1D`] crossings of an element by the fastest P-wave) is
+/// refused at once. The check after the set-up estimates the critical step
+/// itself; a user's bar of 1e6 elements with a step 700 times above it took 7 s
+/// and 1.2 GB of set-up to be told so.
+pub(crate) fn far_above_critical_1d(scene: &Scene, h: f64) -> Option<SceneError> {
+    let dt = scene.time.dt?;
+    let crossing = h / scene.wave_speed();
+    let most = MOST_CROSSINGS_1D * crossing;
+    if scene.time.allow_above_critical || !most.is_finite() || dt <= most {
+        return None;
+    }
+    Some(SceneError::new(
+        "time.dt",
+        ErrorKind::Conflict,
+        format!(
+            "the time step {} is {} times the time the fastest P-wave (√((λ + 2μ)/ρ) = {:.3e}) takes to cross an element (h = {:.3e}: {crossing:.3e}), and no 1D basis or mass strategy has a critical step above {MOST_CROSSINGS_1D} such crossings ({most:.3e}; `bspline` with `lumped` reaches 1.4, the others 0.6 to 1): lower `time.dt` below {most:.3e} (the run estimates the critical step itself once set up), or give `courant = 0.5` instead of `dt`, or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway",
+            echo_number(dt),
+            echo_fixed(dt / crossing, 1),
+            scene.wave_speed(),
+            h,
+        ),
+    ))
+}
+
 /// The error for a fixed `dt` above the critical step. The power iteration
 /// approaches `λ_max(M⁻¹K)` from below, so its `Δt_crit` errs on the large side
 /// (within 0.01 % of a dense eigenvalue computation after 40 iterations, test in
