@@ -410,6 +410,64 @@ fn mesh_plot_draws_one_control_triangle_per_vertex() {
     ));
 }
 
+/// A mesh picture draws at most `MAX_PICTURE_TRIANGLES` (a user's 17 829
+/// triangles made a 57 MB SVG); a window draws the part of a larger mesh that
+/// meets it: the main edges, control triangles and points there, nothing else.
+#[test]
+fn a_mesh_picture_of_a_large_mesh_is_drawn_a_window_at_a_time() {
+    use psmpm::output::mesh_picture::MAX_PICTURE_TRIANGLES;
+    use psmpm_basis::Vec2;
+    let dir = TempDir::created("mesh-window");
+    // 40 × 40 blocks of four triangles: 6 400 triangles, above the limit.
+    let mesh = block_grid(0.0, 40.0, 0.0, 40.0, 40, 40).unwrap();
+    let ps = bases::powell_sabin::<f64>(mesh).unwrap();
+    assert!(ps.mesh().num_triangles() > MAX_PICTURE_TRIANGLES);
+    let path = dir.join("whole.svg");
+    let err = mesh_plot(&path, &ps, &MeshPlotOptions::default()).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            PlotError::TooManyTriangles {
+                count: 6400,
+                most: MAX_PICTURE_TRIANGLES
+            }
+        ),
+        "{err}"
+    );
+    assert!(!path.exists());
+    // The window [10.5, 12.5] × [20.5, 21.5] meets blocks 10–12 by 20–21: 3 × 2
+    // blocks, 24 triangles, the main edges among them and around them, and the
+    // control triangles of the vertices near it.
+    let window = MeshPlotOptions {
+        window: Some((Vec2::new(10.5, 20.5), Vec2::new(12.5, 21.5))),
+        ..MeshPlotOptions::default()
+    };
+    mesh_plot(&path, &ps, &window).unwrap();
+    keep(&path);
+    let (_, elements) = read_svg(&path);
+    let labels = texts(&elements);
+    assert!(
+        labels.contains(&"24 of 6400 triangles in the window"),
+        "{labels:?}"
+    );
+    let polygons = count(&elements, "polygon", |_| true);
+    assert!((6..=60).contains(&polygons), "{polygons} control triangles");
+    let edges = count(&elements, "polyline", |e| {
+        e.attr("stroke") == "#000000" && e.attr("stroke-width") == "2" && e.num_points() == 2
+    });
+    assert!((30..=80).contains(&edges), "{edges} main edges");
+    assert!(std::fs::metadata(&path).unwrap().len() < 200_000);
+    // A window that is not a rectangle.
+    let flat = MeshPlotOptions {
+        window: Some((Vec2::new(1.0, 1.0), Vec2::new(1.0, 2.0))),
+        ..MeshPlotOptions::default()
+    };
+    assert!(matches!(
+        mesh_plot(&path, &ps, &flat),
+        Err(PlotError::InvalidOption(_))
+    ));
+}
+
 #[test]
 fn basis_function_plot_shades_one_function_with_mesh_edges_on_top() {
     let dir = TempDir::created("basis");

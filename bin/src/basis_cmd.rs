@@ -8,7 +8,7 @@ use psmpm::bases::BasisKind;
 use psmpm::basis::basis::linear::Linear;
 use psmpm::basis::basis::powell_sabin::{PowellSabin, SplitPoint};
 use psmpm::basis::mesh::generators::block_grid;
-use psmpm::basis::{Basis, TriMesh};
+use psmpm::basis::{Basis, TriMesh, Vec2};
 use psmpm::output::basis_picture::{basis_function_plot, BasisPlotOptions};
 use psmpm::output::mesh_picture::{mesh_plot, MeshPlotOptions};
 use psmpm::scene::{parse_mirror_line, parse_split};
@@ -50,6 +50,11 @@ pub struct PlotArgs {
     /// about both axes: vertical or horizontal.
     #[arg(long, value_name = "LINE", default_value = "vertical")]
     mirror_line: String,
+    /// Draw only the part of the mesh in the rectangle [X0, X1] × [Y0, Y1] (the
+    /// mesh picture shows at most 5000 triangles; a larger mesh is drawn a window
+    /// at a time).
+    #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true)]
+    window: Option<String>,
     /// Output file. An existing file is refused unless --overwrite is given.
     #[arg(long, default_value = "basis.svg")]
     out: PathBuf,
@@ -105,6 +110,31 @@ fn mesh(args: &PlotArgs) -> Result<TriMesh, CliError> {
     block_grid(0.0, nx as f64, 0.0, ny as f64, nx, ny).map_err(|e| CliError::Input(e.to_string()))
 }
 
+/// The rectangle of `--window X0,X1,Y0,Y1`.
+fn window(text: &str) -> Result<(Vec2, Vec2), CliError> {
+    let bad = |why: &str| {
+        CliError::Input(format!(
+            "--window must look like 0,2,0,1 (X0,X1,Y0,Y1 with X0 < X1 and Y0 < Y1), got `{}`: {why}",
+            psmpm::scene::limits::echo(text)
+        ))
+    };
+    let numbers = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<Vec<f64>, _>>()
+        .map_err(|_| bad("four numbers"))?;
+    let [x0, x1, y0, y1] = numbers[..] else {
+        return Err(bad(&format!("four numbers, not {}", numbers.len())));
+    };
+    if !numbers.iter().all(|v| v.is_finite()) {
+        return Err(bad("finite numbers"));
+    }
+    if !(x0 < x1 && y0 < y1) {
+        return Err(bad("X0 below X1 and Y0 below Y1"));
+    }
+    Ok((Vec2::new(x0, y0), Vec2::new(x1, y1)))
+}
+
 /// Runs a `basis` subcommand.
 pub fn basis(command: BasisCommand) -> Result<(), CliError> {
     let BasisCommand::Plot(args) = command;
@@ -114,13 +144,35 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
         .map_err(|m| CliError::Input(format!("--mirror-line: {m}")))?;
     let kind =
         BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+    let window = args.window.as_deref().map(window).transpose()?;
+    if window.is_some() && args.function.is_some() {
+        return Err(CliError::Input(
+            "--window: a function picture shows the function's support; --window is for the mesh picture".into(),
+        ));
+    }
     check_out(&args.out, args.overwrite)?;
     let mesh = mesh(&args)?;
-    let plot_error = |e: psmpm::output::chart::PlotError| match e {
+    let extent = {
+        let (mut lo, mut hi) = (mesh.vertices()[0], mesh.vertices()[0]);
+        for v in mesh.vertices() {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+        format!("[{}, {}] × [{}, {}]", lo.x, hi.x, lo.y, hi.y)
+    };
+    let plot_error = |e: psmpm::output::chart::PlotError| {
+        match e {
         psmpm::output::chart::PlotError::FunctionIndex { .. } => {
             CliError::Input(format!("--function: {e}"))
         }
+        e @ psmpm::output::chart::PlotError::TooManyTriangles { .. } => CliError::Input(format!(
+            "{e}: give --window X0,X1,Y0,Y1 within the mesh's {extent} (a few elements across), or a coarser mesh"
+        )),
+        e @ psmpm::output::chart::PlotError::InvalidOption(_) if window.is_some() => {
+            CliError::Input(format!("--window: {e}"))
+        }
         e => CliError::Input(format!("{}: {e}", args.out.display())),
+    }
     };
     let functions = match (args.function, kind) {
         (None, BasisKind::Ps) => {
@@ -132,6 +184,7 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
                     ps.mesh().num_triangles(),
                     ps.num_functions()
                 ),
+                window,
                 ..MeshPlotOptions::default()
             };
             mesh_plot(&args.out, &ps, &options).map_err(plot_error)?;

@@ -110,6 +110,19 @@ pub enum PlotError {
         /// Element where it was sampled.
         element: usize,
     },
+    /// A mesh picture that would draw more triangles than a reader can tell apart
+    /// (and an SVG of tens of megabytes).
+    #[error(
+        "{count} triangles in view, more than the {most} a picture shows readably \
+         (about {} MB of SVG, 1.6 KB per triangle); draw a part of the mesh (a window)",
+        count * 1630 / 1_000_000
+    )]
+    TooManyTriangles {
+        /// Triangles the picture would draw.
+        count: usize,
+        /// The most it draws.
+        most: usize,
+    },
     /// An option out of its allowed range (size, subdivisions, vertex index).
     #[error("invalid plot option: {0}")]
     InvalidOption(String),

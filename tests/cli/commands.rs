@@ -689,6 +689,59 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
     );
 }
 
+/// `basis plot` of a mesh above 5000 triangles says so and how to draw a part
+/// (`--window`), where it wrote a 57 MB SVG; the window draws that part.
+#[test]
+fn basis_plot_of_a_large_mesh_asks_for_a_window_and_draws_it() {
+    let dir = temp_dir("basis-window");
+    let picture = dir.join("big.svg");
+    let out = cli()
+        .args(["basis", "plot", "--blocks", "40x40", "--out"])
+        .arg(&picture)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with(
+            "error: 6400 triangles in view, more than the 5000 a picture shows readably"
+        ) && stderr.contains("give --window X0,X1,Y0,Y1 within the mesh's [0, 40] × [0, 40]"),
+        "{stderr}"
+    );
+    assert!(!picture.exists());
+    assert!(stdout(&[
+        "basis",
+        "plot",
+        "--blocks",
+        "40x40",
+        "--window",
+        "10.5,12.5,20.5,21.5",
+        "--out",
+        picture.to_str().unwrap(),
+    ])
+    .contains("wrote"));
+    assert!(std::fs::read_to_string(&picture)
+        .unwrap()
+        .contains("24 of 6400 triangles in the window"));
+    for (window, why) in [
+        ("2,1,0,1", "X0 below X1 and Y0 below Y1"),
+        ("0,1,0", "four numbers, not 3"),
+        ("0,1,0,inf", "finite numbers"),
+    ] {
+        let out = cli()
+            .args(["basis", "plot", "--window", window, "--overwrite", "--out"])
+            .arg(&picture)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains("--window must look like 0,2,0,1") && stderr.contains(why),
+            "{stderr}"
+        );
+    }
+}
+
 /// `basis plot --out FILE` replaced an existing file without a word, where `run
 /// --out` refuses a folder of an earlier run: it now refuses an existing file unless
 /// `--overwrite` is given, and a directory always, before drawing anything.
