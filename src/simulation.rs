@@ -846,6 +846,7 @@ impl Sampled {
             filled: 0,
             thin: 0,
             empty: 0,
+            whole: None,
         });
         let value = sampling.per_element();
         let alike = bodies
@@ -867,6 +868,7 @@ impl Sampled {
             filled: 0,
             thin: 0,
             empty: 0,
+            whole: None,
         }])
     }
 
@@ -1186,6 +1188,13 @@ pub const THIN_SHARE: f64 = 0.25;
 /// small triangle of the `polygon` mesh that no lattice point falls in.
 pub const THIN_LEAST_FILLED: usize = 10;
 
+/// Elements a body that fills its elements whole (edges on element edges,
+/// `BodySampling::whole`) needs for its share of thin ones to count ([`Thin`]):
+/// a body of 2 × 2 or 3 × 3 blocks has no element or 8 whose every neighbour
+/// holds its particles (fewer than [`THIN_LEAST_FILLED`]), and all of its 16 or 36
+/// elements are inside it.
+pub const THIN_LEAST_WHOLE: usize = 4;
+
 /// A body whose filled elements are thin in part although its average per
 /// element is enough ([`ps_sampling_warning`] is silent): a lattice of 3 × 4 per
 /// block of four triangles, 3 per triangle on average, puts 2 in the left and
@@ -1208,17 +1217,27 @@ impl Thin {
     /// [`THIN_SHARE`] or more (of the bodies with [`THIN_LEAST_FILLED`] filled
     /// elements or more).
     pub fn of(bodies: &[BodySampling]) -> Option<Self> {
-        let share = |b: &BodySampling| b.thin as f64 / b.filled.max(1) as f64;
-        let (b, worst) = bodies
+        // `(thin, filled, empty)` of a body: its elements inside it, or for a
+        // small body that fills its elements whole, all of them.
+        let counted = |b: &BodySampling| {
+            if b.filled >= THIN_LEAST_FILLED {
+                return Some((b.thin, b.filled, b.empty));
+            }
+            b.whole
+                .filter(|&(filled, _)| filled >= THIN_LEAST_WHOLE)
+                .map(|(filled, thin)| (thin, filled, 0))
+        };
+        let share = |(thin, filled, _): (usize, usize, usize)| thin as f64 / filled.max(1) as f64;
+        let (b, (thin, filled, empty)) = bodies
             .iter()
             .enumerate()
-            .filter(|(_, b)| b.filled >= THIN_LEAST_FILLED)
-            .max_by(|(_, a), (_, b)| share(a).total_cmp(&share(b)))?;
-        (share(worst) >= THIN_SHARE && worst.thin > 0).then_some(Thin {
+            .filter_map(|(b, body)| counted(body).map(|c| (b, c)))
+            .max_by(|(_, a), (_, b)| share(*a).total_cmp(&share(*b)))?;
+        (share((thin, filled, empty)) >= THIN_SHARE && thin > 0).then_some(Thin {
             body: (b, bodies.len()),
-            thin: worst.thin,
-            filled: worst.filled,
-            empty: worst.empty,
+            thin,
+            filled,
+            empty,
         })
     }
 

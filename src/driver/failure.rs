@@ -293,6 +293,17 @@ where
                     }
                 }
                 let occupied = elements.len();
+                // A body whose particles' volume is that of the elements holding
+                // them fills those elements whole (its edges on element edges):
+                // every one of them is inside it.
+                let whole =
+                    ((volume - size_of_elements).abs() <= 1e-9 * size_of_elements).then(|| {
+                        let thin = elements
+                            .iter()
+                            .filter(|&&e| (touching[e] as f64) < THIN_ELEMENT)
+                            .count();
+                        (occupied, thin)
+                    });
                 for &e in &elements {
                     own[e] = 0;
                 }
@@ -315,6 +326,7 @@ where
                     filled,
                     thin,
                     empty,
+                    whole,
                 }
             })
             .collect()
@@ -875,6 +887,11 @@ pub struct BodySampling {
     /// sampling: `per_block = [1, 16]` on blocks of four triangles leaves the left
     /// and right triangles of every block empty).
     pub empty: usize,
+    /// `(elements, thin)` where the body fills the elements holding its particles
+    /// whole (their size is its particles' volume, its edges on element edges):
+    /// all of them, and those holding fewer than 3 (`THIN_ELEMENT`); `None` where
+    /// its edges cut elements.
+    pub whole: Option<(usize, usize)>,
 }
 
 /// Particles per occupied element below which a critical step far below the

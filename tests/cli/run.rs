@@ -1786,6 +1786,64 @@ fn a_ps_lattice_with_thin_triangles_is_warned_about() {
         holes.contains("64 of the 128 triangles inside the body hold fewer than 3 particles (50 %; 64 of them none"),
         "{holes}"
     );
+    // A body of 2 × 2 or 3 × 3 blocks has no triangle, or 8, whose every
+    // neighbour holds its particles, too few to judge by (a user's small bodies at
+    // 3 × 4 were not warned about): a body whose edges lie on element edges fills
+    // all its triangles, and all of them count.
+    for (blocks, count) in [(2, "8 of the 16"), (3, "18 of the 36")] {
+        let end = 1.0 + 0.25 * blocks as f64;
+        let small = SceneFile::new(
+            &format!("small-{blocks}"),
+            &format!(
+                r#"name = "small"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [16, 16]
+[material]
+young = 1e4
+poisson = 0.3
+density = 1.0
+[[body]]
+min = [1.0, 1.0]
+max = [{end}, {end}]
+per_block = [3, 4]
+[time]
+courant = 0.5
+t_end = 0.01
+"#
+            ),
+        );
+        let run = |particles: &str| {
+            let out = cli()
+                .args([
+                    "run",
+                    small.arg(),
+                    "--diag-every",
+                    "0",
+                    "--particles",
+                    particles,
+                ])
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(0), "{out:?}");
+            String::from_utf8(out.stderr).unwrap()
+        };
+        let thin = run("3x4");
+        assert!(
+            thin.contains(&format!(
+                "{count} triangles inside the body hold fewer than 3 particles (50 %)"
+            )),
+            "{blocks} x {blocks} blocks: {thin}"
+        );
+        assert!(
+            !run("4x4").contains("hold fewer than 3"),
+            "{blocks} x {blocks} blocks at 4 x 4"
+        );
+    }
 }
 
 /// A contact wall closing around an obstacle narrower than 1.5 times the triangles
