@@ -102,9 +102,17 @@ fn mesh(args: &PlotArgs) -> Result<TriMesh, CliError> {
         return psmpm::simulation::triangulation(&scene).map_err(located);
     }
     let (nx, ny) = pair(args.blocks.as_deref().unwrap_or("2x2"), "--blocks")?;
-    if nx == 0 || ny == 0 || nx > 64 || ny > 64 {
+    // A whole picture shows at most 5000 triangles (35 × 35 blocks); with a
+    // window, a grid up to 256 × 256 (262 144 triangles, about 0.5 GB of basis).
+    let most = if args.window.is_some() { 256 } else { 64 };
+    if nx == 0 || ny == 0 || nx > most || ny > most {
         return Err(CliError::Input(format!(
-            "--blocks: each count must be in 1..=64 for a picture, got {nx}x{ny}"
+            "--blocks: each count must be in 1..={most} for a picture{}, got {nx}x{ny}",
+            if args.window.is_some() {
+                " with --window"
+            } else {
+                " (up to 256 with --window)"
+            }
         )));
     }
     block_grid(0.0, nx as f64, 0.0, ny as f64, nx, ny).map_err(|e| CliError::Input(e.to_string()))
@@ -144,12 +152,12 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
         .map_err(|m| CliError::Input(format!("--mirror-line: {m}")))?;
     let kind =
         BasisKind::parse(&args.basis).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
-    let window = args.window.as_deref().map(window).transpose()?;
-    if window.is_some() && args.function.is_some() {
+    if args.window.is_some() && args.function.is_some() {
         return Err(CliError::Input(
             "--window: a function picture shows the function's support; --window is for the mesh picture".into(),
         ));
     }
+    let window = args.window.as_deref().map(window).transpose()?;
     check_out(&args.out, args.overwrite)?;
     let mesh = mesh(&args)?;
     let extent = {
@@ -165,9 +173,19 @@ pub fn basis(command: BasisCommand) -> Result<(), CliError> {
         psmpm::output::chart::PlotError::FunctionIndex { .. } => {
             CliError::Input(format!("--function: {e}"))
         }
-        e @ psmpm::output::chart::PlotError::TooManyTriangles { .. } => CliError::Input(format!(
-            "{e}: give --window X0,X1,Y0,Y1 within the mesh's {extent} (a few elements across), or a coarser mesh"
-        )),
+        e @ psmpm::output::chart::PlotError::TooManyTriangles { .. } => {
+            CliError::Input(match window {
+                None => format!(
+                    "{e}: draw a part of the mesh, give --window X0,X1,Y0,Y1 within the mesh's {extent}, or a coarser mesh"
+                ),
+                Some(_) => {
+                    format!("--window: {e}: give a smaller window within the mesh's {extent}")
+                }
+            })
+        }
+        e @ psmpm::output::chart::PlotError::Empty(_) if window.is_some() => {
+            CliError::Input(format!("--window: {e}: the mesh spans {extent}"))
+        }
         e @ psmpm::output::chart::PlotError::InvalidOption(_) if window.is_some() => {
             CliError::Input(format!("--window: {e}"))
         }

@@ -114,7 +114,7 @@ pub enum PlotError {
     /// (and an SVG of tens of megabytes).
     #[error(
         "{count} triangles in view, more than the {most} a picture shows readably \
-         (about {} MB of SVG, 1.6 KB per triangle); draw a part of the mesh (a window)",
+         (about {} MB of SVG, 1.6 KB per triangle)",
         count * 1630 / 1_000_000
     )]
     TooManyTriangles {

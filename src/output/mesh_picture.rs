@@ -293,6 +293,11 @@ fn render_mesh_plot(
     let triangles: Vec<usize> = (0..mesh.num_triangles())
         .filter(|&t| meets(&mesh.triangle_points(t)))
         .collect();
+    if triangles.is_empty() {
+        return Err(PlotError::Empty(
+            "no triangle of the mesh meets the window".into(),
+        ));
+    }
     if triangles.len() > MAX_PICTURE_TRIANGLES {
         return Err(PlotError::TooManyTriangles {
             count: triangles.len(),
@@ -475,7 +480,7 @@ fn render_mesh_plot(
             match options.window {
                 None => format!("{} vertices, {} triangles", nv, mesh.num_triangles()),
                 Some(_) => format!(
-                    "{} of {} triangles in the window",
+                    "{} of {} triangles shown",
                     triangles.len(),
                     mesh.num_triangles()
                 ),

@@ -105,6 +105,10 @@ pub(crate) const HEADROOM: f64 = 0.15;
 /// allocator's arenas and the threads' stacks, reserved address space.
 pub(crate) const HEADROOM_BYTES: f64 = 64e6;
 
+/// Address space the allocator reserves for a thread's arena (glibc on 64-bit
+/// Linux: `HEAP_MAX_SIZE`), which an address-space limit counts.
+pub(crate) const ARENA_BYTES: f64 = 64.0 * 1024.0 * 1024.0;
+
 /// The memory the process may still allocate, as the code can see it, and which
 /// limit sets it.
 #[derive(Debug, Clone, PartialEq)]
@@ -316,6 +320,15 @@ pub(crate) fn check_against(
         .iter()
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .filter(|b| b.1 * footprint.per_particle >= element_bytes);
+    // With an address-space limit, every thread's allocator arena reserves up to
+    // 64 MB of address space (glibc) that the limit counts before anything is
+    // resident: a user's 64-triangle scene under `ulimit -v 400000` was refused
+    // with `--threads 8` and ran with 2, told to coarsen its mesh.
+    let threads = crate::threads::current();
+    let arenas = threads.saturating_sub(1) as f64 * ARENA_BYTES;
+    let by_threads = room.limit.starts_with("its address-space")
+        && threads > 1
+        && need <= room.bytes.max(0.0) + arenas;
     let (field, fix) = match largest {
         Some((field, _)) => (
             field.clone(),
@@ -333,6 +346,13 @@ pub(crate) fn check_against(
                 }
             ),
         ),
+    };
+    let fix = if by_threads {
+        format!(
+            "run with fewer threads (`--threads 1` or 2: each of the {threads} reserves up to 64 MB of address space for its allocator, which the limit counts), or {fix}"
+        )
+    } else {
+        fix
     };
     let element = if scene.dim == 1 {
         "elements"

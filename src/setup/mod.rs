@@ -1062,11 +1062,14 @@ pub(crate) fn far_above_critical_1d(scene: &Scene, h: f64) -> Option<SceneError>
         "time.dt",
         ErrorKind::Conflict,
         format!(
-            "the time step {} is {} times the time the fastest P-wave (√((λ + 2μ)/ρ) = {:.3e}) takes to cross an element (h = {:.3e}: {crossing:.3e}), and no 1D basis or mass strategy has a critical step above {MOST_CROSSINGS_1D} such crossings ({most:.3e}; `bspline` with `lumped` reaches 1.4, the others 0.6 to 1): lower `time.dt` below {most:.3e} (the run estimates the critical step itself once set up), or give `courant = 0.5` instead of `dt`, or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway",
+            "the time step {} is {} times the {} the fastest P-wave (√((λ + 2μ)/ρ) = {}) takes to cross an element of length {}, and no 1D basis or mass strategy has a critical step above {MOST_CROSSINGS_1D} such crossings ({}; `bspline` with `lumped` reaches 1.4, the others 0.6 to 1): lower `time.dt` below {} (the run estimates the critical step itself once set up), or give `courant = 0.5` instead of `dt`, or set `allow_above_critical = true` in `[time]` (`--allow-above-critical`) to run anyway",
             echo_number(dt),
-            echo_fixed(dt / crossing, 1),
-            scene.wave_speed(),
-            h,
+            crate::scene::limits::echo_significant(dt / crossing, 3),
+            crate::scene::limits::echo_significant(crossing, 3),
+            crate::scene::limits::echo_significant(scene.wave_speed(), 3),
+            crate::scene::limits::echo_significant(h, 3),
+            crate::scene::limits::echo_significant(most, 3),
+            crate::scene::limits::echo_significant(most, 3),
         ),
     ))
 }

@@ -722,7 +722,62 @@ fn basis_plot_of_a_large_mesh_asks_for_a_window_and_draws_it() {
     .contains("wrote"));
     assert!(std::fs::read_to_string(&picture)
         .unwrap()
-        .contains("24 of 6400 triangles in the window"));
+        .contains("24 of 6400 triangles shown"));
+    // A window that misses the mesh, one that holds too much, and a grid above
+    // the whole picture's 64 blocks a side, drawn through a window.
+    let out = cli()
+        .args([
+            "basis",
+            "plot",
+            "--blocks",
+            "40x40",
+            "--window",
+            "50,60,0,1",
+            "--overwrite",
+            "--out",
+        ])
+        .arg(&picture)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr.starts_with("error: --window: nothing to plot: no triangle of the mesh meets the window: the mesh spans [0, 40] × [0, 40]"),
+        "{stderr}"
+    );
+    let out = cli()
+        .args([
+            "basis",
+            "plot",
+            "--blocks",
+            "40x40",
+            "--window",
+            "0,40,0,36",
+            "--overwrite",
+            "--out",
+        ])
+        .arg(&picture)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr.starts_with("error: --window: 5880 triangles in view")
+            && stderr.contains("give a smaller window"),
+        "{stderr}"
+    );
+    assert!(stdout(&[
+        "basis",
+        "plot",
+        "--blocks",
+        "100x100",
+        "--window",
+        "10,15.5,10,12",
+        "--overwrite",
+        "--out",
+        picture.to_str().unwrap()
+    ])
+    .contains("wrote"));
     for (window, why) in [
         ("2,1,0,1", "X0 below X1 and Y0 below Y1"),
         ("0,1,0", "four numbers, not 3"),

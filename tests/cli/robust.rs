@@ -1223,6 +1223,64 @@ t_end = 0.01
     }
 }
 
+/// Under an address-space limit each thread's allocator reserves up to 64 MB that
+/// the limit counts: a user's 64-triangle scene under `ulimit -v 400000` with
+/// `--threads 8` was refused and told to coarsen its mesh (with 2 threads it
+/// ran). It runs, or is refused naming the threads as the fix, never the mesh.
+#[test]
+#[cfg(target_os = "linux")]
+fn a_run_refused_for_its_threads_address_space_names_the_threads() {
+    let file = SceneFile::new(
+        "tiny",
+        r#"name = "tiny"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 1.0]
+y = [0.0, 1.0]
+blocks = [4, 4]
+[material]
+young = 1e4
+poisson = 0.3
+density = 1.0
+[[body]]
+min = [0.25, 0.25]
+max = [0.75, 0.75]
+per_block = [2, 2]
+[time]
+courant = 0.5
+t_end = 0.01
+"#,
+    );
+    for threads in ["8", "16"] {
+        let out = std::process::Command::new("sh")
+            .args([
+                "-c",
+                "ulimit -v 400000 && exec \"$0\" \"$@\"",
+                assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
+                "run",
+                file.arg(),
+                "--threads",
+                threads,
+                "--diag-every",
+                "0",
+            ])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        match out.status.code() {
+            Some(0) => {}
+            Some(2) => assert!(
+                stderr.contains("run with fewer threads")
+                    && !stderr.contains(": give a coarser mesh"),
+                "{threads} threads: {stderr}"
+            ),
+            _ => panic!("{threads} threads: {out:?}"),
+        }
+    }
+}
+
 /// A 1D bar whose fixed `dt` is far above any 1D critical step (1000 crossings of
 /// an element by the P-wave; the largest critical step of a 1D basis and mass
 /// strategy is 1.4 crossings) is refused before its mesh and basis are built: a
@@ -1261,8 +1319,8 @@ t_end = 0.4
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
-        "long-bar.toml:19:6: time.dt: the time step 0.0002 is 1000.0 times the time the fastest P-wave",
-        "no 1D basis or mass strategy has a critical step above 4 such crossings (8.000e-7",
+        "long-bar.toml:19:6: time.dt: the time step 0.0002 is 1000 times the 2e-7 the fastest P-wave",
+        "no 1D basis or mass strategy has a critical step above 4 such crossings (8e-7;",
         "give `courant = 0.5` instead of `dt`",
     ] {
         assert!(stderr.contains(part), "{part:?} not in {stderr}");
