@@ -104,36 +104,33 @@ def peaks(s):
     ]
 
 
+def row(rows, ref_t, ref_s):
+    """The error against the reference, the first and eighth strain-energy peaks
+    (x 100) and the rows lumped at the end, of a run's diagnostics rows."""
+    t, s = series(rows)
+    err = math.sqrt(
+        sum((si - interpolate(ti, ref_t, ref_s)) ** 2 for ti, si in zip(t, s)) / len(s)
+    ) / max(ref_s)
+    p = peaks(s)
+    return (
+        f"{err:14.3e}  {p[0] * 100:6.3f}  {p[7] * 100:6.3f}"
+        f"  {rows[-1]['lumped_rows']}/{rows[-1]['active']}"
+    )
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cli", default="target/release/mpm-cli")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as workdir:
         ref_t, ref_s = series(run(args.cli, scene(0.0, 8, "default"), workdir, "reference"))
-        top = max(ref_s)
         print("mass      v0  shift  error(RMS/max)  peak 1  peak 8  lumped/held at the end")
         for mass in ("default", "lumped"):
             for v0, shift in ((0.0, 0.0), (5.0, 0.0), (1.0, 0.0), (0.0, 0.05), (0.0, 0.1)):
                 rows = run(args.cli, scene(v0, 4, mass, shift), workdir, f"{mass}-{v0}-{shift}")
-                t, s = series(rows)
-                err = math.sqrt(
-                    sum((si - interpolate(ti, ref_t, ref_s)) ** 2 for ti, si in zip(t, s)) / len(s)
-                ) / top
-                p = peaks(s)
-                print(
-                    f"{mass:8s} {v0:3.0f}  {shift:5.2f}  {err:14.3e}  {p[0] * 100:6.3f}  {p[7] * 100:6.3f}"
-                    f"  {rows[-1]['lumped_rows']}/{rows[-1]['active']}"
-                )
+                print(f"{mass:8s} {v0:3.0f}  {shift:5.2f}  " + row(rows, ref_t, ref_s))
         rows = run(args.cli, scene(5.0, 8, "default"), workdir, "reference-moving")
-        t, s = series(rows)
-        err = math.sqrt(
-            sum((si - interpolate(ti, ref_t, ref_s)) ** 2 for ti, si in zip(t, s)) / len(s)
-        ) / top
-        p = peaks(s)
-        print(
-            f"refined   5   0.00  {err:14.3e}  {p[0] * 100:6.3f}  {p[7] * 100:6.3f}"
-            f"  {rows[-1]['lumped_rows']}/{rows[-1]['active']}"
-        )
+        print("refined   5   0.00  " + row(rows, ref_t, ref_s))
         print(f"(reference at rest: peaks {peaks(ref_s)[0] * 100:.3f}, {peaks(ref_s)[7] * 100:.3f}; strain energies x 100)")
 
 
