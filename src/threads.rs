@@ -29,6 +29,13 @@ pub fn install<R: Send>(
     Ok(pool(threads)?.install(work))
 }
 
+/// Whether the process runs under an address-space limit (`ulimit -v`), which
+/// counts the address space each thread reserves (its stack, and up to 64 MB for
+/// its allocator's arena) before anything is resident.
+pub fn address_space_limited() -> bool {
+    crate::setup::memory::address_space_limit_set()
+}
+
 /// The number of threads of the current pool.
 pub fn current() -> usize {
     rayon::current_num_threads()

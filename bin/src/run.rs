@@ -600,14 +600,9 @@ pub fn check_threads(threads: Option<usize>) -> Result<(), CliError> {
 pub fn thread_pool(threads: Option<usize>) -> Result<psmpm::threads::ThreadPool, CliError> {
     check_threads(threads)?;
     psmpm::threads::pool(threads).map_err(|e| {
-        let limited = std::fs::read_to_string("/proc/self/limits").is_ok_and(|l| {
-            l.lines()
-                .find(|l| l.starts_with("Max address space"))
-                .is_some_and(|l| !l.contains("unlimited"))
-        });
         CliError::Input(format!(
             "--threads: no thread pool ({e}){}",
-            if limited {
+            if psmpm::threads::address_space_limited() {
                 ": under this process's address-space limit (`ulimit -v`), each thread needs address space for its stack and up to 64 MB for its allocator; give fewer --threads, or a higher limit"
             } else {
                 ""

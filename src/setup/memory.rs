@@ -131,7 +131,7 @@ pub(crate) fn room() -> Option<Room> {
         {
             rooms.push(Room {
                 bytes: limit - used,
-                limit: "its address-space limit (`ulimit -v`)",
+                limit: ADDRESS_SPACE_LIMIT,
             });
         }
     }
@@ -153,6 +153,17 @@ pub(crate) fn room() -> Option<Room> {
         }
     }
     rooms.into_iter().min_by(|a, b| a.bytes.total_cmp(&b.bytes))
+}
+
+/// [`Room::limit`] of the address-space limit.
+const ADDRESS_SPACE_LIMIT: &str = "its address-space limit (`ulimit -v`)";
+
+/// Whether this process has an address-space limit (`/proc/self/limits`).
+pub(crate) fn address_space_limit_set() -> bool {
+    std::fs::read_to_string("/proc/self/limits")
+        .ok()
+        .and_then(|limits| address_space_limit(&limits))
+        .is_some()
 }
 
 /// The soft address-space limit in bytes of a `/proc/self/limits` text, `None`
@@ -326,9 +337,8 @@ pub(crate) fn check_against(
     // with `--threads 8` and ran with 2, told to coarsen its mesh.
     let threads = crate::threads::current();
     let arenas = threads.saturating_sub(1) as f64 * ARENA_BYTES;
-    let by_threads = room.limit.starts_with("its address-space")
-        && threads > 1
-        && need <= room.bytes.max(0.0) + arenas;
+    let by_threads =
+        room.limit == ADDRESS_SPACE_LIMIT && threads > 1 && need <= room.bytes.max(0.0) + arenas;
     let (field, fix) = match largest {
         Some((field, _)) => (
             field.clone(),

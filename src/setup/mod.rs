@@ -8,7 +8,7 @@
 //! [`crate::simulation`] runs what this builds.
 
 mod effects;
-mod memory;
+pub(crate) mod memory;
 mod mesh;
 mod particles;
 mod regions;

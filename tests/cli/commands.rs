@@ -695,11 +695,17 @@ fn basis_plot_draws_the_ps_mesh_and_a_function() {
 fn basis_plot_of_a_large_mesh_asks_for_a_window_and_draws_it() {
     let dir = temp_dir("basis-window");
     let picture = dir.join("big.svg");
-    let out = cli()
-        .args(["basis", "plot", "--blocks", "40x40", "--out"])
-        .arg(&picture)
-        .output()
-        .unwrap();
+    // `basis plot ARGS --out PICTURE`.
+    let plot = |args: &[&str]| {
+        cli()
+            .args(["basis", "plot"])
+            .args(args)
+            .arg("--out")
+            .arg(&picture)
+            .output()
+            .unwrap()
+    };
+    let out = plot(&["--blocks", "40x40"]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -725,40 +731,14 @@ fn basis_plot_of_a_large_mesh_asks_for_a_window_and_draws_it() {
         .contains("24 of 6400 triangles shown"));
     // A window that misses the mesh, one that holds too much, and a grid above
     // the whole picture's 64 blocks a side, drawn through a window.
-    let out = cli()
-        .args([
-            "basis",
-            "plot",
-            "--blocks",
-            "40x40",
-            "--window",
-            "50,60,0,1",
-            "--overwrite",
-            "--out",
-        ])
-        .arg(&picture)
-        .output()
-        .unwrap();
+    let out = plot(&["--blocks", "40x40", "--window", "50,60,0,1", "--overwrite"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2));
     assert!(
         stderr.starts_with("error: --window: nothing to plot: no triangle of the mesh meets the window: the mesh spans [0, 40] × [0, 40]"),
         "{stderr}"
     );
-    let out = cli()
-        .args([
-            "basis",
-            "plot",
-            "--blocks",
-            "40x40",
-            "--window",
-            "0,40,0,36",
-            "--overwrite",
-            "--out",
-        ])
-        .arg(&picture)
-        .output()
-        .unwrap();
+    let out = plot(&["--blocks", "40x40", "--window", "0,40,0,36", "--overwrite"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2));
     assert!(
@@ -783,11 +763,7 @@ fn basis_plot_of_a_large_mesh_asks_for_a_window_and_draws_it() {
         ("0,1,0", "four numbers, not 3"),
         ("0,1,0,inf", "finite numbers"),
     ] {
-        let out = cli()
-            .args(["basis", "plot", "--window", window, "--overwrite", "--out"])
-            .arg(&picture)
-            .output()
-            .unwrap();
+        let out = plot(&["--window", window, "--overwrite"]);
         assert_eq!(out.status.code(), Some(2));
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(

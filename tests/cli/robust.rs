@@ -1067,6 +1067,19 @@ fn a_scene_error_leaves_nothing_in_out() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `mpm-cli ARGS` run under an address-space limit of `kilobytes` (`ulimit -v`, set
+/// for the child alone).
+#[cfg(target_os = "linux")]
+fn under_address_space_limit(kilobytes: u32, args: &[&str]) -> std::process::Output {
+    std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {kilobytes} && exec \"$0\" \"$@\""))
+        .arg(assert_cmd::cargo::cargo_bin("mpm-cli"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
 /// A valid scene (9e6 PS particles, under the particle limit) that needs more
 /// memory than the process may use is refused before anything large is allocated,
 /// naming the file, line and field, the memory needed and the limit, instead of
@@ -1099,16 +1112,7 @@ courant = 0.5
 t_end = 1.0
 "#,
     );
-    let out = std::process::Command::new("sh")
-        .args([
-            "-c",
-            "ulimit -v 1500000 && exec \"$0\" \"$@\"",
-            assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
-            "run",
-            file.arg(),
-        ])
-        .output()
-        .unwrap();
+    let out = under_address_space_limit(1500000, &["run", file.arg()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
@@ -1146,18 +1150,10 @@ t_end = 0.8
 "#,
     );
     let dir = std::env::temp_dir().join(format!("psmpm-framed-out-{}", std::process::id()));
-    let out = std::process::Command::new("sh")
-        .args([
-            "-c",
-            "ulimit -v 1000000 && exec \"$0\" \"$@\"",
-            assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
-            "run",
-            file.arg(),
-            "--out",
-            dir.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let out = under_address_space_limit(
+        1000000,
+        &["run", file.arg(), "--out", dir.to_str().unwrap()],
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
@@ -1201,16 +1197,7 @@ courant = 0.5
 t_end = 0.01
 "#,
     );
-    let out = std::process::Command::new("sh")
-        .args([
-            "-c",
-            "ulimit -v 150000 && exec \"$0\" \"$@\"",
-            assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
-            "run",
-            file.arg(),
-        ])
-        .output()
-        .unwrap();
+    let out = under_address_space_limit(150000, &["run", file.arg()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     for part in [
@@ -1254,20 +1241,10 @@ t_end = 0.01
 "#,
     );
     for threads in ["8", "16"] {
-        let out = std::process::Command::new("sh")
-            .args([
-                "-c",
-                "ulimit -v 400000 && exec \"$0\" \"$@\"",
-                assert_cmd::cargo::cargo_bin("mpm-cli").to_str().unwrap(),
-                "run",
-                file.arg(),
-                "--threads",
-                threads,
-                "--diag-every",
-                "0",
-            ])
-            .output()
-            .unwrap();
+        let out = under_address_space_limit(
+            400000,
+            &["run", file.arg(), "--threads", threads, "--diag-every", "0"],
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         match out.status.code() {
             Some(0) => {}
