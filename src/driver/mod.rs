@@ -881,14 +881,28 @@ where
         self.assemble_effects();
         let t_assemble = clock.elapsed().as_secs_f64();
         let power_start = self.power_at_start()?;
-        self.solve_acceleration()?;
-        let t_solve = clock.elapsed().as_secs_f64() - t_assemble;
-        self.update_velocities_and_momentum()?;
-        let before_projection = clock.elapsed().as_secs_f64();
-        self.solve_projection()?;
-        let t_projection = clock.elapsed().as_secs_f64() - before_projection;
+        let (t_solve, t_projection, accelerate);
+        if self.mass.solves_mass_itself() {
+            // `M v̂ = P(vⁿ⁺¹) = P(vⁿ) + Δt M a`: with `M` itself solved,
+            // `v̂ = M⁻¹ P(vⁿ) + Δt a`, both solves in one pass over the factor and
+            // the particle velocities updated in phase 6.
+            self.scatter_momentum();
+            let before = clock.elapsed().as_secs_f64();
+            self.solve_both()?;
+            t_solve = clock.elapsed().as_secs_f64() - before;
+            t_projection = 0.0;
+            accelerate = true;
+        } else {
+            self.solve_acceleration()?;
+            t_solve = clock.elapsed().as_secs_f64() - t_assemble;
+            self.update_velocities_and_momentum()?;
+            let before_projection = clock.elapsed().as_secs_f64();
+            self.solve_projection()?;
+            t_projection = clock.elapsed().as_secs_f64() - before_projection;
+            accelerate = false;
+        }
         self.book_work(power_start);
-        self.update_particles()?;
+        self.update_particles(accelerate)?;
         times.assemble += t_assemble;
         times.solve += t_solve + t_projection;
         times.update += clock.elapsed().as_secs_f64() - t_assemble - t_solve - t_projection;
@@ -1261,6 +1275,39 @@ where
         self.solve_projected(Which::Velocity)
     }
 
+    /// `P(vⁿ)_i = Σ_p m_p phi_i(x_p) vⁿ_p` into `velocity`.
+    fn scatter_momentum(&mut self) {
+        phases::zero(&mut self.velocity);
+        phases::scatter_to_functions(
+            &self.evals,
+            &self.bins,
+            &self.gather,
+            &mut self.local,
+            &self.particles.mass,
+            &self.particles.v,
+            &mut self.velocity,
+        );
+    }
+
+    /// Phases 3b and 5 at once for a strategy that solves `M` itself: `a = M⁻¹ F`
+    /// (eq. (17)) and `v̂ = M⁻¹ P(vⁿ) + Δt a`, which is `M⁻¹ P(vⁿ⁺¹)` (eq. (20))
+    /// since `P(vⁿ⁺¹) = P(vⁿ) + Δt M a` (eq. (18)); both projected onto the general
+    /// constraints (a linear projection that leaves `a` as it is).
+    fn solve_both(&mut self) -> Result<(), StepError> {
+        if let Err(source) = self.mass.solve_all_two(&mut self.rhs, &mut self.velocity) {
+            return Err(self.mass_failure(source));
+        }
+        self.constraints.project(&mut self.rhs);
+        self.constraints.project(&mut self.velocity);
+        let dt = self.dt;
+        for (v, a) in self.velocity.iter_mut().zip(&self.rhs) {
+            for (v, &a) in v.iter_mut().zip(a) {
+                *v += dt * a;
+            }
+        }
+        Ok(())
+    }
+
     /// Phases 4–5: particle velocities and momentum, with the affine correction
     /// when the strategy lumped rows and asked for it (it needs `v̂ⁿ`, projected
     /// from the initial velocities before the first step).
@@ -1294,14 +1341,15 @@ where
     }
 
     /// Phase 6: deformation, stress, volume and positions (eqs. (22)–(31)).
-    fn update_particles(&mut self) -> Result<(), StepError> {
+    fn update_particles(&mut self, accelerate: bool) -> Result<(), StepError> {
         phases::update_particles(
             &self.evals,
             &self.velocity,
+            accelerate.then_some(self.rhs.as_slice()),
             self.dt,
             &self.material,
             &mut self.particles,
-            &mut self.energy_terms,
+            (&mut self.energy_terms, &mut self.centred_terms),
         )
         .map_err(|failure| {
             let (particle, quantity) = match failure {

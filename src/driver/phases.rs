@@ -1096,13 +1096,15 @@ pub fn update_deformation_gradient<T: Scalar, const D: usize>(
 /// `energy[c]` receives the [`crate::diagnostics::particle_terms`] of the updated
 /// particles of chunk `c`, accumulated in particle order
 /// ([`crate::diagnostics::accumulate_terms`]), for the step's energies.
+#[allow(clippy::too_many_arguments)]
 pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>(
     evals: &Evaluations<T, D>,
     velocity: &[Vec<T>],
+    acceleration: Option<&[Vec<T>]>,
     dt: T,
     material: &Mat,
     parts: &mut Particles<T, D>,
-    energy: &mut [[f64; crate::diagnostics::TERMS]],
+    (energy, centred): (&mut [[f64; crate::diagnostics::TERMS]], &mut [f64]),
 ) -> Result<(), UpdateFailure> {
     // Empty when no particle has an initial stress (then it is zero).
     let sigma0 = &parts.sigma0;
@@ -1116,18 +1118,33 @@ pub fn update_particles<T: Scalar, const D: usize, Mat: ParticleMaterials<T, D>>
         ),
         (
             parts.volume0.par_chunks(CHUNK),
-            parts.v.par_chunks(CHUNK),
+            parts.v.par_chunks_mut(CHUNK),
             parts.mass.par_chunks(CHUNK),
             energy.par_iter_mut(),
+            centred.par_iter_mut(),
         ),
     )
         .into_par_iter()
         .enumerate()
         .filter_map(
-            |(c, ((fs, sigma, volume, x, u), (volume0, v, mass, energy)))| {
+            |(c, ((fs, sigma, volume, x, u), (volume0, v, mass, energy, centred)))| {
                 *energy = [0.0; crate::diagnostics::TERMS];
+                if acceleration.is_some() {
+                    *centred = 0.0;
+                }
                 for q in 0..fs.len() {
                     let p = c * CHUNK + q;
+                    if let Some(acceleration) = acceleration {
+                        let mut a = SVector::<T, D>::zeros();
+                        for (s, i) in evals.entries(p) {
+                            for k in 0..D {
+                                a[k] += acceleration[k][i] * evals.phi[s];
+                            }
+                        }
+                        let dv = a * dt;
+                        *centred += mass[q].to_f64() * v[q].dot(&dv).to_f64();
+                        v[q] += dv;
+                    }
                     let mut grad_v = SMatrix::<T, D, D>::zeros();
                     let mut v_hat = SVector::<T, D>::zeros();
                     for (s, i) in evals.entries(p) {

@@ -38,6 +38,16 @@ impl<T: Scalar> MassStrategy<T> for Consistent<T> {
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         self.solver.solve_all(rhs)
     }
+    fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        self.solver.solve_all_two(first, second)
+    }
+    fn solves_mass_itself(&self) -> bool {
+        true
+    }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }

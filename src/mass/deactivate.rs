@@ -65,6 +65,17 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         self.solver.solve_all(rhs)
     }
+    fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        self.solver.solve_all_two(first, second)
+    }
+    /// The active rows' own system: deactivated rows are held at zero.
+    fn solves_mass_itself(&self) -> bool {
+        true
+    }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }

@@ -100,10 +100,10 @@ impl<T: Scalar> Compact<T> {
             slot[i] = usize::MAX;
         }
         let m = rows.len();
-        let solver = SparseCholesky::from_upper(col_ptr.clone(), row_idx.clone(), 1);
+        let solver = SparseCholesky::from_upper(col_ptr.clone(), row_idx.clone(), 2);
         Compact {
             values: vec![T::zero(); source.len()],
-            rhs: vec![T::zero(); m],
+            rhs: vec![T::zero(); 2 * m],
             work: [vec![T::zero(); m], vec![T::zero(); m]],
             rows,
             col_ptr,
@@ -151,9 +151,28 @@ impl<T: Scalar> Compact<T> {
             *v = rhs[i];
         }
         rhs.iter_mut().for_each(|v| *v = T::zero());
-        self.solver.solve_in_place(&mut self.rhs, 1);
+        let m = self.rows.len();
+        self.solver.solve_in_place(&mut self.rhs[..m], 1);
         for (v, &i) in self.rhs.iter().zip(&self.rows) {
             rhs[i] = *v;
+        }
+    }
+
+    /// [`solve`](Self::solve) of two right-hand sides in one pass over the factor.
+    fn solve_two(&mut self, first: &mut [T], second: &mut [T]) {
+        let m = self.rows.len();
+        let (r0, r1) = self.rhs.split_at_mut(m);
+        for ((a, b), &i) in r0.iter_mut().zip(r1.iter_mut()).zip(&self.rows) {
+            *a = first[i];
+            *b = second[i];
+        }
+        first.iter_mut().for_each(|v| *v = T::zero());
+        second.iter_mut().for_each(|v| *v = T::zero());
+        self.solver.solve_in_place(&mut self.rhs, 2);
+        let (r0, r1) = self.rhs.split_at(m);
+        for ((&a, &b), &i) in r0.iter().zip(r1).zip(&self.rows) {
+            first[i] = a;
+            second[i] = b;
         }
     }
 
@@ -204,6 +223,22 @@ fn solve_one<T: Scalar>(
             .as_mut()
             .expect("solve before a successful factorisation")
             .solve_in_place(rhs, 1),
+    }
+}
+
+/// [`solve_one`] of two right-hand sides in one pass over the factor.
+fn solve_two<T: Scalar>(
+    solver: &mut Option<SparseCholesky<T>>,
+    compact: &mut Option<Compact<T>>,
+    first: &mut [T],
+    second: &mut [T],
+) {
+    match compact {
+        Some(c) => c.solve_two(first, second),
+        None => solver
+            .as_mut()
+            .expect("solve before a successful factorisation")
+            .solve_two_in_place(first, second),
     }
 }
 
@@ -365,7 +400,7 @@ impl<T: Scalar> MaskedCholesky<T> {
                             .err();
                         return;
                     }
-                    let solver = solver.get_or_insert_with(|| SparseCholesky::new(pattern, 1));
+                    let solver = solver.get_or_insert_with(|| SparseCholesky::new(pattern, 2));
                     if modified.len() != pattern.nnz() {
                         *modified = vec![T::zero(); pattern.nnz()];
                     }
@@ -435,6 +470,45 @@ impl<T: Scalar> MaskedCholesky<T> {
                 for (k, r) in rhs.iter_mut().enumerate() {
                     let s = self.solver_of[k];
                     solve_one(&mut self.solvers[s], &mut self.compact[s], r);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// [`solve_all`](Self::solve_all) of two sets of right-hand sides, each
+    /// component's pair in one pass over its factor.
+    pub fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        for (k, (a, b)) in first.iter_mut().zip(second.iter_mut()).enumerate() {
+            if self.compact[self.solver_of[k]].is_none() {
+                self.mask(k, a);
+                self.mask(k, b);
+            }
+        }
+        match (first, second, self.solver_of.as_slice()) {
+            ([a0, a1], [b0, b1], &[a, b]) if a != b => {
+                let (low, high) = self.solvers.split_at_mut(a.max(b));
+                let (s0, s1) = if a < b {
+                    (&mut low[a], &mut high[0])
+                } else {
+                    (&mut high[0], &mut low[b])
+                };
+                let (clow, chigh) = self.compact.split_at_mut(a.max(b));
+                let (c0, c1) = if a < b {
+                    (&mut clow[a], &mut chigh[0])
+                } else {
+                    (&mut chigh[0], &mut clow[b])
+                };
+                rayon::join(|| solve_two(s0, c0, a0, b0), || solve_two(s1, c1, a1, b1));
+            }
+            (first, second, _) => {
+                for (k, (a, b)) in first.iter_mut().zip(second.iter_mut()).enumerate() {
+                    let s = self.solver_of[k];
+                    solve_two(&mut self.solvers[s], &mut self.compact[s], a, b);
                 }
             }
         }

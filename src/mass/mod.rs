@@ -504,6 +504,23 @@ pub trait MassStrategy<T: Scalar>: Send {
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         solve_each(self, rhs)
     }
+    /// [`solve_all`](Self::solve_all) of two sets of right-hand sides with the
+    /// same systems; a strategy with a factorisation solves each component's
+    /// pair in one pass over its factor.
+    fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        self.solve_all(first)?;
+        self.solve_all(second)
+    }
+    /// `true` when the system last factorised is `M` itself on the rows it
+    /// solves, every other row held at zero (no row lumped, no function
+    /// extended): then `M'⁻¹ M x = x` for every `x` that vanishes off those rows.
+    fn solves_mass_itself(&self) -> bool {
+        false
+    }
     /// An estimate of the spectral condition number of the systems last factorised
     /// (the largest over components). Costs about `2 ×` [`CONDITION_ITERATIONS`]
     /// solves; call on request.
@@ -557,6 +574,16 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         (**self).solve_all(rhs)
+    }
+    fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        (**self).solve_all_two(first, second)
+    }
+    fn solves_mass_itself(&self) -> bool {
+        (**self).solves_mass_itself()
     }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         (**self).condition_estimate(pattern)

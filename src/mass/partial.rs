@@ -24,6 +24,8 @@ pub struct Partial<T: Scalar> {
     rule: LumpRule,
     solver: MaskedCholesky<T>,
     support_volume: Vec<f64>,
+    /// Some row lumped in the system last factorised.
+    any_lumped: bool,
 }
 
 impl<T: Scalar> Partial<T> {
@@ -33,6 +35,7 @@ impl<T: Scalar> Partial<T> {
             rule,
             solver: MaskedCholesky::default(),
             support_volume: Vec::new(),
+            any_lumped: false,
         }
     }
 }
@@ -95,6 +98,7 @@ impl<T: Scalar> MassStrategy<T> for Partial<T> {
             report.lumped_rows += lumped as usize;
             report.active += !inactive as usize;
         }
+        self.any_lumped = report.lumped_rows > 0;
         self.solver.factorize(pattern, values)?;
         Ok(report)
     }
@@ -103,6 +107,16 @@ impl<T: Scalar> MassStrategy<T> for Partial<T> {
     }
     fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
         self.solver.solve_all(rhs)
+    }
+    fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        self.solver.solve_all_two(first, second)
+    }
+    fn solves_mass_itself(&self) -> bool {
+        !self.any_lumped
     }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)

@@ -45,6 +45,10 @@ fn rounded(v: Value) -> Value {
     match v {
         Value::Number(n) if n.is_f64() => {
             let x = n.as_f64().unwrap();
+            // Below 1e-12: the round-off of an exact zero (the sideways
+            // displacement of a bar that moves along its axis), whose digits
+            // follow the order of the sums, not the method.
+            let x = if x.abs() < 1e-12 { 0.0 } else { x };
             let r: f64 = format!("{x:.3e}").parse().unwrap();
             serde_json::json!(r)
         }

@@ -670,6 +670,29 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         self.fill_ghosts(k, rhs);
         result
     }
+    fn solve_all_two(
+        &mut self,
+        first: &mut [Vec<T>],
+        second: &mut [Vec<T>],
+    ) -> Result<(), MassError> {
+        if !self.direct {
+            self.solve_all(first)?;
+            return self.solve_all(second);
+        }
+        self.cholesky.solve_all_two(first, second)?;
+        for rhs in [first, second] {
+            for (k, r) in rhs.iter_mut().enumerate() {
+                self.fill_ghosts(k, r);
+            }
+        }
+        Ok(())
+    }
+    /// Nothing extended and no row lumped: `M` itself, solved by Cholesky; the
+    /// ghosts (functions without mass) are filled from their neighbours, a
+    /// linear map, after each solve.
+    fn solves_mass_itself(&self) -> bool {
+        self.direct && !self.any_lumped
+    }
     /// `κ(Eᵀ M E)` on the solved functions, from Lanczos steps (no solves).
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         if self.direct {
