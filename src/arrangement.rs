@@ -570,7 +570,7 @@ pub fn irregularity_warning(
     (irregular >= 3 && irregular as f64 >= IRREGULAR_WARNING * measured as f64).then(|| {
         let fix = if ps && sampling < PS_REGULAR_SAMPLING {
             format!(
-                "with PS, {sampling:.1} particles per occupied triangle under-sample its nine quadratic functions once the strains are large, and the body's rows buckle into modes the particles do not resist (a soft block dropped onto a floor: 9.4 % of its particles irregular at 4 per triangle, 1.3 % at 6.25, none at 9); give {PS_REGULAR_SAMPLING:.0} or more per triangle (`per_block` 6 × 6 on block meshes of four triangles, `per_triangle`, `count` or `spacing`; `--particles`)"
+                "with PS, {sampling:.1} particles per occupied triangle under-sample its nine quadratic functions once the strains are large, and the body's rows buckle into modes the particles do not resist (a soft block dropped onto a floor: 9.4 % of its particles irregular at 4 per triangle, 1.3 % at 6.25, none at 9); give {PS_REGULAR_SAMPLING:.0} or more per triangle (`per_block` 6 × 6 on block meshes of four triangles, `per_triangle`, `count` or `spacing`; `--particles`); a hard impact can leave some at any sampling (a 1 × 1 block, E = 1e5, dropped 1 m onto a floor: 20 % at 4 per triangle, 8–12 % at 9 and 16, whatever the step): look at them to judge"
             )
         } else {
             "give more particles per element (`per_block`, `per_triangle`, `count` or `spacing`; `--particles`), and if the body was struck hard a smaller `courant`".to_string()

@@ -107,6 +107,13 @@ pub trait Effect<T: Scalar, const D: usize>: Send + Sync {
     fn potential_energy(&self, _particles: &Particles<T, D>) -> f64 {
         0.0
     }
+    /// A bound on the acceleration the effect alone gives every particle, the same
+    /// for all (gravity's `|g|`, a uniform body force's `|b|`): the watch adds the
+    /// speed it gives in a step to the particles' own when it bounds how far a
+    /// step moves them (`Driver::advection_substeps`). 0 (the default): none known.
+    fn acceleration_bound(&self) -> f64 {
+        0.0
+    }
     /// How much the effect can scale the grid forces of a step: the critical time
     /// step is divided by the square root of it (1: not at all).
     fn force_amplification(&self) -> f64 {
@@ -181,6 +188,9 @@ impl<T: Scalar, const D: usize> Effect<T, D> for Gravity<T, D> {
     }
     fn acts_per_particle(&self) -> bool {
         true
+    }
+    fn acceleration_bound(&self) -> f64 {
+        self.g.norm().to_f64()
     }
     fn potential_energy(&self, particles: &Particles<T, D>) -> f64 {
         particles
@@ -273,6 +283,14 @@ impl<T: Scalar, const D: usize> Effect<T, D> for BodyForce<T, D> {
     }
     fn acts_per_particle(&self) -> bool {
         true
+    }
+    fn acceleration_bound(&self) -> f64 {
+        match self {
+            BodyForce::Uniform(b) => b.norm().to_f64(),
+            // A field that varies in space and time, with no uniform bound known
+            // here: the particles' own speeds, which follow it, bound the move.
+            BodyForce::Manufactured(_) => 0.0,
+        }
     }
     fn does_work(&self) -> bool {
         true

@@ -1452,6 +1452,10 @@ where
         phases.solve += r.phases.solve;
         phases.update += r.phases.update;
     }
+    if failure.is_none() && !interrupted {
+        // A particle the last step carried out of the mesh: no next step finds it.
+        failure = driver.check_in_mesh().err();
+    }
     Tally {
         tracked,
         verdict,

@@ -877,6 +877,39 @@ fn csv(rows: &[Level]) -> String {
 }
 
 /// `converge.csv`, `converge.json`, `error-vs-h.svg`, `work-precision.svg`.
+/// Per basis with two stable levels or more, a guide of the slope its degree
+/// gives the displacement error (`h^(p+1)`: 3 for the quadratic PS and B-spline
+/// bases, 2 for PL) through its finest stable level, over its levels' mesh sizes:
+/// the order read off the plot against the one the theory gives.
+fn reference_slopes(rows: &[Level]) -> Vec<Series> {
+    let mut bases: Vec<&str> = rows.iter().map(|r| r.basis).collect();
+    bases.dedup();
+    bases
+        .into_iter()
+        .filter_map(|b| {
+            let stable: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.basis == b && r.stable)
+                .filter_map(|r| r.error.map(|e| (r.h, e)))
+                .filter(|(h, e)| *h > 0.0 && *e > 0.0)
+                .collect();
+            let order = match BasisKind::parse(b).ok()? {
+                BasisKind::Ps | BasisKind::Bspline => 3,
+                BasisKind::Pl | BasisKind::Pl1d => 2,
+            };
+            let &(h0, e0) = stable.iter().min_by(|a, b| a.0.total_cmp(&b.0))?;
+            let h1 = stable.iter().map(|p| p.0).fold(h0, f64::max);
+            (h1 > h0).then(|| {
+                Series::new(
+                    format!("slope {order} ({} reference)", b.to_uppercase()),
+                    [(h0, e0), (h1, e0 * (h1 / h0).powi(order))],
+                    SeriesStyle::Guide,
+                )
+            })
+        })
+        .collect()
+}
+
 fn write_outputs(dir: &std::path::Path, scene: &str, study: &Study) -> Result<(), CliError> {
     let (rows, against) = (study.rows, study.against);
     let io = |path: &std::path::Path, e: std::io::Error| {
@@ -917,12 +950,14 @@ fn write_outputs(dir: &std::path::Path, scene: &str, study: &Study) -> Result<()
         }
         series
     };
+    let mut against_h = curves(&|r| r.h);
+    against_h.extend(reference_slopes(rows));
     let plots = [
         (
             "error-vs-h.svg",
             format!("{scene}: error against mesh size"),
             "mesh size h",
-            curves(&|r| r.h),
+            against_h,
         ),
         (
             "work-precision.svg",

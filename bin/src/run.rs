@@ -389,6 +389,12 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
                     "{}: no such file; give a scene file FILE.toml or a built-in scene (known: {known}",
                     psmpm::scene::limits::echo(name)
                 ))
+            } else if std::path::Path::new(&format!("{name}.toml")).is_file() {
+                // The scene file's name without its extension (`run drop`).
+                CliError::Input(format!(
+                    "{unknown}; a scene file `{}.toml` is here: give the file's whole name",
+                    psmpm::scene::limits::echo(name)
+                ))
             } else {
                 CliError::Input(unknown)
             }
@@ -399,7 +405,15 @@ pub fn read_scene(name: &str) -> Result<Scene, CliError> {
 /// The basis `--basis NAME` gives a scene of dimension `dim`; the error names the
 /// option, the scene's dimension and the bases that fit it.
 pub fn basis_option(name: &str, dim: usize) -> Result<BasisKind, CliError> {
-    let basis = BasisKind::parse(name).map_err(|m| CliError::Input(format!("--basis: {m}")))?;
+    let basis = BasisKind::parse(name).map_err(|m| {
+        // Several bases side by side are `compare`'s (`run --basis ps,pl`).
+        let side_by_side = if name.contains(',') {
+            "; `run` takes one basis: to run several side by side, `mpm-cli compare SCENE --basis ps,pl`"
+        } else {
+            ""
+        };
+        CliError::Input(format!("--basis: {m}{side_by_side}"))
+    })?;
     if basis.dim() != dim {
         let fit: Vec<&str> = BasisKind::ALL
             .into_iter()
@@ -668,6 +682,8 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
     let mut table = Table::new(&COLUMNS);
     let format = args.format;
     let mut csv_header = true;
+    // When the steps began, and whether the run's length was told (once).
+    let (mut stepping, mut told) = (None::<std::time::Instant>, false);
     let mut observer = |r: &StepReport, particles: ParticlesRef<'_>| {
         if let Some(recorder) = recorder.as_mut() {
             recorder.observe(r, particles);
@@ -723,6 +739,20 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
             progress.set_total(out::steps_from_dt(t_end, r.time) as u64);
         }
         progress.inc(1);
+        // A long run says how long, once its first seconds tell (a student's
+        // mesh of a million triangles ran 70 of its 41 000 steps in 5 minutes,
+        // with no bar where stderr is not a terminal).
+        let started = *stepping.get_or_insert_with(std::time::Instant::now);
+        if !told && format == Format::Table && r.step > 1 {
+            let seconds = started.elapsed().as_secs_f64();
+            if seconds >= LENGTH_NOTE_AFTER {
+                told = true;
+                let total = out::steps_from_dt(t_end, r.dt);
+                if let Some(note) = run_length_note(r.step - 1, seconds, total) {
+                    let _ = writeln!(std::io::stderr(), "note: {note}");
+                }
+            }
+        }
         if every > 0 && r.step % every == 0 {
             match format {
                 Format::Json => stdout.line(&row_json(r).to_string()),
@@ -820,6 +850,47 @@ fn run_on_pool(args: RunArgs) -> Result<(), CliError> {
 
 /// Steps from which a run says at the start how many it takes and why.
 pub const LONG_RUN_STEPS: usize = 1_000_000;
+
+/// Seconds of steps after which a run tells how long it will take
+/// ([`run_length_note`]).
+pub const LENGTH_NOTE_AFTER: f64 = 2.0;
+
+/// A run whose steps take longer than this in all is told its length.
+pub const LONG_RUN_SECONDS: f64 = 60.0;
+
+/// The note of a run that `done` steps in `seconds` project beyond
+/// [`LONG_RUN_SECONDS`] over its `total` steps: the time left and the ways to
+/// a shorter first look.
+pub fn run_length_note(done: usize, seconds: f64, total: usize) -> Option<String> {
+    if done == 0 || total <= done {
+        return None;
+    }
+    let per_step = seconds / done as f64;
+    let left = per_step * (total - done) as f64;
+    (seconds + left > LONG_RUN_SECONDS).then(|| {
+        format!(
+            "{done} of {total} steps in {seconds:.1} s ({} per step): about {} to go; for a first look lower `t_end` (`--t-end`) or coarsen the mesh; Ctrl-C stops the run and writes its files",
+            duration(per_step),
+            duration(left)
+        )
+    })
+}
+
+/// `seconds` as a person reads it: ms, s, min or h.
+fn duration(seconds: f64) -> String {
+    if seconds < 1.0 {
+        let ms = format!("{:.3}", 1e3 * seconds);
+        format!("{} ms", ms.trim_end_matches('0').trim_end_matches('.'))
+    } else if seconds < 10.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else if seconds < 7200.0 {
+        format!("{:.0} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
+}
 
 /// For a run of [`LONG_RUN_STEPS`] steps or more, how many and why: the critical
 /// step is the element size over the P-wave speed, `√((λ + 2μ)/ρ)`, which a
@@ -1154,5 +1225,25 @@ mod tests {
             nearly.contains("ν = 0.4999999999 makes 35200× that of ν = 0.3"),
             "{nearly}"
         );
+    }
+
+    /// A run projected beyond a minute is told its length once its first seconds
+    /// are measured (a mesh of a million triangles: 70 of 41 000 steps in 300 s);
+    /// a short one is not.
+    #[test]
+    fn a_long_run_is_told_its_length_from_its_first_steps() {
+        assert!(run_length_note(100, 2.0, 2000).is_none(), "40 s in all");
+        let note = run_length_note(5, 21.4, 41_000).unwrap();
+        assert!(
+            note.starts_with("5 of 41000 steps in 21.4 s (4.3 s per step): about 48.7 h to go;"),
+            "{note}"
+        );
+        let note = run_length_note(700, 2.1, 588_295).unwrap();
+        assert!(
+            note.contains("(3 ms per step): about 29 min to go"),
+            "{note}"
+        );
+        assert!(run_length_note(0, 2.0, 10).is_none());
+        assert!(run_length_note(10, 2.0, 10).is_none());
     }
 }

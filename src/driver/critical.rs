@@ -356,10 +356,21 @@ where
     /// soft block at 60 m/s moved 3.3 elements per step at `courant` 0.4 and
     /// passed through a slip wall; a contact wall's springs stop a body arriving
     /// at `v` within about `v Δt / κ`, `κ = 1/2`). The particle speed `|v_p|`
-    /// bounds the speed that moves it. Fewer sub-steps than now only where they
-    /// stay below [`ADVECTION_RELEASE`] of the limit (a hysteresis).
+    /// bounds the speed that moves it, with what the loads' acceleration adds
+    /// over the step ([`Effect::acceleration_bound`](crate::effect::Effect::acceleration_bound)):
+    /// a body at rest under gravity falls `|g| Δt²` in a step, which the speed at
+    /// the start does not see (a soft block with the critical step of seconds
+    /// fell 40 elements, out of the mesh, in its first step). Fewer sub-steps than
+    /// now only where they stay below [`ADVECTION_RELEASE`] of the limit (a
+    /// hysteresis).
     fn advection_substeps(&mut self) -> Result<usize, StepError> {
         let dt = self.dt_outer;
+        let gained: f64 = dt
+            * self
+                .effects
+                .iter()
+                .map(|e| e.acceleration_bound())
+                .sum::<f64>();
         let (x, v, element, volume0) = (
             &self.particles.x,
             &self.particles.v,
@@ -375,7 +386,7 @@ where
         let worst = (0..x.len())
             .into_par_iter()
             .map(|p| {
-                let speed = v[p].norm().to_f64();
+                let speed = v[p].norm().to_f64() + gained;
                 let e = element[p];
                 let mut allowed = ADVECTION_SHARE * width[e];
                 // Not only the particles already within a wall's reach: one on
@@ -424,6 +435,33 @@ where
                 ),
                 _ => format!("`dt` to {:.2e}", shorter * dt),
             };
+            // The loads' share of the speed, where it is most of it.
+            let moves = if gained > 0.5 * speed {
+                "reaches"
+            } else {
+                "moves at"
+            };
+            let loads = if gained > 0.5 * speed {
+                format!(
+                    " within the step ({:.3e} of it from the loads' acceleration, {:.3e}, over the step)",
+                    gained,
+                    gained / dt
+                )
+            } else {
+                String::new()
+            };
+            // A step far longer than a motion under the loads allows: the critical
+            // step is long, which a soft or light material makes.
+            let soft = if gained > 0.5 * speed {
+                match self.dt_critical {
+                    Some(c) if c.is_finite() && c >= dt => format!(
+                        "; the critical step, {c:.3e}, is long for the motion: the material is very soft for its density (check the units of `young`, Pa, and `density`, kg/m³)"
+                    ),
+                    _ => String::new(),
+                }
+            } else {
+                "; if that speed is not one the scene gives (its initial velocities and what its loads add), the run became unstable earlier (see the energy column)".to_string()
+            };
             let how_far = if contact {
                 "half its element's width, or a quarter of its contact distance near a contact wall"
             } else {
@@ -432,7 +470,7 @@ where
             return Err(StepError::TooFast {
                 step: self.step + 1,
                 reason: format!(
-                    "particle {particle} at {at} moves at {speed:.3e}: a step of {dt:.3e} carries it {share:.0} times as far as it may go in one sub-step ({how_far}), more than the {MAX_SUBSTEPS} sub-steps a step may be split into; lower {lower}; if that speed is not one the scene gives (its initial velocities and what its loads add), the run became unstable earlier (see the energy column)"
+                    "particle {particle} at {at} {moves} {speed:.3e}{loads}: a step of {dt:.3e} carries it {share:.0} times as far as it may go in one sub-step ({how_far}), more than the {MAX_SUBSTEPS} sub-steps a step may be split into; lower {lower}{soft}"
                 ),
             });
         }

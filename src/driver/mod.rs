@@ -931,8 +931,21 @@ where
         Ok(report)
     }
 
+    /// Locates the particles after the last step, so that a particle the last
+    /// step carried out of the mesh fails the run as the next step would have
+    /// (a run whose bodies fell out of the mesh in its last step was reported
+    /// complete). The error names the last step, the one that moved it.
+    pub fn check_in_mesh(&mut self) -> Result<(), StepError> {
+        self.locate_at(self.step)
+    }
+
     /// Phase 1.
     fn locate_and_evaluate(&mut self) -> Result<(), StepError> {
+        self.locate_at(self.step + 1)
+    }
+
+    /// Phase 1, a failure reported at `step`.
+    fn locate_at(&mut self, step: usize) -> Result<(), StepError> {
         phases::locate_and_evaluate(
             &self.basis,
             &self.particles.x,
@@ -1004,7 +1017,7 @@ where
                     if speeds > critical.max(1) {
                         let sub = self.dt.to_f64() / c;
                         return StepError::ParticleLeftMesh {
-                            step: self.step + 1,
+                            step,
                             particle: p,
                             position: to_f64(&self.particles.x[p]),
                             hint: format!(
@@ -1042,6 +1055,19 @@ where
                 format!(
                     "it moved {moved:.3e} in the last step at speed {speed:.3e} and went out of an element that a wall (`fix`) holds functions of: if it crossed the wall, a wall holds the velocity of the functions on it, not of each particle, and a particle that moves a large part of an element in one step can cross it: lower `time.courant` (or `time.dt`); if it left through a free side beside the wall, add a wall there or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
                 )
+            } else if moved > self.element_width[from] {
+                // Across elements in one step: a `fix` wall holds the grid's
+                // velocity at the boundary, and a particle carried past it in one
+                // step leaves the mesh whatever the walls.
+                let watch = if self.watch.is_none() {
+                    "the watch over the step is off (`--no-watch`), which splits a step that would carry a particle more than half its element: turn it on, or "
+                } else {
+                    ""
+                };
+                format!(
+                    "it moved {moved:.3e} in the last step at speed {speed:.3e}, {:.0} widths of its element: a step that carries a particle across elements takes it through the mesh's walls (a `fix` wall holds the grid's velocity at the boundary, not a particle carried past it); {watch}lower the step (`time.courant` or `dt`); if the speed is unphysical, the run became unstable earlier (see the energy column)",
+                    moved / self.element_width[from]
+                )
             } else {
                 format!(
                     "it moved {moved:.3e} in the last step at speed {speed:.3e}: if the body should stay inside, add a wall (`fix`, or a contact wall) on that side of the mesh or enlarge the mesh; if the speed is unphysical, the run became unstable earlier (see the energy column)"
@@ -1054,7 +1080,7 @@ where
                 None => hint,
             };
             StepError::ParticleLeftMesh {
-                step: self.step + 1,
+                step,
                 particle: p,
                 position: to_f64(&self.particles.x[p]),
                 hint,

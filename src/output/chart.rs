@@ -159,11 +159,16 @@ pub enum SeriesStyle {
     Markers,
     /// Both.
     LineAndMarkers,
+    /// A thin grey line: a guide such as a reference slope, in no series' colour.
+    Guide,
 }
 
 impl SeriesStyle {
     fn has_line(self) -> bool {
         matches!(self, SeriesStyle::Line | SeriesStyle::LineAndMarkers)
+    }
+    fn is_guide(self) -> bool {
+        self == SeriesStyle::Guide
     }
     fn has_markers(self) -> bool {
         matches!(self, SeriesStyle::Markers | SeriesStyle::LineAndMarkers)
@@ -498,6 +503,11 @@ pub(crate) fn line_swatch(area: &Area, x: i32, y: i32, style: ShapeStyle) -> Res
     .map_err(draw_err)
 }
 
+/// The stroke of a guide line ([`SeriesStyle::Guide`]).
+fn guide_style() -> ShapeStyle {
+    BLACK.mix(0.4).stroke_width(1)
+}
+
 /// Renders a line plot to an SVG string.
 fn render_line_plot(plot: &LinePlot) -> Result<String, PlotError> {
     render_stacked(std::slice::from_ref(plot))
@@ -586,6 +596,11 @@ fn draw_line_plot(root: &Area, plot: &LinePlot, legend_width: u32) -> Result<(),
                     .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
                     .map_err(draw_err)?;
             }
+            if s.style.is_guide() {
+                chart
+                    .draw_series(LineSeries::new(s.points.iter().copied(), guide_style()))
+                    .map_err(draw_err)?;
+            }
             if s.style.has_markers() {
                 chart
                     .draw_series(
@@ -604,6 +619,9 @@ fn draw_line_plot(root: &Area, plot: &LinePlot, legend_width: u32) -> Result<(),
             let y = top + 12 + LEGEND_ROW * k as i32;
             if s.style.has_line() {
                 line_swatch(&legend, 6, y, c.stroke_width(2))?;
+            }
+            if s.style.is_guide() {
+                line_swatch(&legend, 6, y, guide_style())?;
             }
             if s.style.has_markers() {
                 legend

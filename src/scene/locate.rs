@@ -380,7 +380,14 @@ fn located(text: &str, at: usize, message: String) -> (usize, Option<String>, St
                 || message.starts_with("invalid type: integer")
             {
                 if let Some(value) = quoted.filter(|_| message.ends_with("expected a sequence")) {
-                    message = format!("{message}: write it as a list, `[{value}]`");
+                    // In 2D a vector has two entries (`g = -9.81` for `[0.0, -9.81]`).
+                    message = if declared_dim(text) == Some(2) {
+                        format!(
+                            "{message}: write it as a list of its x and y entries, e.g. `[0.0, {value}]`"
+                        )
+                    } else {
+                        format!("{message}: write it as a list, `[{value}]`")
+                    };
                 }
             }
         } else if message.starts_with("invalid type: sequence") {
@@ -478,4 +485,15 @@ fn header_field(text: &str, at: usize, message: &str) -> Option<(String, String)
         (Some(key), None) => Some((path, key)),
         _ => None,
     }
+}
+
+/// The scene's `dim = N` from its text (a top-level line), if written.
+fn declared_dim(text: &str) -> Option<u32> {
+    text.lines()
+        .map(str::trim)
+        .take_while(|line| !line.starts_with('['))
+        .find_map(|line| {
+            let (key, value) = line.split_once('=')?;
+            (key.trim() == "dim").then(|| value.split('#').next()?.trim().parse().ok())?
+        })
 }

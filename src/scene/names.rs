@@ -181,9 +181,19 @@ fn closest<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
                     .is_some_and(|stem| wanted == format!("{stem}ies"))
         })
     };
+    // An abbreviation of a name (`norm` for `normal`): the one candidate that
+    // starts with a name of 3 letters or more.
+    let abbreviated = || {
+        let mut longer = candidates.iter().copied().filter(|c| {
+            let c = plain(c);
+            wanted.chars().count() >= 3 && c.len() > wanted.len() && c.starts_with(&wanted)
+        });
+        let first = longer.next()?;
+        longer.next().is_none().then_some(first)
+    };
     // A long form of a name (`youngs_modulus`, `poisson_ratio`): the longest
     // candidate of 4 letters or more that the name starts with.
-    near.or_else(plural).or_else(|| {
+    near.or_else(plural).or_else(abbreviated).or_else(|| {
         candidates
             .iter()
             .filter(|c| **c != name)
@@ -253,6 +263,11 @@ mod tests {
                 "unknown boundary tag `Ramp`; the mesh has tags `ramp`, `walls`, `top`",
                 "unknown boundary tag `Ramp` (did you mean `ramp`?); the mesh has tags",
             ),
+            // An abbreviation a student wrote (`fix = ["norm"]`).
+            (
+                "unknown variant `norm`, expected one of `x`, `y`, `normal`",
+                "unknown variant `norm` (did you mean `normal`?), expected one of",
+            ),
         ];
         for (message, part) in cases {
             let out = did_you_mean(message.to_string());
@@ -263,6 +278,8 @@ mod tests {
         for message in [
             "unknown field `colour`, expected one of `model`, `young`",
             "unknown field `nx`, expected one of `x`, `y`, `blocks`, `layout`",
+            // A prefix of two candidates names neither.
+            "unknown variant `gra`, expected one of `gravity`, `graded`",
             "unknown basis `bezier` (known: ps, pl, bspline, pl1d)",
             "expected a number",
             "unknown field `x",

@@ -503,7 +503,11 @@ fn type_cases() -> Vec<Case> {
         // number (a user's 1D traction after `max = [2.0]`): at its own key.
         case("number-for-a-vector-after-the-same-number", COLUMN)
             .edit("traction = [0.0, -1.0]", "traction = @@4.0")
-            .expect("effect[2].traction: invalid type: floating point `4.0`, expected a sequence: write it as a list, `[4.0]`"),
+            .expect("effect[2].traction: invalid type: floating point `4.0`, expected a sequence: write it as a list of its x and y entries, e.g. `[0.0, 4.0]`"),
+        // A student's 2D gravity as one number: the list it wants has two entries.
+        case("number-for-gravity-in-2d", COLUMN)
+            .edit("g = [0.0, -9.81]", "g = @@-9.81")
+            .expect("effect[0].g: invalid type: floating point `-9.81`, expected a sequence: write it as a list of its x and y entries, e.g. `[0.0, -9.81]`"),
         case("array-of-arrays-for-a-vector", COLUMN)
             .edit("traction = [0.0, -1.0]", "traction = @@[[0.0, -1.0]]")
             .expect("effect[2].traction: invalid type: sequence, expected a number"),

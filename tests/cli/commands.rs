@@ -330,6 +330,21 @@ fn converge_prints_levels_orders_and_writes_its_plots() {
                 !text.contains("stroke=\"#2CA02C\""),
                 "{file}: a third curve"
             );
+            // Against h, a grey guide of each basis's theoretical slope (3 for the
+            // B-spline, 2 for PL1D) through its finest level; none against time.
+            let guides = text
+                .split("<polyline")
+                .skip(1)
+                .filter(|l| l.contains("stroke=\"#000000\"") && l.contains("opacity=\"0.4\""))
+                .count();
+            let against_h = file == "error-vs-h.svg";
+            assert_eq!(guides, if against_h { 2 } else { 0 }, "{file}: guides");
+            assert_eq!(
+                text.contains("slope 3 (BSPLINE reference)")
+                    && text.contains("slope 2 (PL1D reference)"),
+                against_h,
+                "{file}: guide legend"
+            );
         }
     }
     let table = stdout(&[

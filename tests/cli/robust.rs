@@ -400,6 +400,13 @@ fn command_line_cases() -> Vec<Case> {
     ));
     let gmsh_body = Some(gmsh_body);
     vec![
+        // Two bases to `run` (a student's `compare` command): `compare` named.
+        args_case(
+            "run-two-bases",
+            bar.clone(),
+            &["run", "@", "--basis", "ps,pl"],
+            "--basis: unknown basis `ps,pl` (known: ps, pl, bspline, pl1d); `run` takes one basis: to run several side by side, `mpm-cli compare SCENE --basis ps,pl`",
+        ),
         args_case("particles-with-gmsh-bodies-only", gmsh_body.clone(), &["run", "@", "--particles", "2x2"], "--particles 2x2: every body is a Gmsh body (`shape = \"gmsh\"`), whose particles `per_triangle` and `subdivide` set"),
         args_case("converge-particles-with-gmsh-bodies-only", gmsh_body, &["converge", "@", "--particles", "2x2"], "--particles 2x2: every body is a Gmsh body"),
         args_case("resolution-per-block-with-gmsh-bodies-only", gmsh_resolution, &["run", "@"], "resolution[0].per_block: every body is a Gmsh body"),
@@ -1361,4 +1368,92 @@ t_end = 1e6
         assert!(stderr.contains(part), "{part:?} not in {stderr}");
     }
     assert!(!stderr.contains("system of units"), "{stderr}");
+}
+
+/// A body far too soft for its density (E = 0.1 Pa, typed in MPa): its critical
+/// step is seconds long, and a step of it carries the body, at rest at the start,
+/// tens of elements under gravity. The watch counts the speed the loads add over
+/// the step and refuses the step, naming the soft material; without the watch the
+/// run is not reported complete with its body fallen out of the mesh in its last
+/// (and only) step (it was: "stable", exit 0).
+#[test]
+fn a_body_carried_out_of_the_mesh_by_one_long_step_fails_the_run() {
+    let scene = r#"name = "soft-drop"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [16, 16]
+[material]
+model = "neo-hookean"
+young = 0.1
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.5, 2.0]
+max = [2.5, 3.0]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["normal"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.5
+t_end = 1.0
+"#;
+    let file = SceneFile::new("soft-drop", scene);
+    let out = cli().args(["run", file.arg()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for part in [
+        "step 1: particle",
+        "within the step",
+        "from the loads' acceleration, 9.810e0",
+        "the material is very soft for its density",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+    let out = cli()
+        .args(["run", file.arg(), "--no-watch"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stdout.contains("FAILED"), "{stdout}");
+    for part in [
+        "step 1: particle",
+        "left the mesh; it moved 9.810e0 in the last step",
+        "widths of its element",
+        "the watch over the step is off (`--no-watch`)",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+}
+
+/// A scene file named without its `.toml` (`run drop` for `drop.toml`): the
+/// message names the file that is there.
+#[test]
+fn a_scene_file_named_without_its_extension_is_pointed_at() {
+    let file = SceneFile::new("lab-drop", &edited(BAR, &[]));
+    let dir = file.path.parent().unwrap();
+    let out = cli()
+        .current_dir(dir)
+        .args(["run", "lab-drop"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("unknown scene `lab-drop` (known: ")
+            && stderr
+                .contains("; a scene file `lab-drop.toml` is here: give the file's whole name"),
+        "{stderr}"
+    );
 }
