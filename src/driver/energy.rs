@@ -58,16 +58,7 @@ where
     /// `v̂⁰`: the projection of the initial particle velocities with this step's
     /// mass matrix.
     pub(super) fn project_initial_velocity(&mut self) -> Result<(), StepError> {
-        phases::zero(&mut self.velocity);
-        phases::scatter_to_functions(
-            &self.evals,
-            &self.bins,
-            &self.gather,
-            &mut self.local,
-            &self.particles.mass,
-            &self.particles.v,
-            &mut self.velocity,
-        );
+        self.scatter_momentum();
         self.solve_projection()?;
         self.velocity_known = true;
         Ok(())

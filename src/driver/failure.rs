@@ -601,6 +601,9 @@ where
                 ));
             }
         }
+        if let Some(cause) = self.dropped_function_cause(particle) {
+            return Some(cause);
+        }
         let speed = self.particles.v[particle].norm().to_f64();
         let element = self.particles.element[particle];
         let (inside, functions) = (
@@ -647,6 +650,37 @@ where
             ));
         }
         None
+    }
+
+    /// With `deactivate`, a function the particle sees that the strategy dropped
+    /// (`0 < M_ii` below its threshold): its coefficient is held at zero, which
+    /// holds back a moving body's edge as it crosses elements, and the elements
+    /// there invert whatever the sampling (a user's disk thrown in free flight
+    /// inverted at 7 particles per triangle and again at 28; the advice to add
+    /// particles did not help).
+    fn dropped_function_cause(&self, particle: usize) -> Option<String> {
+        let spec = self.mass.spec();
+        let threshold: f64 = spec.strip_prefix("deactivate:")?.parse().ok()?;
+        let dropped = self
+            .evals
+            .functions(particle)
+            .iter()
+            .map(|&i| i as usize)
+            .map(|i| (i, self.values[self.pattern.diagonal_position(i)].to_f64()))
+            .filter(|&(_, m)| m > 0.0 && m < threshold)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let fix = "use the default mass strategy (`extended-hybrid`: remove `mass`, or `--mass default`), which expresses such functions through their neighbours instead of dropping them";
+        match dropped {
+            Some((i, m)) => Some(format!(
+                "the particle sits in the support of function {i} at {}, whose mass {m:.2e} is below the threshold of `{spec}`, which dropped it: a dropped function's coefficient is held at zero, which holds back a moving body's edge as it crosses elements, and the elements there invert whatever the number of particles; {fix}",
+                point(&to_f64_point(&self.basis.function_point(i)))
+            )),
+            None if self.last_report.deactivated > 0 => Some(format!(
+                "`{spec}` dropped {} in this step (their mass below its threshold), each held at zero, which holds back a moving body's edge as it crosses elements; {fix}",
+                crate::scene::limits::plural(self.last_report.deactivated, "function", "functions")
+            )),
+            None => None,
+        }
     }
 
     /// In 2D, the largest aspect ratio (longest edge over the height on it) of the

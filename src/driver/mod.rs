@@ -1302,7 +1302,7 @@ where
     }
 
     /// `P(vⁿ)_i = Σ_p m_p phi_i(x_p) vⁿ_p` into `velocity`.
-    fn scatter_momentum(&mut self) {
+    pub(super) fn scatter_momentum(&mut self) {
         phases::zero(&mut self.velocity);
         phases::scatter_to_functions(
             &self.evals,

@@ -441,6 +441,28 @@ impl<T: Scalar> MaskedCholesky<T> {
         }
     }
 
+    /// The factorisations of the distinct fixed sets `a ≠ b`, each with its
+    /// compact system, borrowed apart (to solve them side by side).
+    #[allow(clippy::type_complexity)]
+    fn two_sets(
+        &mut self,
+        a: usize,
+        b: usize,
+    ) -> (
+        (&mut Option<SparseCholesky<T>>, &mut Option<Compact<T>>),
+        (&mut Option<SparseCholesky<T>>, &mut Option<Compact<T>>),
+    ) {
+        let (low, high) = self.solvers.split_at_mut(a.max(b));
+        let (clow, chigh) = self.compact.split_at_mut(a.max(b));
+        let lower = (&mut low[a.min(b)], &mut clow[a.min(b)]);
+        let higher = (&mut high[0], &mut chigh[0]);
+        if a < b {
+            (lower, higher)
+        } else {
+            (higher, lower)
+        }
+    }
+
     /// [`solve`](Self::solve) for every component; two components with different
     /// fixed sets (two factorisations) are solved side by side on the pool.
     pub fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
@@ -452,18 +474,7 @@ impl<T: Scalar> MaskedCholesky<T> {
         }
         match (rhs, self.solver_of.as_slice()) {
             ([r0, r1], &[a, b]) if a != b => {
-                let (low, high) = self.solvers.split_at_mut(a.max(b));
-                let (s0, s1) = if a < b {
-                    (&mut low[a], &mut high[0])
-                } else {
-                    (&mut high[0], &mut low[b])
-                };
-                let (clow, chigh) = self.compact.split_at_mut(a.max(b));
-                let (c0, c1) = if a < b {
-                    (&mut clow[a], &mut chigh[0])
-                } else {
-                    (&mut chigh[0], &mut clow[b])
-                };
+                let ((s0, c0), (s1, c1)) = self.two_sets(a, b);
                 rayon::join(|| solve_one(s0, c0, r0), || solve_one(s1, c1, r1));
             }
             (rhs, _) => {
@@ -491,18 +502,7 @@ impl<T: Scalar> MaskedCholesky<T> {
         }
         match (first, second, self.solver_of.as_slice()) {
             ([a0, a1], [b0, b1], &[a, b]) if a != b => {
-                let (low, high) = self.solvers.split_at_mut(a.max(b));
-                let (s0, s1) = if a < b {
-                    (&mut low[a], &mut high[0])
-                } else {
-                    (&mut high[0], &mut low[b])
-                };
-                let (clow, chigh) = self.compact.split_at_mut(a.max(b));
-                let (c0, c1) = if a < b {
-                    (&mut clow[a], &mut chigh[0])
-                } else {
-                    (&mut chigh[0], &mut clow[b])
-                };
+                let ((s0, c0), (s1, c1)) = self.two_sets(a, b);
                 rayon::join(|| solve_two(s0, c0, a0, b0), || solve_two(s1, c1, a1, b1));
             }
             (first, second, _) => {

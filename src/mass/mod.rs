@@ -200,7 +200,17 @@ impl MassKind {
             ("consistent", None) => Ok(MassKind::Consistent),
             ("lumped", None) => Ok(MassKind::Lumped),
             ("partial", None) => Ok(MassKind::Partial(LumpRule::EmptyElement)),
-            ("partial", Some(a)) => Ok(MassKind::Partial(LumpRule::Threshold(number(a)?))),
+            ("partial", Some(a)) => {
+                let tau = number(a)?;
+                // `M_ii < TAU max M_jj` with `TAU ≥ 1` lumps every row but the
+                // largest: `lumped` under another name.
+                if tau >= 1.0 {
+                    return Err(format!(
+                        "`{shown}`: the threshold is a fraction of the largest diagonal entry, so at 1 or more it lumps every row but the largest, which is `lumped`: give a number below 1 (e.g. `partial:0.1`), or `lumped`"
+                    ));
+                }
+                Ok(MassKind::Partial(LumpRule::Threshold(tau)))
+            }
             ("partial-coverage", Some(a)) => {
                 Ok(MassKind::Partial(LumpRule::Coverage(fraction(a)?)))
             }

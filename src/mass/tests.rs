@@ -483,6 +483,16 @@ fn mass_parameters_that_are_not_finite_are_named_so() {
             format!("`{spec}`: the coverage `{value}` is not finite (it reads as infinity: beyond ±1.8e308); give a number in (0, 1)")
         );
     }
+    // A partial-lumping threshold of 1 or more lumps every row: `lumped` by
+    // another name, refused (a user's `partial:2` ran as `lumped`).
+    for spec in ["partial:1", "partial:2"] {
+        assert!(
+            error(spec).contains("at 1 or more it lumps every row but the largest, which is `lumped`: give a number below 1"),
+            "{}",
+            error(spec)
+        );
+    }
+    assert!(MassKind::parse("partial:0.99").is_ok());
     // Finite values out of range keep their messages.
     assert_eq!(
         error("deactivate:-1"),

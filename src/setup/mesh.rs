@@ -213,11 +213,18 @@ fn fewest_polygon_triangles(scene: &Scene) -> Option<usize> {
 /// closest tag where one is near, and for a Gmsh mesh where its tags come from (a
 /// user's missing `Physical Curve` was told only the tags the file has).
 fn unknown_tag(scene: &Scene, tag: &str, tags: &[String]) -> String {
-    let message = crate::scene::names::did_you_mean(format!(
-        "unknown boundary tag `{}`; the mesh has tags {}",
-        crate::scene::limits::echo(tag),
-        crate::scene::limits::echo_tags(tags)
-    ));
+    let message = if tags.is_empty() {
+        format!(
+            "unknown boundary tag `{}`; the mesh has no boundary tags",
+            crate::scene::limits::echo(tag)
+        )
+    } else {
+        crate::scene::names::did_you_mean(format!(
+            "unknown boundary tag `{}`; the mesh has tags {}",
+            crate::scene::limits::echo(tag),
+            crate::scene::limits::echo_tags(tags)
+        ))
+    };
     match &scene.mesh {
         MeshSpec::Gmsh { file } => format!(
             "{message}: the tags of `{file}` are its physical curves (1D physical groups) on boundary edges, a physical curve on interior edges is none; add `Physical Curve(\"{}\") = {{...}};` for the wall's boundary curves to the .geo and mesh it again",

@@ -675,7 +675,7 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
         "the time step is 0.50 of the critical step",
         // 0.5 × 0.04 / 0.106 (the growth): stable when run (drift 1.45e-2), as is
         // 0.25 (2.8e-2).
-        "lower `time.courant` (to 0.19, say: a growth of 1.06e-1 that falls in proportion to the step would be 4 % there; if it does not, lower it again; `--courant` on the command line)",
+        "lower `time.courant` (to 0.19, say: a growth of 1.06e-1 that falls in proportion to the step would be 4.0 % there; if it does not, lower it again; `--courant` on the command line)",
     ] {
         assert!(stderr.contains(part), "`{part}` not in: {stderr}");
     }
@@ -701,7 +701,7 @@ fn an_energy_growth_verdict_says_when_and_what_to_lower() {
     for part in [
         "the run is UNSTABLE: energy growth",
         "the time step `time.dt` = 6.300e-4 is 0.50 of the critical step 1.261e-3",
-        "lower `time.dt` (to 2.832e-4, say: a growth of 8.90e-2 that falls in proportion to the step would be 4 % there; if it does not, lower it again; `--dt` on the command line)",
+        "lower `time.dt` (to 2.832e-4, say: a growth of 8.90e-2 that falls in proportion to the step would be 4.0 % there; if it does not, lower it again; `--dt` on the command line)",
     ] {
         assert!(stderr.contains(part), "`{part}` not in: {stderr}");
     }
