@@ -226,12 +226,30 @@ fn unknown_tag(scene: &Scene, tag: &str, tags: &[String]) -> String {
         ))
     };
     match &scene.mesh {
+        MeshSpec::Gmsh { file } if is_physical_surface(file, tag) => format!(
+            "{message}: `{}` is a physical surface of `{file}` (a region of triangles, what a `gmsh` body's `surface` names), not a curve; a wall is on boundary edges, tagged by a physical curve: add `Physical Curve(\"{}-wall\") = {{...}};` for the wall's boundary curves to the .geo, mesh it again and give that tag",
+            crate::scene::limits::echo(tag),
+            crate::scene::limits::echo(tag)
+        ),
         MeshSpec::Gmsh { file } => format!(
             "{message}: the tags of `{file}` are its physical curves (1D physical groups) on boundary edges, a physical curve on interior edges is none; add `Physical Curve(\"{}\") = {{...}};` for the wall's boundary curves to the .geo and mesh it again",
             crate::scene::limits::echo(tag)
         ),
         _ => message,
     }
+}
+
+/// `tag` names a physical surface of the Gmsh file `file` (read again: only on
+/// the way to an error, a user's wall tagged with the domain's surface name).
+fn is_physical_surface(file: &str, tag: &str) -> bool {
+    let Ok(bytes) = crate::scene::limits::read_bounded(
+        std::path::Path::new(file),
+        crate::scene::limits::MAX_MESH_FILE_BYTES,
+    ) else {
+        return false;
+    };
+    psmpm_basis::mesh::gmsh::parse_msh_with_surfaces(&String::from_utf8_lossy(&bytes), file)
+        .is_ok_and(|(_, surfaces)| surfaces.find(tag).is_some())
 }
 
 /// Every boundary condition names a tag of the mesh.

@@ -1519,3 +1519,24 @@ t_end = 0.8
         "{stderr}"
     );
 }
+
+/// A wall tagged with the name of the Gmsh file's physical surface (the domain's
+/// triangles, not boundary curves): the message says so and what a wall needs.
+#[test]
+fn a_wall_tagged_with_a_physical_surface_is_told_it_needs_a_curve() {
+    let scene = format!(
+        "name = \"g\"\ndim = 2\nbasis = \"pl\"\n[mesh]\nkind = \"gmsh\"\nfile = \"{}/../tests/data/square.msh\"\n[material]\nyoung = 100.0\ndensity = 1.0\n[[body]]\nmin = [0.25, 0.25]\nmax = [0.75, 0.75]\nspacing = [0.1, 0.1]\n[[boundary]]\ntag = \"domain\"\nfix = [\"normal\"]\n[time]\ndt = 1e-3\nt_end = 0.01\n",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let file = SceneFile::new("surface-wall", &scene);
+    let out = cli().args(["run", file.arg()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    for part in [
+        "boundary[0].tag: unknown boundary tag `domain`",
+        "`domain` is a physical surface of",
+        "not a curve; a wall is on boundary edges, tagged by a physical curve",
+    ] {
+        assert!(stderr.contains(part), "{part:?} not in {stderr}");
+    }
+}
