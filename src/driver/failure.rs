@@ -659,8 +659,8 @@ where
     /// inverted at 7 particles per triangle and again at 28; the advice to add
     /// particles did not help).
     fn dropped_function_cause(&self, particle: usize) -> Option<String> {
+        let threshold = self.mass.deactivation_threshold()?;
         let spec = self.mass.spec();
-        let threshold: f64 = spec.strip_prefix("deactivate:")?.parse().ok()?;
         let dropped = self
             .evals
             .functions(particle)

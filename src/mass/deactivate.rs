@@ -76,6 +76,9 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
     fn solves_mass_itself(&self) -> bool {
         true
     }
+    fn deactivation_threshold(&self) -> Option<f64> {
+        Some(self.threshold)
+    }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         self.solver.condition_estimate(pattern)
     }

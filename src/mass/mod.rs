@@ -525,6 +525,11 @@ pub trait MassStrategy<T: Scalar>: Send {
         self.solve_all(first)?;
         self.solve_all(second)
     }
+    /// For a strategy that drops the functions whose `M_ii` is below an absolute
+    /// threshold (`deactivate`): that threshold, for the driver's failure messages.
+    fn deactivation_threshold(&self) -> Option<f64> {
+        None
+    }
     /// `true` when the system last factorised is `M` itself on the rows it
     /// solves, every other row held at zero (no row lumped, no function
     /// extended): then `M'⁻¹ M x = x` for every `x` that vanishes off those rows.
@@ -594,6 +599,9 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn solves_mass_itself(&self) -> bool {
         (**self).solves_mass_itself()
+    }
+    fn deactivation_threshold(&self) -> Option<f64> {
+        (**self).deactivation_threshold()
     }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         (**self).condition_estimate(pattern)
