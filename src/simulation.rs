@@ -1663,7 +1663,7 @@ fn pl_lumping_hint(scene: &Scene) -> Option<String> {
     use crate::bases::BasisKind;
     (matches!(scene.basis, BasisKind::Pl | BasisKind::Pl1d) && scene.mass == crate::mass::MassKind::default())
         .then(|| {
-            "with PL, `mass = \"lumped\"` (`--mass lumped`) takes some impacts with less gain than PL's default (a disk dropped on a contact floor, `docs/examples/disk-bounce.toml`: 0.26 of the energy scale with the default, 2.8e-3 with `lumped`) but not every one, nor a body settling under large strains (a block dropped on a slip floor: 0.18 with the default, 0.08 with `lumped`; PL wants a `courant` of about 0.12 there), or the PS basis, whose default holds them".to_string()
+            "with PL, `mass = \"lumped\"` (`--mass lumped`) takes some impacts with less gain than PL's default (a disk dropped on a contact floor, `docs/examples/disk-bounce.toml`: 0.26 of the energy scale with the default, 2.8e-3 with `lumped`) but not every one, nor a body settling under large strains (`docs/examples/block-drop.toml`: 0.18 with the default, 0.07 with `lumped`; PL wants a `courant` of about 0.12 there), or the PS basis, whose default holds them".to_string()
         })
 }
 

@@ -160,5 +160,5 @@ fn every_documented_example_parses() {
         }
         count += 1;
     }
-    assert!(count >= 29, "{count} examples");
+    assert!(count >= 31, "{count} examples");
 }
