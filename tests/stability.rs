@@ -681,13 +681,14 @@ t_end = 0.5
     assert!(stands.stable && stands.failure.is_none(), "{stands:?}");
 }
 
-/// A soft neo-Hookean block hanging from a no-slip ceiling, sampled by 3 × 3
+/// A soft neo-Hookean block hanging from a no-slip ceiling, sampled by 3 × 2
 /// particles per block (a user's scene at 4 × 4, which tore there too until the
 /// elements with too few particles beside full ones kept the whole
-/// affine-preserving lumping, 2026-12-05): it settles, then tears below its top
-/// rows and falls, with its energy bounded (stable by the verdict). The run says
-/// so: its particles form two pieces at the end, one at the start. With 6 × 6 per
-/// block it holds, and nothing is said.
+/// affine-preserving lumping, 2026-12-05; at 3 × 3 until the affine spread test
+/// was relaxed, 2026-12-07): it settles, then tears below its top rows and falls,
+/// with its energy bounded (stable by the verdict). The run says so: its
+/// particles form two pieces at the end, one at the start. With 6 × 6 per block
+/// it holds, and nothing is said.
 #[test]
 fn a_hanging_block_that_tears_is_warned_about() {
     let text = include_str!("data/hanging-block.toml");
@@ -705,7 +706,7 @@ fn a_hanging_block_that_tears_is_warned_about() {
     assert!(torn.pieces == [1, 2] && torn.came_apart(), "{torn:?}");
     let whole = run(
         &Scene::from_toml(
-            &text.replace("per_block = [3, 3]", "per_block = [6, 6]"),
+            &text.replace("per_block = [3, 2]", "per_block = [6, 6]"),
             "hang.toml",
         )
         .unwrap(),

@@ -140,11 +140,12 @@ where
             .fold(0.0, f64::max)
     }
 
-    /// Per body (`body_sizes` as [`Driver::sampling_by_body`]): its extent, the
-    /// smallest over the axes of its particles' spread plus their mean spacing
-    /// (`(V⁰_p)^(1/D)`, so that a lattice filling a box of side 1 measures 1), and
-    /// the width of the widest element holding one of its particles.
-    pub fn body_extents(&self, body_sizes: &[usize]) -> Vec<(f64, f64)> {
+    /// Per body (`body_sizes` as [`Driver::sampling_by_body`]): its extents, the
+    /// smallest and the largest over the axes of its particles' spread plus their
+    /// mean spacing (`(V⁰_p)^(1/D)`, so that a lattice filling a box of side 1
+    /// measures 1), and the width of the widest element holding one of its
+    /// particles.
+    pub fn body_extents(&self, body_sizes: &[usize]) -> Vec<(f64, f64, f64)> {
         let sizes = bodies_or_one(body_sizes, self.particles.len());
         let mut first = 0;
         sizes
@@ -164,10 +165,10 @@ where
                     widest = widest.max(self.element_width[self.particles.element[p]]);
                 }
                 let spacing = spacing / size.max(1) as f64;
-                let extent = (0..D)
-                    .map(|k| high[k] - low[k] + spacing)
-                    .fold(f64::INFINITY, f64::min);
-                (extent, widest)
+                let spread = |k: usize| high[k] - low[k] + spacing;
+                let smallest = (0..D).map(spread).fold(f64::INFINITY, f64::min);
+                let largest = (0..D).map(spread).fold(0.0, f64::max);
+                (smallest, largest, widest)
             })
             .collect()
     }

@@ -695,8 +695,12 @@ pub fn add_affine_lumping<T: Scalar, const D: usize>(
 
 /// The spread `α` of [`add_affine_lumping`]: an element's particles determine an
 /// affine field when their covariance has `det S ≥ (α s_e)^D` (a uniform fill of
-/// a triangle gives about `0.5 s_e` per axis).
-pub const AFFINE_SPREAD: f64 = 0.01;
+/// a triangle gives about `0.5 s_e` per axis). At `0.01` a disk of radius 0.05
+/// (12 or 112 particles) in triangles of edge 1, a tenth of their size, failed
+/// the test and its element's plain share stopped its spin; at `0.001` it turns
+/// as a rigid body (`docs/stability.md`, "A body smaller than its elements"),
+/// and the cells of the stability matrix are the same to every digit.
+pub const AFFINE_SPREAD: f64 = 0.001;
 
 /// The share `θ` of the plain pair term `(e_i − e_j)(e_i − e_j)ᵀ` in the elements
 /// whose particles do not determine an affine field ([`add_affine_lumping`]).

@@ -928,9 +928,12 @@ fn time_steps<const D: usize, B: Basis<f64, D>>(
 /// takes to cross the widest element holding particles, above which the system
 /// solved holds almost no stiffness. Measured on every example and built-in
 /// scene with PS and PL (1D: B-spline and PL): 0.09 to 1.03; for bodies smaller
-/// than their elements, whose functions the default mass strategy extends into
-/// one or two (a disk of radius 0.05 in blocks of 1, PS; radius 0.1 in blocks of
-/// 0.5, PL): 1e12 to 5e15.
+/// than their elements whose functions a strategy extends into one or two (a
+/// disk of radius 0.05 in blocks of 1, PS; radius 0.1 in blocks of 0.5, PL):
+/// 1e12 to 5e15. Since 2026-12-07 the default keeps linear precision there
+/// (`docs/stability.md`, "A body smaller than its elements") and `extended`,
+/// which keeps its constant rows, is the strategy this still finds (that disk:
+/// 1.5e16).
 pub const RIGID_CRITICAL: f64 = 10.0;
 
 /// When the critical step estimated at the start, `critical`, is more than
@@ -952,10 +955,10 @@ fn rigid_bodies<const D: usize, B: Basis<f64, D>>(
         return None;
     }
     let extents = driver.body_extents(body_sizes);
-    let (b, &(extent, width)) = extents
+    let (b, &(extent, _, width)) = extents
         .iter()
         .enumerate()
-        .min_by(|a, b| (a.1 .0 / a.1 .1).total_cmp(&(b.1 .0 / b.1 .1)))?;
+        .min_by(|a, b| (a.1 .0 / a.1 .2).total_cmp(&(b.1 .0 / b.1 .2)))?;
     let who = if extents.len() > 1 {
         format!("body {} ", b + 1)
     } else {
@@ -988,6 +991,13 @@ fn rigid_bodies<const D: usize, B: Basis<f64, D>>(
 /// built-in (PS and PL; 1D B-spline and PL): at most 0.35; a user's disk of
 /// radius 0.075 in blocks of 1 (PS): 7.3, its first strain peak at 0.39 s
 /// against 0.0043 s on a mesh that resolves it, with no warning.
+///
+/// Or a body whose largest extent is below the width of the elements it lies
+/// in: since the default keeps linear precision for a body smaller than its
+/// elements (`docs/stability.md`, "A body smaller than its elements") its
+/// critical step is that of its own affine modes (that disk: 0.42 of the
+/// crossing time) and the test above is silent, but one affine field is all the
+/// basis gives it.
 fn unresolved_body<const D: usize, B: Basis<f64, D>>(
     scene: &Scene,
     driver: &SceneDriver<D, B>,
@@ -996,23 +1006,39 @@ fn unresolved_body<const D: usize, B: Basis<f64, D>>(
 ) -> Option<String> {
     use crate::scene::limits::echo_significant;
     let extents = driver.body_extents(body_sizes);
-    let (b, ratio, extent, width) = extents
+    let who = |b: usize| {
+        if extents.len() > 1 {
+            format!("body {}", b + 1)
+        } else {
+            "the body".to_string()
+        }
+    };
+    let Some((b, ratio, extent, width)) = extents
         .iter()
         .enumerate()
-        .map(|(b, &(extent, width))| {
+        .map(|(b, &(extent, _, width))| {
             let c = scene.body_wave_speed(b.min(scene.bodies.len().saturating_sub(1)));
             (b, critical * c / extent, extent, width)
         })
         .filter(|(_, r, _, _)| r.is_finite())
-        .max_by(|a, c| a.1.total_cmp(&c.1))?;
-    if ratio <= UNRESOLVED_BODY {
-        return None;
-    }
-    let who = if extents.len() > 1 {
-        format!("body {}", b + 1)
-    } else {
-        "the body".to_string()
+        .max_by(|a, c| a.1.total_cmp(&c.1))
+        .filter(|&(_, ratio, _, _)| ratio > UNRESOLVED_BODY)
+    else {
+        // The body smallest against its elements, if within one.
+        let (b, &(_, largest, width)) = extents
+            .iter()
+            .enumerate()
+            .filter(|(_, &(_, largest, width))| largest < width)
+            .min_by(|a, c| (a.1 .1 / a.1 .2).total_cmp(&(c.1 .1 / c.1 .2)))?;
+        return Some(format!(
+            "{} spans at most {} across, less than the width of the elements it lies in ({}): within one or two elements the basis gives it one affine field, a translation, a rotation and a uniform strain, and none of its bending or waves; refine the mesh so that the body spans at least three elements (elements about {} wide or less)",
+            who(b),
+            echo_significant(largest, 3),
+            echo_significant(width, 3),
+            echo_significant(largest / 3.0, 2),
+        ));
     };
+    let who = who(b);
     Some(format!(
         "the critical step, {}, is {:.1} times the time a P-wave takes to cross {who} ({} across, in elements {} wide): the mesh is too coarse to resolve its deformation, whose vibrations are faster than the step (a disk of radius 0.075 in blocks of 1 had its first strain peak at 0.39 s against 0.0043 s on a mesh that resolves it); refine the mesh so that the body spans at least three elements (elements about {} wide or less)",
         echo_significant(critical, 3),

@@ -192,8 +192,22 @@ impl<T: Scalar> Extended<T> {
             }
         }
         if !found {
-            // Lower precision with every candidate found: linear, then constant.
-            let lower = [1 + self.support.dim, 1];
+            // Lower precision with every candidate found: linear, then (without
+            // lumped rows) constant. The hybrid keeps a function that only a
+            // constant can carry as an unknown with a lumped row instead
+            // (`extend` fails): a body smaller than its elements has one or two
+            // functions covered above `C1`, and rows of `E` through them alone
+            // carry no rotation (a disk of radius 0.05 spinning at ω = 3 in
+            // triangles of edge 1 stopped turning: `docs/stability.md`, "A body
+            // smaller than its elements"). Without lumping such an unknown's
+            // consistent row is nearly singular (`extended` then inverts an
+            // element), so there the constant is kept.
+            let linear = 1 + self.support.dim;
+            let lower: &[usize] = if self.lump > self.coverage {
+                &[linear]
+            } else {
+                &[linear, 1]
+            };
             found = lower
                 .iter()
                 .filter(|&&t| t < full)
