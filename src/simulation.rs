@@ -900,7 +900,7 @@ impl Sampled {
 pub fn sparse_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
     (sampled.value < SPARSE_SAMPLING).then(|| {
         format!(
-            "{}: with about one particle per element or fewer, an element holds none as soon as its particle moves out of it (or already, between particles), the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it); use 3 or more particles per element ({keys})",
+            "{}: with about one particle per element or fewer, an element holds none as soon as its particle moves out of it (or already, between particles), the functions there get no mass, and a body can come apart while its energy stays bounded (a verdict of stable does not show it), or bend far too stiffly (a cantilever one element thick, `docs/examples/cantilever.toml` with `count = [24, 2]`, 1.2 per element: PS's tip deflection 0.44 of the one at [96, 8], while PL's beam comes apart); use 3 or more particles per element ({keys})",
             sampled.phrase("element", 2)
         )
     })
@@ -1248,13 +1248,13 @@ impl Thin {
             (b, n) => format!("body {} of {n}", b + 1),
         };
         format!(
-            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %{}), although it has 3 or more per triangle on average: a lattice of 3 × 4 per block of four triangles puts 2 in the left and right triangles of every block (4 × 3 in the top and bottom ones); each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes a square `per_block` such as [4, 4] or [6, 6]: non-square ones such as [5, 4] leave PS 2–8 times less accurate than [4, 4] on the same block; PL wants one odd and one even count, so compare the two bases each on its own lattice)",
+            "{} of the {} triangles inside {who} hold fewer than 3 particles ({:.0} %{}), although it has 3 or more per triangle on average: how a lattice falls on the triangles decides how many each holds (on blocks of four triangles 3 × 4 per block puts 2 in the left and right triangles of every block, 4 × 3 in the top and bottom ones, and a lattice of 4 per block out of step with the blocks, as the lattice a disk centres on itself can be, 2 or fewer in some); each PS triangle holds 9 functions, quadratic on its Powell–Sabin sub-triangles, which 2 particles integrate poorly (a block in its first P-wave mode, docs/examples/p-wave-block.toml: E_u 3.17e-5 at `per_block = [3, 4]`, 6.20e-7 at [4, 4], 1.56e-6 at [5, 4]); give 3 or more in every triangle ({keys}; on block meshes a square `per_block` such as [4, 4] or [6, 6], or for a disk a spacing of a quarter block with its `centre` on a block corner or centre, which puts its lattice in step with the blocks (a disk of radius 0.25 at [1.0, 1.2] on blocks of 0.125 with spacing 0.03125 leaves 10 of its 30 triangles thin, at [1.0, 1.25] none); non-square ones such as [5, 4] leave PS 2–8 times less accurate than [4, 4] on the same block; PL wants one odd and one even count, so compare the two bases each on its own lattice)",
             self.thin,
             self.filled,
             100.0 * self.thin as f64 / self.filled.max(1) as f64,
             if self.empty > 0 {
                 format!(
-                    "; {} of them none, a lattice with one particle per block along an axis leaving the triangles beside its rows empty",
+                    "; {} of them none: a lattice coarse along an axis, one particle per block, leaves the triangles beside its rows empty",
                     self.empty
                 )
             } else {
@@ -1888,7 +1888,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     StepError::NotFinite { .. } | StepError::Collapsed { .. }
                 );
                 match (&self_weight, body_contact_fix(scene).filter(|_| inverted)) {
-                    (Some(w), _) => format!("{e}. Before anything else: {w}"),
+                    // The material's scale first: the step's own advice (a
+                    // smaller step, a stiffer wall) does not fit a `young` in MPa.
+                    (Some(w), _) => format!(
+                        "{w}, which explains this failure before anything the step saw: {e}"
+                    ),
                     (None, Some(fix)) => format!(
                         "{e}. Before anything else: the contact between the bodies with the `{}` mass can add energy (the warning above), which can make a run fail this way; {fix}",
                         scene.mass.spec()

@@ -102,6 +102,7 @@ pub fn build_effects<const D: usize>(
                     body_sizes,
                     &crate::simulation::lattice_stretch(scene),
                 );
+                let coarsest = coarsest_body(&distance, body_sizes);
                 let wall = ContactWall::new(geometry, particles, distance).map_err(|d| {
                     let tags: Vec<String> = scene
                         .effects
@@ -111,12 +112,32 @@ pub fn build_effects<const D: usize>(
                             _ => None,
                         })
                         .collect();
+                    // The error points at the body whose lattice sets the distance,
+                    // at the key that sets its lattice: that is what to change.
+                    let (field, whose) = match coarsest.and_then(|b| scene.bodies.get(b).map(|body| (b, body))) {
+                        Some((b, body)) => {
+                            let key = if body.spacing.is_some() {
+                                "spacing"
+                            } else if body.per_block.is_some() {
+                                "per_block"
+                            } else if body.count.is_some() {
+                                "count"
+                            } else if body.per_triangle.is_some() {
+                                "per_triangle"
+                            } else {
+                                "min"
+                            };
+                            (format!("body[{b}].{key}"), format!("the particles of body[{b}]"))
+                        }
+                        None => (format!("effect[{i}].tag"), "the particles".to_string()),
+                    };
                     SceneError::new(
-                        format!("effect[{i}].tag"),
+                        field,
                         ErrorKind::Conflict,
                         format!(
-                            "the particles near {} are coarser than the mesh: a contact distance of {d:.4e} (half a particle spacing) exceeds the longest edge {reach:.4e}; use more particles (`per_block`, `count` or `spacing`)",
-                            tags.join(", ")
+                            "{whose} are coarser than the mesh for the contact wall on {} (effect[{i}]): their contact distance, half a particle spacing, is {d:.4e}, above the longest edge {reach:.4e}; give the body a spacing below {:.4e}, twice that edge (3 or more particles per element want far less: `per_block = [4, 4]` on block meshes), with `per_block`, `count` or `spacing`",
+                            tags.join(", "),
+                            2.0 * reach,
                         ),
                     )
                 })?;
@@ -130,6 +151,27 @@ pub fn build_effects<const D: usize>(
         }
     }
     Ok(effects)
+}
+
+/// The body (index into `body_sizes`, the particles of each body in order) whose
+/// particles have the largest contact distance; `None` when the sizes do not
+/// cover the particles.
+fn coarsest_body(distance: &[f64], body_sizes: &[usize]) -> Option<usize> {
+    if body_sizes.iter().sum::<usize>() != distance.len() {
+        return None;
+    }
+    let mut first = 0;
+    let mut coarsest: Option<(usize, f64)> = None;
+    for (b, &size) in body_sizes.iter().enumerate() {
+        let largest = distance[first..first + size]
+            .iter()
+            .fold(0.0f64, |a, &d| a.max(d));
+        if coarsest.is_none_or(|(_, d)| largest > d) {
+            coarsest = Some((b, largest));
+        }
+        first += size;
+    }
+    coarsest.map(|(b, _)| b)
 }
 
 /// The particles a traction's box `[min, max]` loads: those inside it at the start.

@@ -1042,6 +1042,12 @@ fn inconsistent_cases() -> Vec<Case> {
             .edit("blocks = [4, 1]", "blocks = [4096, 4096]")
             .edit("per_block = [4, 4]", "per_block = [1, 1]")
             .at(13, 10).expect("mesh.blocks: 16777216 blocks in all is above the limit of 1000000"),
+        // A lattice too coarse for a contact wall: the error points at the key
+        // that sets the body's lattice, not at the wall (a student looked there).
+        case("lattice-too-coarse-for-a-contact-wall", SQUARE)
+            .edit("count = [16, 16]", "count = @@[1, 1]")
+            .edit("[[boundary]]\ntag = \"bottom\"\nfix = [\"y\"]", "[[effect]]\nkind = \"contact-wall\"\ntag = \"bottom\"")
+            .expect("body[0].count: the particles of body[0] are coarser than the mesh for the contact wall on `bottom` (effect[0]): their contact distance, half a particle spacing, is 5.0000e-1, above the longest edge 2.7951e-1; give the body a spacing below 5.5902e-1, twice that edge (3 or more particles per element want far less: `per_block = [4, 4]` on block meshes), with `per_block`, `count` or `spacing`"),
     ]
 }
 

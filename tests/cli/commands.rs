@@ -1186,6 +1186,17 @@ fn a_body_far_too_soft_for_its_weight_is_named_as_the_cause() {
         stderr.contains("check the units of `young` (Pa)"),
         "{stderr}"
     );
+    // The failure leads with the material's scale, before the step's own advice
+    // (a student read "lower `time.courant`" first and missed the units).
+    let failure = stderr
+        .lines()
+        .find(|l| l.starts_with("error: "))
+        .expect("the run fails");
+    assert!(
+        failure.starts_with("error: the body's own weight would strain it")
+            && failure.contains("which explains this failure before anything the step saw: step "),
+        "{failure}"
+    );
 }
 
 /// `compare` printed none of the warnings `run` prints (a user's 1D bars with
