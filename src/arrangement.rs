@@ -572,6 +572,12 @@ pub fn irregularity_warning(
             format!(
                 "with PS, {sampling:.1} particles per occupied triangle under-sample its nine quadratic functions once the strains are large, and the body's rows buckle into modes the particles do not resist (a soft block dropped onto a floor: 9.4 % of its particles irregular at 4 per triangle, 1.3 % at 6.25, none at 9); give {PS_REGULAR_SAMPLING:.0} or more per triangle (`per_block` 6 × 6 on block meshes of four triangles, `per_triangle`, `count` or `spacing`; `--particles`); a hard impact can leave some at any sampling (a 1 × 1 block, E = 1e5, dropped 1 m onto a floor: 20 % at 4 per triangle, 8–12 % at 9 and 16, whatever the step): look at them to judge"
             )
+        } else if ps {
+            // A user's block crushed by its own weight (ρ g H / E = 2.5) at 9 per
+            // triangle ended 81 % irregular: more particles was no fix.
+            format!(
+                "with PS at {sampling:.1} particles per occupied triangle, what a smooth motion at large strain needs, irregularity this large comes from strains the particles cannot follow: a body crushed by strains of order one (check `young` and the self-weight warning, if any: a block with ρ g H / E = 2.5 at 9 per triangle ended 81 % irregular) or struck hard (a smaller `courant`, and more particles, help there); look at them to judge"
+            )
         } else {
             "give more particles per element (`per_block`, `per_triangle`, `count` or `spacing`; `--particles`), and if the body was struck hard a smaller `courant`".to_string()
         };
@@ -860,6 +866,13 @@ mod tests {
         assert!(irregularity_warning(&few(5), true, 4.0, true)
             .unwrap()
             .contains("with a contact wall lower `courant`"));
+        // PS already at 9 per triangle: more particles is not the fix it names.
+        let sampled = irregularity_warning(&few(50), true, 9.0, false).unwrap();
+        assert!(
+            sampled.contains("strains the particles cannot follow")
+                && !sampled.contains("give more particles per element"),
+            "{sampled}"
+        );
         // The top three rows (30 particles) slide by a spacing along the rest.
         let slid =
             moved(&|x: Vector2<f64>| x + Vector2::new(if x.y > 0.65 { 0.1 } else { 0.0 }, 0.0));
