@@ -300,4 +300,18 @@ t_end = 0.8
     println!("small disk: {angle:.4} rad of 2.4, centre {c:?}");
     assert!((angle - 2.4).abs() < 0.01 * 2.4, "turned by {angle} rad");
     assert!((c - Vector2::new(2.9, 1.1)).norm() < 1e-9, "centre {c:?}");
+    // PL's default loses the turn (0.048 rad): the warning names PS, not the
+    // particles per triangle (about 100 here).
+    let pl =
+        Scene::from_toml(&text.replace("basis = \"ps\"", "basis = \"pl\""), "pl.toml").unwrap();
+    let warnings = simulation::run(&pl, &mut |_| {}).unwrap().warnings;
+    let spin = warnings
+        .iter()
+        .find(|w| w.contains("angular momentum"))
+        .expect("PL loses the rotation");
+    assert!(
+        spin.contains("PS's default keeps such a rotation")
+            && !spin.contains("fewer than about 3 particles per triangle"),
+        "{spin}"
+    );
 }

@@ -51,15 +51,7 @@ impl Scene {
                 .max_by(|a, c| a.1.total_cmp(&c.1))
                 .unwrap_or((0, particles));
             let body = &self.bodies[b];
-            let key = if body.per_block.is_some() {
-                "per_block"
-            } else if body.count.is_some() {
-                "count"
-            } else if body.spacing.is_some() {
-                "spacing"
-            } else {
-                "per_block"
-            };
+            let key = body.lattice_key();
             let fix = if key == "spacing" {
                 "a larger `spacing`"
             } else if key == "per_block" {

@@ -7,6 +7,23 @@ use super::{
 };
 
 impl Body {
+    /// The key that sets the body's lattice, for messages that point at it:
+    /// `per_block`, `count`, `spacing` or `per_triangle`, the first given
+    /// (`per_block` when none is, the default).
+    pub fn lattice_key(&self) -> &'static str {
+        if self.per_block.is_some() {
+            "per_block"
+        } else if self.count.is_some() {
+            "count"
+        } else if self.spacing.is_some() {
+            "spacing"
+        } else if self.per_triangle.is_some() {
+            "per_triangle"
+        } else {
+            "per_block"
+        }
+    }
+
     /// The bounding box `(min, max)` of the body's region (the second entries 0 in
     /// 1D); `None` for a Gmsh body (its box is known once the file is read) or an
     /// incomplete shape.

@@ -115,20 +115,10 @@ pub fn build_effects<const D: usize>(
                     // The error points at the body whose lattice sets the distance,
                     // at the key that sets its lattice: that is what to change.
                     let (field, whose) = match coarsest.and_then(|b| scene.bodies.get(b).map(|body| (b, body))) {
-                        Some((b, body)) => {
-                            let key = if body.spacing.is_some() {
-                                "spacing"
-                            } else if body.per_block.is_some() {
-                                "per_block"
-                            } else if body.count.is_some() {
-                                "count"
-                            } else if body.per_triangle.is_some() {
-                                "per_triangle"
-                            } else {
-                                "min"
-                            };
-                            (format!("body[{b}].{key}"), format!("the particles of body[{b}]"))
-                        }
+                        Some((b, body)) => (
+                            format!("body[{b}].{}", body.lattice_key()),
+                            format!("the particles of body[{b}]"),
+                        ),
                         None => (format!("effect[{i}].tag"), "the particles".to_string()),
                     };
                     SceneError::new(
