@@ -986,7 +986,7 @@ where
                 let distance = nominal;
                 let how = if moved < 0.25 * distance {
                     format!(
-                        "a small part of its contact distance ({}): it was pressed through over several steps, the springs too soft for the load",
+                        "a small part of its contact distance ({}): it was pressed through over several steps, the springs too soft for the load (a landing body whose weight and momentum bear on one or a few particles, as a disk's lowest particle at its first landing, needs a step at which those few springs carry it)",
                         crate::scene::limits::echo_significant(distance, 3)
                     )
                 } else {
