@@ -1042,3 +1042,53 @@ fn a_falling_block_keeps_its_courant_number_as_the_critical_step_falls() {
         "{failure}"
     );
 }
+
+/// A user's two blocks translating towards each other (`body-contact`) on a Gmsh
+/// mesh of triangles 0.5 × 0.0125 (`tests/data/skinny.msh`), sampled at a spacing
+/// of two element rows with every particle row on a mesh line: each function with
+/// particles is sampled along one line, and its consistent row is singular across
+/// it. The default stopped at step 486 (t = 0.0107: the conjugate gradients
+/// stalled on the singular system); it now lumps the rows of functions whose
+/// elements' particles determine no affine field (`phases::mark_flat_functions`)
+/// and runs on, the blocks translating rigidly.
+#[test]
+fn functions_sampled_along_a_line_are_lumped() {
+    let text = format!(
+        r#"name = "skinny"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "gmsh"
+file = "{}/tests/data/skinny.msh"
+[material]
+model = "neo-hookean"
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [0.5, 0.3]
+max = [1.5, 0.7]
+spacing = [0.05, 0.025]
+initial_velocity = {{ kind = "uniform", value = [2.0, 0.0] }}
+[[body]]
+min = [2.0, 0.3]
+max = [3.0, 0.7]
+spacing = [0.05, 0.025]
+initial_velocity = {{ kind = "uniform", value = [-1.0, 0.0] }}
+[[effect]]
+kind = "body-contact"
+[time]
+courant = 0.4
+t_end = 0.03
+"#,
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let scene = Scene::from_toml(&text, "skinny.toml").unwrap();
+    let summary = run(&scene, &mut |_| {}).unwrap();
+    assert!(
+        summary.failure.is_none() && summary.stable,
+        "{:?}",
+        summary.failure
+    );
+    assert!(summary.energy_drift < 1e-6, "{}", summary.energy_drift);
+}

@@ -106,6 +106,9 @@ struct StrategyInputs {
     element_affine: phases::AffineMarks,
     /// Scratch of [`phases::add_affine_lumping`], one per function.
     function_pinned: Vec<bool>,
+    /// [`StepContext::flat`], one per function (the default with a basis of
+    /// degree 2; else empty).
+    flat: Vec<bool>,
 }
 
 impl StrategyInputs {
@@ -410,6 +413,11 @@ where
                 phases::AffineMarks::default()
             },
             function_pinned: if needs.correction == Correction::InMass {
+                vec![false; basis.num_functions()]
+            } else {
+                Vec::new()
+            },
+            flat: if needs.correction == Correction::InMass && basis.degree() > 1 {
                 vec![false; basis.num_functions()]
             } else {
                 Vec::new()
@@ -1123,6 +1131,17 @@ where
             );
         }
         if self.inputs.needs.correction == Correction::InMass {
+            if !self.inputs.flat.is_empty() {
+                phases::mark_flat_functions(
+                    &self.basis,
+                    &self.bins,
+                    &self.particles.mass,
+                    &self.particles.x,
+                    &self.element_scale,
+                    &self.gather,
+                    &mut self.inputs.flat,
+                );
+            }
             let context = StepContext {
                 touches_empty: &self.inputs.touches_empty,
                 particle_volume: &self.inputs.particle_volume,
@@ -1139,6 +1158,7 @@ where
                     self.gather.live_list()
                 },
                 diagonal_only: self.inputs.needs.row_sums_only,
+                flat: &self.inputs.flat,
             };
             if let Some(lumped) = self.mass.classify(&self.pattern, &self.values, context) {
                 self.inputs.fill_touching(&self.basis, &self.particles);
@@ -1266,6 +1286,7 @@ where
             live: self.gather.live(),
             live_list: self.gather.live_list(),
             diagonal_only: self.inputs.needs.row_sums_only,
+            flat: &self.inputs.flat,
         };
         match self.mass.factorize(&self.pattern, &self.values, context) {
             Ok(report) => self.last_report = report,

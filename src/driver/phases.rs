@@ -743,6 +743,47 @@ impl AffineMarks {
     }
 }
 
+/// `flat[i]` for every function `i`: live (an element holding a particle has it,
+/// [`Gather::live`]) and none of the elements of its support that hold particles has
+/// particles that determine an affine field by themselves ([`determines_affine`],
+/// all of their particles counted). Such a function is sampled along a line at
+/// most (its particles on a mesh line, in elements on either side of it), and
+/// its consistent row is singular across that line however many particles it
+/// has: a user's blocks translating on a mesh of 40:1 slivers, sampled on every
+/// other row of elements with each particle row on a mesh line, stopped at step
+/// 486 on a singular system. With the gather's live list (a body over a small part
+/// of the mesh) only the listed functions are written: the others are not read. The
+/// default lumps such rows
+/// ([`crate::mass::StepContext::flat`]); their elements fail the affine test, so
+/// their pairs keep the share `θ` of the plain term, and
+/// `M + θ L = (1 − θ) M + θ M_L` is positive definite.
+pub fn mark_flat_functions<T: Scalar, const D: usize, B: Basis<T, D>>(
+    basis: &B,
+    bins: &Bins,
+    mass: &[T],
+    x: &[SVector<T, D>],
+    element_scale: &[T],
+    gather: &Gather,
+    flat: &mut [bool],
+) {
+    match gather.live_list() {
+        Some(list) => list.iter().for_each(|&i| flat[i as usize] = true),
+        None => {
+            for (f, &l) in flat.iter_mut().zip(gather.live()) {
+                *f = l;
+            }
+        }
+    }
+    for &e in bins.occupied_elements() {
+        let e = e as usize;
+        if determines_affine(bins.particles(e).iter(), mass, x, element_scale[e]) {
+            for &f in basis.element_functions(e) {
+                flat[f] = false;
+            }
+        }
+    }
+}
+
 /// Whether the particles `inside` one element determine an affine field
 /// ([`add_affine_lumping`]).
 fn determines_affine<'a, T: Scalar, const D: usize>(

@@ -475,6 +475,12 @@ pub struct StepContext<'a> {
     /// The values hold the row sums on the diagonal and zero elsewhere (the
     /// driver assembled only those, as [`Needs::row_sums_only`] asked).
     pub diagonal_only: bool,
+    /// `flat[i]`: no element of function `i`'s support that holds particles has
+    /// particles that determine an affine field (fewer than `D + 1`, or nearly
+    /// on a line: `driver::phases::mark_flat_functions`), so that its consistent
+    /// row can be singular however many particles sample it; empty when not
+    /// measured (the default strategy with a basis of degree 2 measures it).
+    pub flat: &'a [bool],
 }
 
 /// What a strategy is prepared with once per mesh.

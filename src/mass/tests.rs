@@ -106,6 +106,7 @@ fn context(c: &Column) -> StepContext<'_> {
         live: &[],
         live_list: None,
         diagonal_only: false,
+        flat: &[],
     }
 }
 

@@ -369,7 +369,13 @@ impl<T: Scalar> Extended<T> {
         } else {
             MIN_PARTICLE_COUNT
         };
-        let sparse = context.particle_count[i] < sampled_by;
+        // A function sampled only along a line (every element of its support
+        // with particles failing the affine test) is lumped as one sampled by too
+        // few: its consistent row is singular across the line (a user's blocks
+        // on a mesh of 40:1 slivers, each particle row on a mesh line, stopped at
+        // step 486: `docs/stability.md`, "Functions sampled along a line").
+        let flat = context.flat.get(i).copied().unwrap_or(false);
+        let sparse = context.particle_count[i] < sampled_by || flat;
         self.lumped[i] = self.role[i] == Role::Solved
             && self.lump > self.coverage
             && (coverage < self.lump || sparse);
