@@ -744,8 +744,8 @@ impl AffineMarks {
 }
 
 /// `flat[i]` for every function `i`: live (an element holding a particle has it,
-/// [`Gather::live`]) and none of the elements of its support that hold particles has
-/// particles that determine an affine field by themselves ([`determines_affine`],
+/// `Gather::live`) and none of the elements of its support that hold particles has
+/// particles that determine an affine field by themselves (`determines_affine`,
 /// all of their particles counted). Such a function is sampled along a line at
 /// most (its particles on a mesh line, in elements on either side of it), and
 /// its consistent row is singular across that line however many particles it
