@@ -101,12 +101,8 @@ impl Scene {
                     // The lattice cell: the box's extent, or the lattice's field.
                     let lattice = if body.shape.is_box() {
                         "max"
-                    } else if body.spacing.is_some() {
-                        "spacing"
-                    } else if body.count.is_some() {
-                        "count"
                     } else {
-                        "per_block"
+                        body.lattice_key()
                     };
                     format!("body[{b}].{lattice}")
                 } else if body.material.is_some() {

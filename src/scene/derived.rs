@@ -8,8 +8,8 @@ use super::{
 
 impl Body {
     /// The key that sets the body's lattice, for messages that point at it:
-    /// `per_block`, `count`, `spacing` or `per_triangle`, the first given
-    /// (`per_block` when none is, the default).
+    /// `per_block`, `count`, `spacing` (one at most: `Scene::validate`) or
+    /// `per_triangle`, else `per_block`, the default.
     pub fn lattice_key(&self) -> &'static str {
         if self.per_block.is_some() {
             "per_block"

@@ -245,6 +245,12 @@ impl<T: Scalar> Extended<T> {
         }
     }
 
+    /// The hybrid: rows of solved functions covered below `lump` are lumped
+    /// (plain `extended` lumps none).
+    fn lumps_rows(&self) -> bool {
+        self.lump > self.coverage
+    }
+
     fn reduced(&self, s: usize) -> Reduced<'_, T> {
         Reduced {
             col_ptr: &self.col_ptr,
@@ -309,7 +315,7 @@ impl<T: Scalar> Extended<T> {
                 } else {
                     // Nothing to carry it: keep it as an unknown, lumped in the hybrid.
                     self.role[j] = Role::Solved;
-                    self.lumped[j] = self.lump > self.coverage;
+                    self.lumped[j] = self.lumps_rows();
                 }
             } else if self.role[j] == Role::Ghost && !self.extend(j) {
                 self.role[j] = Role::Inactive;
@@ -349,7 +355,7 @@ impl<T: Scalar> Extended<T> {
             SupportFacts::coverage_of(context.particle_volume[i], self.support.volume[i]);
         // A wall's function extended rather than lumped (`with_walls`).
         let on_wall = context.on_wall.get(i).copied().unwrap_or(false);
-        let threshold = if on_wall && self.lump > self.coverage {
+        let threshold = if on_wall && self.lumps_rows() {
             self.coverage.max(self.walls)
         } else {
             self.coverage
@@ -376,9 +382,8 @@ impl<T: Scalar> Extended<T> {
         // step 486: `docs/stability.md`, "Functions sampled along a line").
         let flat = context.flat.get(i).copied().unwrap_or(false);
         let sparse = context.particle_count[i] < sampled_by || flat;
-        self.lumped[i] = self.role[i] == Role::Solved
-            && self.lump > self.coverage
-            && (coverage < self.lump || sparse);
+        self.lumped[i] =
+            self.role[i] == Role::Solved && self.lumps_rows() && (coverage < self.lump || sparse);
         self.sparse[i] = self.lumped[i] && sparse;
     }
 
@@ -441,7 +446,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
         if (self.coverage, self.lump) == (super::DEFAULT_HYBRID_EXTEND, super::DEFAULT_HYBRID_LUMP)
         {
             hybrid.into()
-        } else if self.lump > self.coverage {
+        } else if self.lumps_rows() {
             format!("{hybrid}:{}:{}", self.coverage, self.lump)
         } else if self.coverage == DEFAULT_COVERAGE {
             "extended".into()
@@ -454,7 +459,7 @@ impl<T: Scalar> MassStrategy<T> for Extended<T> {
             empty_elements: false,
             coverage: true,
             polynomials: true,
-            correction: if self.lump > self.coverage {
+            correction: if self.lumps_rows() {
                 self.correction
             } else {
                 Correction::None

@@ -203,7 +203,7 @@ impl<T: Scalar> Extended<T> {
             // consistent row is nearly singular (`extended` then inverts an
             // element), so there the constant is kept.
             let linear = 1 + self.support.dim;
-            let lower: &[usize] = if self.lump > self.coverage {
+            let lower: &[usize] = if self.lumps_rows() {
                 &[linear]
             } else {
                 &[linear, 1]
