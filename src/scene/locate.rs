@@ -260,7 +260,9 @@ pub(super) fn parse_error(text: &str, e: &toml::de::Error) -> (usize, Option<Str
     let at = e.span().map_or(0, |s| s.start);
     let message = e.message().trim().to_string();
     let at = if message.starts_with("missing field") {
-        failing_effect(text, &message).unwrap_or(at)
+        failing_effect(text, &message)
+            .or_else(|| failing_hole(text, &message))
+            .unwrap_or(at)
     } else {
         at
     };
@@ -309,6 +311,20 @@ fn failing_effect(text: &str, message: &str) -> Option<usize> {
             .is_err_and(|e| e.message().trim() == message)
     })?;
     Some(field_offset(text, &format!("effect[{k}]")))
+}
+
+/// Likewise a missing field of a `[[mesh.holes]]` table is reported at the header
+/// of `[mesh]` (the tagged table around it): the header of the first hole that
+/// fails alone with the same message.
+fn failing_hole(text: &str, message: &str) -> Option<usize> {
+    let table: toml::Table = text.parse().ok()?;
+    let holes = table.get("mesh")?.get("holes")?.as_array()?;
+    let k = holes.iter().position(|hole| {
+        hole.clone()
+            .try_into::<super::Hole>()
+            .is_err_and(|e| e.message().trim() == message)
+    })?;
+    Some(field_offset(text, &format!("mesh.holes[{k}]")))
 }
 
 /// [`parse_error`] from the position and message of the error.

@@ -78,6 +78,23 @@ fn a_missing_field_of_a_later_effect_names_that_effect() {
     assert_eq!(e.field.as_deref(), Some(field.as_str()), "{e}");
 }
 
+/// A field missing from a `[[mesh.holes]]` table is named at that hole (the parser
+/// reports it at `[mesh]`, as `mesh.tag`, which does not exist; found by a user).
+#[test]
+fn a_missing_field_of_a_hole_names_that_hole() {
+    let text = "name = \"h\"\ndim = 2\n[mesh]\nkind = \"polygon\"\noutline = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]\nedge_length = 0.5\n\n[[mesh.holes]]\ntag = \"a\"\noutline = [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]\n\n[[mesh.holes]]\noutline = [[3.0, 1.0], [3.5, 1.0], [3.5, 2.0]]\n\n[material]\nyoung = 1e5\npoisson = 0.3\ndensity = 1.0\n[[body]]\nmin = [0.2, 0.2]\nmax = [0.8, 0.8]\ncount = [4, 4]\n[time]\ncourant = 0.5\nt_end = 0.1\n";
+    let e = Scene::from_toml(text, "h.toml").unwrap_err();
+    let header = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.trim() == "[[mesh.holes]]")
+        .map(|(i, _)| i + 1)
+        .nth(1)
+        .unwrap();
+    assert_eq!(e.line, header, "{e}");
+    assert_eq!(e.field.as_deref(), Some("mesh.holes[1].tag"), "{e}");
+}
+
 #[test]
 fn errors_are_typed_values_with_field_and_kind() {
     let text = Scene::builtin("column-small").unwrap().to_toml();

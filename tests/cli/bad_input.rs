@@ -955,6 +955,15 @@ fn inconsistent_cases() -> Vec<Case> {
         case("second-hole-inside-the-first", SQUARE)
             .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.2, 0.2], [0.8, 0.2], [0.8, 0.8], [0.2, 0.8]]\ntag = \"a\"\n\n[[mesh.holes]]\noutline = @@[[0.4, 0.4], [0.6, 0.4], [0.6, 0.6]]\ntag = \"b\"\n")
             .expect("mesh.holes[1].outline: invalid mesh parameter: holes `a` and `b` are nested (one lies inside the other)"),
+        // Holes that nearly touch: the mesher would grade its triangles down to
+        // their gap (a user's 1e-5 gave 66 000 triangles silently, 1e-6 a
+        // degenerate triangle named on `mesh.outline`).
+        case("holes-nearly-touching", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = [[0.2, 0.4], [0.4, 0.4], [0.4, 0.6], [0.2, 0.6]]\ntag = \"a\"\n\n[[mesh.holes]]\noutline = @@[[0.40001, 0.4], [0.6, 0.4], [0.6, 0.6], [0.40001, 0.6]]\ntag = \"b\"\n")
+            .expect("mesh.holes[1].outline: segment (0.40001, 0.4)–(0.6, 0.4) of hole `b` comes within 1e-5 of segment (0.2, 0.4)–(0.4, 0.4) of hole `a`, 4e-5 of `mesh.edge_length` (0.25): the mesher grades its triangles down to the gap (two holes 1e-5 apart at an edge length of 0.25 gave 66 000 triangles; closer, no mesh); if the two are meant to touch, write them as one (a hole whose outline is their union, or a notch of the outline); else move them 0.025 or more apart (a tenth of the edge length)"),
+        case("hole-without-a-tag", SQUARE)
+            .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n@@[[mesh.holes]]\noutline = [[0.2, 0.4], [0.4, 0.4], [0.4, 0.6], [0.2, 0.6]]\n")
+            .expect("mesh.holes[0].tag: missing field `tag`"),
         case("hole-with-two-corners", SQUARE)
             .edit("edge_length = 0.25\n", "edge_length = 0.25\n\n[[mesh.holes]]\noutline = @@[[0.4, 0.4], [0.6, 0.4]]\ntag = \"a\"\n")
             .expect("mesh.holes[0].outline: invalid mesh parameter: hole `a` needs at least 3 corners, got 2"),

@@ -28,8 +28,8 @@ pub use block::{block_delaunay, block_grid, two_triangle_grid, Diagonal};
 pub use delaunay::delaunay;
 pub use lattice::{jittered_lattice_delaunay, lattice_delaunay};
 pub use polygon::{
-    fewest_polygon_triangles, largest_triangle_area, polygon_mesh, PolygonDomain, PolygonFault,
-    PolygonPart, MAX_STEINER_POINTS, MIN_ANGLE_DEG,
+    fewest_polygon_triangles, largest_triangle_area, polygon_mesh, NarrowGap, PolygonDomain,
+    PolygonFault, PolygonPart, MAX_STEINER_POINTS, MIN_ANGLE_DEG,
 };
 
 use super::{MeshError, TriMesh, Vec2};
