@@ -38,15 +38,35 @@ fn key_line_after(text: &str, from: usize, key: &str) -> Option<usize> {
 /// Byte offset of the first value at or after `from` (in a `key = value` line of the
 /// table whose header is the first at or after `from`, or of the tables of the same
 /// array `[[T]]` that follow it) that contains `value`.
-fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
+fn value_after(text: &str, from: usize, value: &str, whole_number: bool) -> Option<usize> {
     // A key whose whole value is the one quoted first (`traction = 2.0` where a
     // sequence was expected, not the `2.0` inside `max = [2.0]` above it), then
-    // any value holding it.
-    let whole = |v: &str| {
+    // a value holding it as a number of its own (not `11.5` for `1.5`): where a
+    // whole number was expected, first among the keys that take whole numbers
+    // (`blocks = [1.5, 30]` under `y = [0.0, 1.5]`: a user was pointed at `y`).
+    let whole = |_: &str, v: &str| {
         (v.split('#').next().unwrap_or("").trim() == value).then(|| v.len() - v.trim_start().len())
     };
-    let holding = |v: &str| v.find(value);
-    keyed_value_after(text, from, whole).or_else(|| keyed_value_after(text, from, holding))
+    let holding = |v: &str| {
+        let is_number = |c: char| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-' | '+');
+        v.match_indices(value)
+            .map(|(i, _)| i)
+            .find(|&i| !v[..i].ends_with(is_number) && !v[i + value.len()..].starts_with(is_number))
+    };
+    let integer_key = |key: &str, v: &str| {
+        whole_number_rule(key.trim())
+            .is_some()
+            .then(|| holding(v))
+            .flatten()
+    };
+    keyed_value_after(text, from, whole)
+        .or_else(|| {
+            whole_number
+                .then(|| keyed_value_after(text, from, integer_key))
+                .flatten()
+        })
+        .or_else(|| keyed_value_after(text, from, |_, v| holding(v)))
+        .or_else(|| keyed_value_after(text, from, |_, v| v.find(value)))
 }
 
 /// The byte offset in the value text (after `=`) of the first key line from
@@ -56,7 +76,7 @@ fn value_after(text: &str, from: usize, value: &str) -> Option<usize> {
 fn keyed_value_after(
     text: &str,
     from: usize,
-    wanted: impl Fn(&str) -> Option<usize>,
+    wanted: impl Fn(&str, &str) -> Option<usize>,
 ) -> Option<usize> {
     let mut offset = 0;
     let mut header: Option<&str> = None;
@@ -71,7 +91,7 @@ fn keyed_value_after(
                     Some(_) => return None,
                 }
             } else if let Some(eq) = line.find('=') {
-                if let Some(i) = wanted(&line[eq + 1..]) {
+                if let Some(i) = wanted(&line[..eq], &line[eq + 1..]) {
                     return Some(offset + eq + 1 + i);
                 }
             }
@@ -386,10 +406,9 @@ fn located(text: &str, at: usize, message: String) -> (usize, Option<String>, St
             let rest = message.split_once("string \"")?.1;
             rest.rfind('"').map(|end| format!("\"{}\"", &rest[..end]))
         });
-        if let Some(offset) = quoted
-            .as_ref()
-            .and_then(|value| value_after(text, at, value))
-        {
+        if let Some(offset) = quoted.as_ref().and_then(|value| {
+            value_after(text, at, value, message.contains("expected a whole number"))
+        }) {
             at = offset;
             // A number where a list was expected (a 1D vector): show the list.
             if message.starts_with("invalid type: floating point")
@@ -409,7 +428,7 @@ fn located(text: &str, at: usize, message: String) -> (usize, Option<String>, St
         } else if message.starts_with("invalid type: sequence") {
             // An array where a number was expected, with nothing quoted: an
             // array of arrays (`traction = [[2.0]]` for `[2.0]`) is the likely one.
-            let nested = |v: &str| {
+            let nested = |_: &str, v: &str| {
                 let value = v.trim_start();
                 (value.starts_with('[') && value[1..].trim_start().starts_with('['))
                     .then(|| v.len() - value.len())

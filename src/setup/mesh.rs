@@ -238,7 +238,8 @@ fn narrow_gap_warning(scene: &Scene, mesh: &TriMesh, smallest: f64) -> Option<St
     else {
         return None;
     };
-    let gap = polygon_domain(outline, tags, holes).narrowest_gap(NARROW_GAP_WARNED * edge_length)?;
+    let gap =
+        polygon_domain(outline, tags, holes).narrowest_gap(NARROW_GAP_WARNED * edge_length)?;
     Some(format!(
         "{} comes within {} of {}, {} of `mesh.edge_length` ({}): the mesher grades its triangles down to about that gap there (smallest edge {}, {} triangles), so the mesh holds more functions than the edge length suggests and its small triangles lower the critical step where the bodies reach them; {}",
         gap.second,

@@ -471,6 +471,12 @@ fn type_cases() -> Vec<Case> {
             .edit("[mesh]", "@@[mesh]")
             .edit("blocks = [4, 1]", "blocks = [4.5, 1]")
             .at(13, 11).expect("mesh.blocks: invalid type: floating point `4.5`, expected a whole number in 1..=4096 along each axis"),
+        // The float also written in a key above (`y = [0.0, 1.5]`): the key that
+        // takes whole numbers is named (a user was pointed at `mesh.y`).
+        case("float-for-block-count-written-above", BAR)
+            .edit("y = [0.0, 1.0]", "y = [0.0, 1.5]")
+            .edit("blocks = [4, 1]", "blocks = [@@1.5, 1]")
+            .expect("mesh.blocks: invalid type: floating point `1.5`, expected a whole number in 1..=4096 along each axis"),
         // An integer's range is the field's, not its type's: no block count of 0.
         case("negative-block-count", BAR)
             .edit("blocks = [4, 1]", "blocks = [4, @@-1]")
