@@ -476,13 +476,34 @@ pub struct Deactivation {
     pub active: usize,
     /// The largest diagonal mass `M_ii` of the step.
     pub largest_mass: f64,
+    /// Over the whole run: the sum of every step's
+    /// [`MassReport::held_force_share`](crate::mass::MassReport::held_force_share),
+    pub held_sum: f64,
+    /// the steps summed,
+    pub steps: usize,
+    /// and the largest share with its time.
+    pub held_largest: (f64, f64),
 }
 
 impl Deactivation {
     fn share(&self) -> f64 {
         self.deactivated as f64 / (self.deactivated + self.active).max(1) as f64
     }
+    /// The share of the force the deactivated rows took, averaged over the run.
+    fn held_mean(&self) -> f64 {
+        self.held_sum / self.steps.max(1) as f64
+    }
 }
+
+/// Share of the force on the functions that the rows deactivation holds at zero
+/// may take, averaged over a run's steps, before the run warns
+/// ([`deactivation_warning`]): a user's damped column (1 × 30 blocks of 0.1 ×
+/// 0.05, 4 × 4 particles per block, `deactivate:0.01`) hung from 8 deactivated
+/// functions at its top that took 18 % of the load (19 % at rest), and settled
+/// 0.0258 of the exact 0.0491 with its top particles in tension, judged stable;
+/// the seeds' column (`column-large`, 1 × 10 blocks) 2.5 % (at most 10 %, E_u
+/// 2.51e-3).
+pub const HELD_FORCE_SHARE: f64 = 0.05;
 
 /// Share of the functions with particles that deactivation may remove at a step
 /// before a run warns ([`deactivation_warning`]): the seeds' columns lose at most
@@ -502,6 +523,14 @@ pub const DEACTIVATED_SHARE: f64 = 0.1;
 /// frictionless slope, 18 % of its functions deactivated, stayed put.
 pub fn deactivation_warning(at: &Deactivation, spec: &str) -> Option<String> {
     use crate::scene::limits::echo_significant;
+    if at.held_mean() >= HELD_FORCE_SHARE && at.share() < DEACTIVATED_SHARE {
+        return Some(format!(
+            "deactivation (`{spec}`, an absolute threshold on the diagonal mass M_ii) held rows with particles at zero velocity that took {:.0} % of the force on the functions over the run ({:.0} % at t = {}): the particles on them are held as by a wall, so a body hangs from them or rests on them (a user's damped column hung from the 8 functions at its top, which took 19 % of the load, and settled 0.0258 of the exact 0.0491 with its top in tension), and the verdict does not see it; take the default mass strategy (`--mass default`), which keeps those functions",
+            100.0 * at.held_mean(),
+            100.0 * at.held_largest.0,
+            echo_significant(at.held_largest.1, 4),
+        ));
+    }
     (at.deactivated > 0 && at.share() >= DEACTIVATED_SHARE).then(|| {
         format!(
             "at t = {} deactivation (`{spec}`, an absolute threshold on the diagonal mass M_ii, the thesis's for its columns' masses) removed {} of the {} functions with particles ({:.0} %): a deactivated function takes zero velocity, so at a moving body's edge it holds the body as a wall would (users' bodies judged stable: a block falling freely rebounded in mid-air as the functions below it were deactivated, a disk on a frictionless slope with 18 % of its functions deactivated stayed put), and the verdict does not see it; the largest M_ii then was {}: a threshold well below the masses (`deactivate:{}`) keeps the body's functions, but brings back the nearly empty ones it removes (the consistent mass's failure); for a body moving through a mostly empty mesh take the default mass strategy",
@@ -1450,9 +1479,20 @@ where
             deactivated: r.mass_report.deactivated,
             active: r.mass_report.active,
             largest_mass: r.mass_report.largest_mass,
+            ..Deactivation::default()
         };
         if now.share() > deactivation.share() {
-            deactivation = now;
+            deactivation = Deactivation {
+                held_sum: deactivation.held_sum,
+                steps: deactivation.steps,
+                held_largest: deactivation.held_largest,
+                ..now
+            };
+        }
+        deactivation.held_sum += r.mass_report.held_force_share;
+        deactivation.steps += 1;
+        if r.mass_report.held_force_share > deactivation.held_largest.0 {
+            deactivation.held_largest = (r.mass_report.held_force_share, r.time);
         }
         extended = extended.max(r.mass_report.extended);
         phases.evaluate += r.phases.evaluate;

@@ -1092,3 +1092,64 @@ t_end = 0.03
     );
     assert!(summary.energy_drift < 1e-6, "{}", summary.energy_drift);
 }
+
+/// A user's damped column (1 × 30 blocks of 0.1 × 0.05 with an empty band above
+/// the body, 4 × 4 particles per block) with the seeds' deactivation: the 8
+/// functions at its top are deactivated as it settles, held at zero velocity they
+/// hold the column's top as a wall would (it settled 0.0258 of the exact 0.0491,
+/// its top particles in tension), and the run said nothing. Now it warns, with
+/// the share of the load those rows take; the default mass does not.
+#[test]
+fn a_column_hanging_from_deactivated_functions_is_warned_about() {
+    let text = r#"name = "held-column"
+dim = 2
+basis = "ps"
+[mesh]
+kind = "blocks"
+x = [0.0, 0.1]
+y = [0.0, 1.5]
+blocks = [1, 30]
+[material]
+young = 1e5
+poisson = 0.0
+density = 1e3
+[[body]]
+min = [0.0, 0.0]
+max = [0.1, 1.0]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["x", "y"]
+[[boundary]]
+tag = "left"
+fix = ["x"]
+[[boundary]]
+tag = "right"
+fix = ["x"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[[effect]]
+kind = "damping"
+alpha = 0.6
+[time]
+courant = 0.5
+t_end = 0.6
+"#;
+    let held = |mass: &str| {
+        let scene = Scene::from_toml(&format!("mass = \"{mass}\"\n{text}"), "held.toml").unwrap();
+        let summary = run(&scene, &mut |_| {}).unwrap();
+        assert!(summary.failure.is_none(), "{summary:?}");
+        summary
+            .warnings
+            .iter()
+            .find(|w| w.contains("held rows with particles at zero velocity"))
+            .cloned()
+    };
+    let warned = held("deactivate").expect("warned");
+    assert!(
+        warned.contains("`deactivate:0.01`") && warned.contains("take the default mass strategy"),
+        "{warned}"
+    );
+    assert_eq!(held("default"), None);
+}

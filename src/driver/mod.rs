@@ -1344,6 +1344,7 @@ where
         if let Err(source) = self.mass.solve_all_two(&mut self.rhs, &mut self.velocity) {
             return Err(self.mass_failure(source));
         }
+        self.last_report.held_force_share = self.mass.held_force_share();
         self.constraints.project(&mut self.rhs);
         self.constraints.project(&mut self.velocity);
         let dt = self.dt;

@@ -9,6 +9,10 @@ use crate::sparse::{Scalar, SymmetricPattern};
 pub struct Deactivate<T: Scalar> {
     threshold: f64,
     solver: MaskedCholesky<T>,
+    /// Functions removed (with particles) in the last factorisation.
+    deactivated: Vec<bool>,
+    /// [`MassStrategy::held_force_share`] of the last solve of forces.
+    held_force_share: f64,
 }
 
 impl<T: Scalar> Deactivate<T> {
@@ -17,6 +21,8 @@ impl<T: Scalar> Deactivate<T> {
         Deactivate {
             threshold,
             solver: MaskedCholesky::default(),
+            deactivated: Vec::new(),
+            held_force_share: 0.0,
         }
     }
 }
@@ -56,6 +62,11 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
             });
         }
         report.largest_mass = largest;
+        self.deactivated.clear();
+        self.deactivated.extend((0..pattern.dim()).map(|i| {
+            let d = values[pattern.diagonal_position(i)];
+            d > T::zero() && d.to_f64() < self.threshold
+        }));
         self.solver.factorize(pattern, values)?;
         Ok(report)
     }
@@ -70,7 +81,24 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
         first: &mut [Vec<T>],
         second: &mut [Vec<T>],
     ) -> Result<(), MassError> {
+        // The forces before the solve drops the deactivated rows' share.
+        let (mut held, mut total) = (0.0, 0.0);
+        for i in 0..self.deactivated.len() {
+            let f = first
+                .iter()
+                .map(|c| c[i].to_f64() * c[i].to_f64())
+                .sum::<f64>()
+                .sqrt();
+            total += f;
+            if self.deactivated[i] {
+                held += f;
+            }
+        }
+        self.held_force_share = if total > 0.0 { held / total } else { 0.0 };
         self.solver.solve_all_two(first, second)
+    }
+    fn held_force_share(&self) -> f64 {
+        self.held_force_share
     }
     /// The active rows' own system: deactivated rows are held at zero.
     fn solves_mass_itself(&self) -> bool {

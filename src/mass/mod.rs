@@ -375,6 +375,11 @@ pub struct MassReport {
     /// The largest diagonal mass `M_ii`, where the strategy compares masses
     /// with a threshold of its own (deactivation); `0` otherwise.
     pub largest_mass: f64,
+    /// The share of the step's force `Σ_i |F_i|` on the rows deactivation held
+    /// at zero (set after the step's solve; `0` without deactivation): their
+    /// zero velocity holds the particles on them as a wall would, and this is the
+    /// share of the load that wall takes.
+    pub held_force_share: f64,
 }
 
 impl MassReport {
@@ -536,6 +541,13 @@ pub trait MassStrategy<T: Scalar>: Send {
     fn deactivation_threshold(&self) -> Option<f64> {
         None
     }
+    /// For a strategy that holds rows with particles at zero (`deactivate`): the
+    /// share of `Σ_i |F_i|` on those rows in the last
+    /// [`solve_all_two`](Self::solve_all_two) (the step's solve of the forces and
+    /// momenta), [`MassReport::held_force_share`].
+    fn held_force_share(&self) -> f64 {
+        0.0
+    }
     /// `true` when the system last factorised is `M` itself on the rows it
     /// solves, every other row held at zero (no row lumped, no function
     /// extended): then `M'⁻¹ M x = x` for every `x` that vanishes off those rows.
@@ -608,6 +620,9 @@ impl<T: Scalar> MassStrategy<T> for Box<dyn MassStrategy<T>> {
     }
     fn deactivation_threshold(&self) -> Option<f64> {
         (**self).deactivation_threshold()
+    }
+    fn held_force_share(&self) -> f64 {
+        (**self).held_force_share()
     }
     fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
         (**self).condition_estimate(pattern)
