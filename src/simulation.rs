@@ -584,9 +584,12 @@ pub const SELF_WEIGHT_STRAIN: f64 = 0.5;
 /// [`SELF_WEIGHT_STRAIN`]: per body (`body_sizes`, the numbers of particles of the
 /// bodies in order; empty: one body), the largest `ρ_p |g| H / E_p` over its
 /// particles, `ρ_p` and `E_p` each particle's, `H` the body's height along `g`:
-/// the extent of its particles' centres plus the mean spacing (`√V⁰_p`, `V⁰_p` in
-/// 1D) of its lowest and highest particle, so that a lattice filling a box of
-/// height 1 measures 1, not the 1 less a spacing between its outer centres. The
+/// `heights[b]` where the scene gives it (the extent of the body's region along
+/// an axis-aligned `g`), else the extent of its particles' centres plus the mean
+/// spacing (`√V⁰_p`, `V⁰_p` in 1D) of its lowest and highest particle, so that a
+/// lattice filling a box of height 1 measures about 1, not the 1 less a spacing
+/// between its outer centres (1.0052 for cells of 0.025 × 0.0125: a user asked
+/// why a column of height 1 was said to be 1.0052 high). The
 /// worst body is named where there are several (bodies side by side, or one
 /// above another, each measured by its own height). `law_of(p)` names the
 /// particle's law, which the message speaks of.
@@ -594,6 +597,7 @@ pub fn self_weight_warning<const D: usize>(
     gravity: Option<&[f64]>,
     particles: &Particles<f64, D>,
     body_sizes: &[usize],
+    heights: &[Option<f64>],
     material: &impl crate::materials::ParticleMaterials<f64, D>,
     law_of: impl Fn(usize) -> crate::scene::MaterialModel,
 ) -> Option<String> {
@@ -626,7 +630,11 @@ pub fn self_weight_warning<const D: usize>(
             .fold(((f64::INFINITY, 0), (f64::NEG_INFINITY, 0)), |(l, h), s| {
                 (if s.0 < l.0 { s } else { l }, if s.0 > h.0 { s } else { h })
             });
-        let height = high - low + 0.5 * (spacing(p_low) + spacing(p_high));
+        let height = heights
+            .get(b)
+            .copied()
+            .flatten()
+            .unwrap_or_else(|| high - low + 0.5 * (spacing(p_low) + spacing(p_high)));
         let Some((strain, p)) = range
             .map(|p| {
                 let e = material.elastic(p);
@@ -1568,15 +1576,19 @@ fn error<const D: usize, B: Basis<f64, D>>(
             density,
             gravity,
             young,
-            geostatic,
+            at_reference,
         } => {
             let sigma_base = (height * density * gravity).abs();
             let worst = (0..parts.len())
                 .map(|p| {
-                    let exact = if geostatic {
-                        // Started from the geostatic state: its particles carry
+                    let exact = if at_reference {
+                        // Started from the geostatic state (its particles carry
                         // `σ⁰`, so the law alone does not give the settled height
-                        // of a point; the weight above its reference height does.
+                        // of a point), or a neo-Hookean column (whose profile in
+                        // the current height is not the linear law's: a user's
+                        // soft column was measured against it, 0.335 where the
+                        // weight above gave 0.146): the weight above the
+                        // particle's reference height, whatever the law.
                         let y0 = parts.x0[p][D - 1] - origin[D - 1];
                         exact::bar_equilibrium_stress_at_reference(y0, height, density, gravity)
                     } else {
@@ -1858,10 +1870,28 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let irregularity =
         crate::arrangement::irregularity(&driver.particles, &run.body_sizes, &tally.stretch);
     let keys = particle_keys(scene);
+    // Each body's height along an axis-aligned `g`, from its region.
+    let heights: Vec<Option<f64>> = {
+        let g = scene.gravity();
+        let axis = g.as_deref().and_then(|g| {
+            let nonzero: Vec<usize> = (0..g.len()).filter(|&k| g[k] != 0.0).collect();
+            (nonzero.len() == 1).then(|| nonzero[0])
+        });
+        scene
+            .bodies
+            .iter()
+            .map(|b| {
+                let k = axis?;
+                let (lo, hi) = b.bounds()?;
+                Some(hi[k] - lo[k])
+            })
+            .collect()
+    };
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
         &run.body_sizes,
+        &heights,
         driver.material(),
         |p| {
             let mut first = 0;
@@ -2273,7 +2303,7 @@ mod tests {
         let particles = Particles::<f64, 2>::new(x, vec![0.01; 100], 1.0);
         let soft = NeoHookean::new(Elastic::new(10.0, 0.3, 1.0).unwrap(), 2);
         let warn = |law: MaterialModel| {
-            self_weight_warning(Some(&[0.0, -10.0]), &particles, &[], &soft, |_| law).unwrap()
+            self_weight_warning(Some(&[0.0, -10.0]), &particles, &[], &[], &soft, |_| law).unwrap()
         };
         let neo = warn(MaterialModel::NeoHookean);
         assert!(neo.contains("ρ |g| H / E = 1.0e0"), "{neo}");
@@ -2288,9 +2318,14 @@ mod tests {
         // Two bodies, one above the other: each measured by its own height and
         // named (as one body the pair would be 1 tall).
         let softer = NeoHookean::new(Elastic::new(8.0, 0.3, 1.0).unwrap(), 2);
-        let two = self_weight_warning(Some(&[0.0, -10.0]), &particles, &[50, 50], &softer, |_| {
-            MaterialModel::NeoHookean
-        })
+        let two = self_weight_warning(
+            Some(&[0.0, -10.0]),
+            &particles,
+            &[50, 50],
+            &[],
+            &softer,
+            |_| MaterialModel::NeoHookean,
+        )
         .unwrap();
         assert!(
             two.starts_with(
@@ -2302,7 +2337,7 @@ mod tests {
         // Stiff enough (strain 0.4): no warning.
         let stiff = NeoHookean::new(Elastic::new(25.0, 0.3, 1.0).unwrap(), 2);
         assert!(
-            self_weight_warning(Some(&[0.0, -10.0]), &particles, &[], &stiff, |_| {
+            self_weight_warning(Some(&[0.0, -10.0]), &particles, &[], &[], &stiff, |_| {
                 MaterialModel::NeoHookean
             })
             .is_none()

@@ -1,7 +1,7 @@
 //! The scene's reference solution, resolved from its parameters, in the scene's
 //! dimension.
 
-use crate::scene::{EffectSpec, Reference, Scene};
+use crate::scene::{EffectSpec, MaterialModel, Reference, Scene};
 use crate::studies::exact;
 
 /// The scene's reference solution with its parameters resolved.
@@ -16,10 +16,13 @@ pub(crate) enum Solution {
         density: f64,
         gravity: f64,
         young: f64,
-        /// The column starts from a `geostatic-stress` initial state, so its
-        /// equilibrium is measured at the particles' reference heights (see
-        /// [`exact::column_equilibrium_stress_at_reference`]).
-        geostatic: bool,
+        /// The column starts from a `geostatic-stress` initial state, or its law
+        /// is not one whose uniaxial response is `σ = E (F − 1)` (neo-Hookean),
+        /// so its equilibrium is measured at the particles' reference heights,
+        /// the weight above them (see
+        /// [`exact::column_equilibrium_stress_at_reference`]), which holds for
+        /// any law; else at their current heights, the linear law's profile.
+        at_reference: bool,
     },
 }
 
@@ -54,10 +57,11 @@ impl Solution {
                 density: m.density,
                 gravity,
                 young: m.young,
-                geostatic: scene
+                at_reference: scene
                     .effects
                     .iter()
-                    .any(|e| matches!(e, EffectSpec::GeostaticStress { .. })),
+                    .any(|e| matches!(e, EffectSpec::GeostaticStress { .. }))
+                    || m.model == MaterialModel::NeoHookean,
             },
         })
     }
@@ -108,5 +112,32 @@ impl Solution {
             }
             Solution::Equilibrium { .. } => [0.0; 2],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A neo-Hookean column is measured against the weight above each particle's
+    /// reference height, which holds for any law; the linear laws against their
+    /// own profile at the current height (the seeds' B5c).
+    #[test]
+    fn a_neo_hookean_column_is_measured_at_the_reference_heights() {
+        let at_reference = |model: &str| {
+            let mut scene = Scene::builtin("column-damped").unwrap();
+            scene.material.model = match model {
+                "neo-hookean" => MaterialModel::NeoHookean,
+                "corotational" => MaterialModel::Corotational,
+                _ => MaterialModel::LinearElastic,
+            };
+            match Solution::new(&scene) {
+                Some(Solution::Equilibrium { at_reference, .. }) => at_reference,
+                other => panic!("{other:?}"),
+            }
+        };
+        assert!(at_reference("neo-hookean"));
+        assert!(!at_reference("corotational"));
+        assert!(!at_reference("linear-elastic"));
     }
 }
