@@ -1405,7 +1405,19 @@ where
     let mut rms = exact::RmsPositionError::default();
     let mut failure = None;
     let sampling = driver.particles_per_occupied_element();
-    let bodies = driver.sampling_by_body(&run.body_sizes);
+    let regions: Vec<Option<crate::setup::regions::Region>> = scene
+        .bodies
+        .iter()
+        .map(|b| crate::setup::regions::Region::of(b, scene.dim))
+        .collect();
+    let bodies = driver.sampling_by_body(&run.body_sizes, &|b, x| {
+        let mut p = [0.0; 2];
+        p[..x.len().min(2)].copy_from_slice(&x[..x.len().min(2)]);
+        regions
+            .get(b)
+            .and_then(Option::as_ref)
+            .is_some_and(|r| !r.contains(p))
+    });
     let sampled = Sampled::of(&bodies);
     let thin = Thin::of(&bodies);
     let on_edges = (scene.basis == crate::bases::BasisKind::Pl)

@@ -184,8 +184,14 @@ where
 
     /// How each body is sampled at the last location (`body_sizes`: the numbers of
     /// particles of the bodies, whose particles follow each other in that order;
-    /// empty or not adding up: one body).
-    pub fn sampling_by_body(&self, body_sizes: &[usize]) -> Vec<BodySampling> {
+    /// empty or not adding up: one body). `outside(b, x)`: the point `x` lies
+    /// outside the region body `b` was placed in (`false` where that is not
+    /// known), so that an empty element there is no hole in its sampling.
+    pub fn sampling_by_body(
+        &self,
+        body_sizes: &[usize],
+        outside: &dyn Fn(usize, &[f64]) -> bool,
+    ) -> Vec<BodySampling> {
         let sizes = bodies_or_one(body_sizes, self.particles.len());
         let ne = self.basis.num_elements();
         // Per element, the body's particles in it (`own`), and in its closure
@@ -202,7 +208,8 @@ where
         let mut first = 0;
         sizes
             .iter()
-            .map(|&size| {
+            .enumerate()
+            .map(|(body, &size)| {
                 let (mut size_of_elements, mut volume) = (0.0, 0.0);
                 for p in first..first + size {
                     volume += self.particles.volume0[p].to_f64();
@@ -266,6 +273,19 @@ where
                         edges += usize::from(others == 1 && held);
                     }
                     hole &= edges >= 2;
+                    // Not where the body is not: the empty triangles at a
+                    // re-entrant corner of its outline also border its elements
+                    // on two edges (a user's L-shaped plate was told of 4 empty
+                    // triangles inside it, which it has none of).
+                    if hole {
+                        let mut centre = [0.0; D];
+                        for corner in &pieces {
+                            for k in 0..D {
+                                centre[k] += corner[k] / pieces.len() as f64;
+                            }
+                        }
+                        hole = !outside(body, &centre);
+                    }
                     hole_here[e] = hole;
                     if hole {
                         filled += 1;

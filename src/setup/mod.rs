@@ -11,7 +11,7 @@ mod effects;
 pub(crate) mod memory;
 mod mesh;
 mod particles;
-mod regions;
+pub(crate) mod regions;
 mod solution;
 
 pub use effects::build_effects;
