@@ -313,7 +313,19 @@ pub fn collapse_reason(
     position: &str,
     time: f64,
     law: &AnyMaterial,
+    unstable: Option<(f64, f64)>,
 ) -> String {
+    // The energy grew past the verdict's bound before: the collapse ends an
+    // instability of the step (a user's PL block dropped 2 m onto a slip floor
+    // at `courant = 0.5` collapsed in the air after its rebound, its energy up by
+    // half, and was told to check `young`; at 0.12 it ran stable).
+    if let Some((growth, crossed)) = unstable {
+        return format!(
+            "the body collapsed after its energy grew: det F fell to {jacobian:.1e} at particle {particle} (at {position}, sampled at t = {}), below {COLLAPSED_JACOBIAN}, after the time-centred total had grown by {growth:.2e} of the energy scale (past the verdict's bound of 0.05 at t = {}): an instability of the time integration, not a load the law cannot carry; lower `time.courant` (halve it, and again if the energy still grows; `--courant` on the command line; impacts want 0.25 or less with PS, about 0.12 with PL) or `time.dt`",
+            crate::scene::limits::echo_fixed(time, 4),
+            crate::scene::limits::echo_fixed(crossed, 4)
+        );
+    }
     let fix = match law {
         AnyMaterial::NeoHookean(_) => "the neo-Hookean pressure grows without bound as det F → 0, so the collapse is the discretisation's: a step too long for the impact (lower `time.courant`) or too few particles where the body is crushed (raise `per_block` or `count`, or lower `spacing`)".to_string(),
         AnyMaterial::Linear(_) | AnyMaterial::Corotational(_) => {

@@ -1467,13 +1467,17 @@ where
             rms.finish_step();
         }
         if r.step % ROTATION_EVERY == 0 {
-            if let Some(reason) = collapse_reason(driver, r.time) {
+            if let Some(collapse) = collapse_reason(driver, r.time, None) {
+                on_step(&r, driver.particles.view());
+                verdict.observe(&r);
+                let reason = match unstable(&verdict) {
+                    Some(u) => collapse_reason(driver, r.time, Some(u)).unwrap_or(collapse),
+                    None => collapse,
+                };
                 failure = Some(StepError::Collapsed {
                     step: r.step,
                     reason,
                 });
-                on_step(&r, driver.particles.view());
-                verdict.observe(&r);
                 last_energy = r.total_energy();
                 break;
             }
@@ -1555,9 +1559,12 @@ where
 /// Why the bodies of `driver` collapsed, when a particle's `det F` is below
 /// [`crate::material::COLLAPSED_JACOBIAN`] at `time`
 /// ([`crate::material::collapse_reason`]).
+/// `unstable`: the energy growth and the time it crossed the verdict's bound,
+/// where it did ([`unstable`]).
 fn collapse_reason<const D: usize, B: Basis<f64, D>>(
     driver: &setup::SceneDriver<D, B>,
     time: f64,
+    unstable: Option<(f64, f64)>,
 ) -> Option<String> {
     let particles = &driver.particles;
     let (j, p) = crate::material::min_jacobian(&particles.f);
@@ -1569,8 +1576,18 @@ fn collapse_reason<const D: usize, B: Basis<f64, D>>(
             &crate::driver::point(&x),
             time,
             driver.material().law(p),
+            unstable,
         )
     })
+}
+
+/// The time-centred growth of the energy and the time it crossed the verdict's
+/// bound, if it has.
+fn unstable(verdict: &Verdict) -> Option<(f64, f64)> {
+    let (_, crossed) = verdict.growth_crossed?;
+    verdict
+        .energy_bound_broken()
+        .then(|| (verdict.centred_growth(), crossed))
 }
 
 /// The error against the reference solution at the end of the run.
@@ -1829,9 +1846,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let max_condition = tally.verdict.max_condition;
     // The last state, if the loop's sampling missed it.
     let failure = failure.or_else(|| {
-        collapse_reason(&run.driver, run.driver.time()).map(|reason| StepError::Collapsed {
-            step: run.driver.steps(),
-            reason,
+        collapse_reason(&run.driver, run.driver.time(), unstable(&tally.verdict)).map(|reason| {
+            StepError::Collapsed {
+                step: run.driver.steps(),
+                reason,
+            }
         })
     });
     let stable = tally.verdict.stable(failure.is_some());

@@ -1196,3 +1196,46 @@ t_end = 0.02
         summary.warnings
     );
 }
+
+/// A student's PL block dropped 2 m onto a slip floor at `courant = 0.5`: its
+/// energy grew by half, and it collapsed in the air after its rebound. The
+/// message told them to check `young` and take a stiffer law; the cause was the
+/// step (at 0.12 it runs stable). A collapse after the energy crossed the
+/// verdict's bound now names the growth and the step.
+#[test]
+fn a_collapse_after_the_energy_grew_names_the_step_not_the_material() {
+    let text = r#"name = "drop"
+dim = 2
+basis = "pl"
+[mesh]
+kind = "blocks"
+x = [0.0, 4.0]
+y = [0.0, 4.0]
+blocks = [16, 16]
+[material]
+young = 1e5
+poisson = 0.3
+density = 1000.0
+[[body]]
+min = [1.75, 2.0]
+max = [2.25, 2.5]
+per_block = [4, 4]
+[[boundary]]
+tag = "bottom"
+fix = ["normal"]
+[[effect]]
+kind = "gravity"
+g = [0.0, -9.81]
+[time]
+courant = 0.5
+t_end = 1.2
+"#;
+    let summary = run(&Scene::from_toml(text, "drop.toml").unwrap(), &mut |_| {}).unwrap();
+    let reason = summary.failure.as_deref().unwrap_or_default();
+    assert!(
+        reason.contains("the body collapsed after its energy grew")
+            && reason.contains("lower `time.courant`")
+            && !reason.contains("check `young`"),
+        "{reason}"
+    );
+}
