@@ -1732,7 +1732,7 @@ pub fn energy_growth_hint(
     };
     let sampling = if particles_per_element < functions_per_element as f64 {
         format!(
-            ", or use more particles per element ({particles_per_element:.1} per occupied element at the end, for the {functions_per_element} functions of each; `per_block`, `count` or `spacing`)"
+            "; the bodies end with {particles_per_element:.1} particles per occupied element for the {functions_per_element} functions of each, and more particles per element (`per_block`, `count` or `spacing`) lowered the growth of a jittered plate (9.5 % → 3.8 % with four times as many) but not of every impact (a block dropped 2 m onto a slip floor grew 8.4 % at 4 × 4 per block and 10.3 % at 6 × 6): lower the step first"
         )
     } else {
         String::new()
