@@ -1257,11 +1257,11 @@ fn jitter_warning(scene: &Scene, bodies: &[BodySampling]) -> Option<String> {
         "the body".to_string()
     };
     Some(format!(
-        "{who}'s lattice is jittered by {} of its cell and samples each occupied triangle by {:.1} particles: sums over particles at random points integrate the PS functions' quadratic pieces with errors that fall only as the count grows (a user's column under its weight settled 13.7 % too far at jitter 0.3 with 4 per triangle, 2.2 % at jitter 0.1, and 1.8 % and 0.5 % at jitter 0.3 with 9 and 16; unjittered, 1.1 %); with a jitter of {} give 8 × 8 or more per block of four triangles (16 per triangle) for a static answer within 1 % ({}), or a jitter of 0.1 or less (docs/results.md, \"Jittered particles\")",
+        "{who}'s lattice is jittered by {} of its cell and samples each occupied triangle by {:.1} particles: sums over particles at random points integrate the PS functions' quadratic pieces with errors that fall only as the count grows (a user's column under its weight settled 13.7 % too far at jitter 0.3 with 4 per triangle, 2.2 % at jitter 0.1, and 1.8 % and 0.5 % at jitter 0.3 with 9 and 16; unjittered, 1.1 %); with a jitter of {} give 8 × 8 or more per block of four triangles (16 per triangle) for a static answer within 1 % (`body[{b}].{}`), or a jitter of 0.1 or less (docs/results.md, \"Jittered particles\")",
         crate::scene::limits::echo_number(body.jitter),
         sampling.per_occupied,
         crate::scene::limits::echo_number(body.jitter),
-        format!("`body[{b}].{}`", body.lattice_key()),
+        body.lattice_key(),
     ))
 }
 
