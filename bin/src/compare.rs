@@ -242,11 +242,26 @@ pub fn compare(args: CompareArgs) -> Result<(), CliError> {
         );
         return Err(CliError::Interrupted);
     }
-    // What `run` warns about, per variant (on standard error, before the table).
+    // What `run` warns about, per variant (on standard error, before the table);
+    // a warning several variants give is printed once, naming them all (a user's
+    // comparison of six mass strategies printed PL's lattice warning six times).
+    let mut distinct: Vec<(&str, Vec<String>)> = Vec::new();
     for s in &summaries {
         for warning in &s.warnings {
-            eprintln!("warning ({} {}): {warning}", s.basis, s.mass);
+            let variant = format!("{} {}", s.basis, s.mass);
+            match distinct.iter_mut().find(|(w, _)| *w == warning.as_str()) {
+                Some((_, variants)) => variants.push(variant),
+                None => distinct.push((warning.as_str(), vec![variant])),
+            }
         }
+    }
+    for (warning, variants) in &distinct {
+        let who = if variants.len() > 1 && variants.len() == summaries.len() {
+            "every variant".to_string()
+        } else {
+            variants.join(", ")
+        };
+        eprintln!("warning ({who}): {warning}");
     }
     // As asked: `--jobs 1` runs them one after the other.
     print_summaries(&summaries, args.format, args.jobs != Some(1));

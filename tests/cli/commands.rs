@@ -1233,3 +1233,48 @@ fn compare_prints_each_variants_warnings() {
         "{stderr}"
     );
 }
+
+/// A warning several variants of `compare` give is printed once, naming them
+/// (a user's six mass strategies on PL printed PL's lattice warning six times).
+#[test]
+fn compare_prints_a_warning_shared_by_variants_once() {
+    let dir = temp_dir("compare-shared-warnings");
+    let scene = dir.join("block.toml");
+    // 4 × 4 per block on blocks of four triangles: PL particles on the diagonals.
+    std::fs::write(
+        &scene,
+        "name = \"block\"\ndim = 2\nbasis = \"pl\"\n[mesh]\nkind = \"blocks\"\nx = [0.0, 2.0]\ny = [0.0, 2.0]\nblocks = [8, 8]\n[material]\nyoung = 1e5\ndensity = 1000.0\n[[body]]\nmin = [0.5, 0.5]\nmax = [1.5, 1.0]\nper_block = [4, 4]\n[[effect]]\nkind = \"gravity\"\ng = [0.0, -9.81]\n[[boundary]]\ntag = \"bottom\"\nfix = [\"normal\"]\n[time]\ncourant = 0.5\nt_end = 0.02\n",
+    )
+    .unwrap();
+    let out = cli()
+        .args([
+            "compare",
+            scene.to_str().unwrap(),
+            "--basis",
+            "pl",
+            "--mass",
+            "default,lumped",
+        ])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning"))
+        .collect();
+    let mut texts: Vec<&str> = warnings
+        .iter()
+        .map(|w| w.split_once("): ").map_or(*w, |(_, t)| t))
+        .collect();
+    let all = texts.len();
+    texts.sort_unstable();
+    texts.dedup();
+    assert_eq!(texts.len(), all, "{stderr}");
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.starts_with("warning (every variant): ")),
+        "{stderr}"
+    );
+}
