@@ -1227,11 +1227,11 @@ pub fn ps_sampling_warning(sampled: &Sampled, keys: &str) -> Option<String> {
 }
 
 /// A lattice's `jitter` at or above which a PS body sampled by fewer than
-/// [`JITTER_SAMPLING`] particles per triangle is warned about ([`jitter_warning`]).
+/// [`JITTER_SAMPLING`] particles per triangle is warned about (`jitter_warning`).
 pub const JITTER_WARNED: f64 = 0.2;
 
 /// Particles per occupied triangle from which a jittered PS body's sums hold
-/// ([`jitter_warning`]).
+/// (`jitter_warning`).
 pub const JITTER_SAMPLING: f64 = 9.0;
 
 /// The warning for a PS body whose lattice is jittered by [`JITTER_WARNED`] or
