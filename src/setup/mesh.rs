@@ -229,27 +229,18 @@ fn gap_fix(gap: &generators::NarrowGap, edge_length: f64) -> String {
 /// the gap there, its smallest triangles set the critical step where the bodies
 /// reach them, and it holds more functions than the edge length suggests.
 fn narrow_gap_warning(scene: &Scene, mesh: &TriMesh, smallest: f64) -> Option<String> {
-    let MeshSpec::Polygon {
-        outline,
-        tags,
-        holes,
-        edge_length,
-    } = &scene.mesh
-    else {
-        return None;
-    };
-    let gap =
-        polygon_domain(outline, tags, holes).narrowest_gap(NARROW_GAP_WARNED * edge_length)?;
+    let (domain, edge_length) = scene_polygon(scene)?;
+    let gap = domain.narrowest_gap(NARROW_GAP_WARNED * edge_length)?;
     Some(format!(
         "{} comes within {} of {}, {} of `mesh.edge_length` ({}): the mesher grades its triangles down to about that gap there (smallest edge {}, {} triangles), so the mesh holds more functions than the edge length suggests and its small triangles lower the critical step where the bodies reach them; {}",
         gap.second,
         echo_significant(gap.distance, 3),
         gap.first,
         echo_significant(gap.distance / edge_length, 2),
-        echo_number(*edge_length),
+        echo_number(edge_length),
         echo_significant(smallest, 3),
         mesh.num_triangles(),
-        gap_fix(&gap, *edge_length),
+        gap_fix(&gap, edge_length),
     ))
 }
 
@@ -276,6 +267,12 @@ fn polygon_domain(outline: &[[f64; 2]], tags: &[String], holes: &[Hole]) -> Poly
 /// meshing, so that a mesh too large for the memory allowed is refused before the
 /// mesher allocates it.
 fn fewest_polygon_triangles(scene: &Scene) -> Option<usize> {
+    let (domain, edge_length) = scene_polygon(scene)?;
+    generators::fewest_polygon_triangles(&domain, edge_length).map(|n| n as usize)
+}
+
+/// The domain and edge length of a `polygon` scene (`None` for another mesh).
+fn scene_polygon(scene: &Scene) -> Option<(PolygonDomain, f64)> {
     let MeshSpec::Polygon {
         outline,
         tags,
@@ -285,8 +282,7 @@ fn fewest_polygon_triangles(scene: &Scene) -> Option<usize> {
     else {
         return None;
     };
-    generators::fewest_polygon_triangles(&polygon_domain(outline, tags, holes), *edge_length)
-        .map(|n| n as usize)
+    Some((polygon_domain(outline, tags, holes), *edge_length))
 }
 
 /// The message for a tag `tag` the mesh (of tags `tags`) does not have, with the
