@@ -464,6 +464,8 @@ struct Tally {
     /// The step that deactivated the largest share of the functions with
     /// particles ([`deactivation_warning`]).
     deactivation: Deactivation,
+    /// The force deactivation's held rows took over the run.
+    held: HeldForce,
 }
 
 /// At the step of a run that deactivated the largest share of the functions with
@@ -478,22 +480,38 @@ pub struct Deactivation {
     pub active: usize,
     /// The largest diagonal mass `M_ii` of the step.
     pub largest_mass: f64,
-    /// Over the whole run: the sum of every step's
-    /// [`MassReport::held_force_share`](crate::mass::MassReport::held_force_share),
-    pub held_sum: f64,
-    /// the steps summed,
-    pub steps: usize,
-    /// and the largest share with its time.
-    pub held_largest: (f64, f64),
 }
 
 impl Deactivation {
     fn share(&self) -> f64 {
         self.deactivated as f64 / (self.deactivated + self.active).max(1) as f64
     }
-    /// The share of the force the deactivated rows took, averaged over the run.
-    fn held_mean(&self) -> f64 {
-        self.held_sum / self.steps.max(1) as f64
+}
+
+/// Over a run, the share of the force on the functions that deactivation's held
+/// rows took ([`MassReport::held_force_share`](crate::mass::MassReport::held_force_share)):
+/// summed over the steps, and the largest with its time.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HeldForce {
+    /// The sum of every step's share.
+    pub sum: f64,
+    /// The steps summed.
+    pub steps: usize,
+    /// The largest share and its time.
+    pub largest: (f64, f64),
+}
+
+impl HeldForce {
+    fn observe(&mut self, share: f64, time: f64) {
+        self.sum += share;
+        self.steps += 1;
+        if share > self.largest.0 {
+            self.largest = (share, time);
+        }
+    }
+    /// The share averaged over the run.
+    fn mean(&self) -> f64 {
+        self.sum / self.steps.max(1) as f64
     }
 }
 
@@ -523,14 +541,14 @@ pub const DEACTIVATED_SHARE: f64 = 0.1;
 /// instead of 0.44; a block of density 100 fell until the functions below it were
 /// deactivated (14 of 108 at t = 0.1) and rebounded in mid-air; a PL disk on a
 /// frictionless slope, 18 % of its functions deactivated, stayed put.
-pub fn deactivation_warning(at: &Deactivation, spec: &str) -> Option<String> {
+pub fn deactivation_warning(at: &Deactivation, held: &HeldForce, spec: &str) -> Option<String> {
     use crate::scene::limits::echo_significant;
-    if at.held_mean() >= HELD_FORCE_SHARE && at.share() < DEACTIVATED_SHARE {
+    if held.mean() >= HELD_FORCE_SHARE && at.share() < DEACTIVATED_SHARE {
         return Some(format!(
             "deactivation (`{spec}`, an absolute threshold on the diagonal mass M_ii) held rows with particles at zero velocity that took {:.0} % of the force on the functions over the run ({:.0} % at t = {}): the particles on them are held as by a wall, so a body hangs from them or rests on them (a user's damped column hung from the 8 functions at its top, which took 19 % of the load, and settled 0.0258 of the exact 0.0491 with its top in tension), and the verdict does not see it; take the default mass strategy (`--mass default`), which keeps those functions",
-            100.0 * at.held_mean(),
-            100.0 * at.held_largest.0,
-            echo_significant(at.held_largest.1, 4),
+            100.0 * held.mean(),
+            100.0 * held.largest.0,
+            echo_significant(held.largest.1, 4),
         ));
     }
     (at.deactivated > 0 && at.share() >= DEACTIVATED_SHARE).then(|| {
@@ -1478,6 +1496,7 @@ where
     let mut interrupted = false;
     let mut unseen = (0.0f64, 0.0, 0.0);
     let mut deactivation = Deactivation::default();
+    let mut held = HeldForce::default();
     let clock = std::time::Instant::now();
     for _ in 0..run.steps {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
@@ -1511,13 +1530,10 @@ where
             rms.finish_step();
         }
         if r.step % ROTATION_EVERY == 0 {
-            if let Some(collapse) = collapse_reason(driver, r.time, None) {
+            if let Some(at) = collapsed(driver) {
                 on_step(&r, driver.particles.view());
                 verdict.observe(&r);
-                let reason = match unstable(&verdict) {
-                    Some(u) => collapse_reason(driver, r.time, Some(u)).unwrap_or(collapse),
-                    None => collapse,
-                };
+                let reason = collapse_reason(driver, at, r.time, unstable(&verdict));
                 failure = Some(StepError::Collapsed {
                     step: r.step,
                     reason,
@@ -1547,21 +1563,11 @@ where
             deactivated: r.mass_report.deactivated,
             active: r.mass_report.active,
             largest_mass: r.mass_report.largest_mass,
-            ..Deactivation::default()
         };
         if now.share() > deactivation.share() {
-            deactivation = Deactivation {
-                held_sum: deactivation.held_sum,
-                steps: deactivation.steps,
-                held_largest: deactivation.held_largest,
-                ..now
-            };
+            deactivation = now;
         }
-        deactivation.held_sum += r.mass_report.held_force_share;
-        deactivation.steps += 1;
-        if r.mass_report.held_force_share > deactivation.held_largest.0 {
-            deactivation.held_largest = (r.mass_report.held_force_share, r.time);
-        }
+        held.observe(r.mass_report.held_force_share, r.time);
         extended = extended.max(r.mass_report.extended);
         phases.evaluate += r.phases.evaluate;
         phases.assemble += r.phases.assemble;
@@ -1598,32 +1604,37 @@ where
         max_strain,
         unseen,
         deactivation,
+        held,
     }
 }
 
-/// Why the bodies of `driver` collapsed, when a particle's `det F` is below
-/// [`crate::material::COLLAPSED_JACOBIAN`] at `time`
-/// ([`crate::material::collapse_reason`]).
-/// `unstable`: the energy growth and the time it crossed the verdict's bound,
+/// Why the bodies of `driver` collapsed at `time`, `(det F, particle)` from
+/// [`collapsed`] ([`crate::material::collapse_reason`]). `unstable`: the energy growth and the time it crossed the verdict's bound,
 /// where it did ([`unstable`]).
 fn collapse_reason<const D: usize, B: Basis<f64, D>>(
     driver: &setup::SceneDriver<D, B>,
+    (j, p): (f64, usize),
     time: f64,
     unstable: Option<(f64, f64)>,
-) -> Option<String> {
-    let particles = &driver.particles;
-    let (j, p) = crate::material::min_jacobian(&particles.f);
-    (j < crate::material::COLLAPSED_JACOBIAN).then(|| {
-        let x: Vec<f64> = particles.x[p].iter().copied().collect();
-        crate::material::collapse_reason(
-            j,
-            p,
-            &crate::driver::point(&x),
-            time,
-            driver.material().law(p),
-            unstable,
-        )
-    })
+) -> String {
+    let x: Vec<f64> = driver.particles.x[p].iter().copied().collect();
+    crate::material::collapse_reason(
+        j,
+        p,
+        &crate::driver::point(&x),
+        time,
+        driver.material().law(p),
+        unstable,
+    )
+}
+
+/// The smallest `det F` and its particle, when it is below
+/// [`crate::material::COLLAPSED_JACOBIAN`]: the bodies collapsed.
+fn collapsed<const D: usize, B: Basis<f64, D>>(
+    driver: &setup::SceneDriver<D, B>,
+) -> Option<(f64, usize)> {
+    let (j, p) = crate::material::min_jacobian(&driver.particles.f);
+    (j < crate::material::COLLAPSED_JACOBIAN).then_some((j, p))
 }
 
 /// The time-centred growth of the energy and the time it crossed the verdict's
@@ -1898,11 +1909,9 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let max_condition = tally.verdict.max_condition;
     // The last state, if the loop's sampling missed it.
     let failure = failure.or_else(|| {
-        collapse_reason(&run.driver, run.driver.time(), unstable(&tally.verdict)).map(|reason| {
-            StepError::Collapsed {
-                step: run.driver.steps(),
-                reason,
-            }
+        collapsed(&run.driver).map(|at| StepError::Collapsed {
+            step: run.driver.steps(),
+            reason: collapse_reason(&run.driver, at, run.driver.time(), unstable(&tally.verdict)),
         })
     });
     let stable = tally.verdict.stable(failure.is_some());
@@ -2129,6 +2138,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 ))
                 .chain(deactivation_warning(
                     &tally.deactivation,
+                    &tally.held,
                     &driver.mass_strategy().spec(),
                 ))
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))

@@ -45,12 +45,14 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
     ) -> Result<MassReport, MassError> {
         let mut report = MassReport::default();
         let mut largest = 0.0f64;
+        self.deactivated.resize(pattern.dim(), false);
         for i in 0..pattern.dim() {
             let d = values[pattern.diagonal_position(i)];
             largest = largest.max(d.to_f64());
             let empty = d <= T::zero();
             let deactivated = !empty && d.to_f64() < self.threshold;
             self.solver.inactive[i] = empty || deactivated;
+            self.deactivated[i] = deactivated;
             report.deactivated += deactivated as usize;
             report.active += !self.solver.inactive[i] as usize;
         }
@@ -62,11 +64,6 @@ impl<T: Scalar> MassStrategy<T> for Deactivate<T> {
             });
         }
         report.largest_mass = largest;
-        self.deactivated.clear();
-        self.deactivated.extend((0..pattern.dim()).map(|i| {
-            let d = values[pattern.diagonal_position(i)];
-            d > T::zero() && d.to_f64() < self.threshold
-        }));
         self.solver.factorize(pattern, values)?;
         Ok(report)
     }
