@@ -844,14 +844,15 @@ fn end_time_warning(scene: &Scene, dt: f64, steps: usize) -> Option<String> {
     let ends = steps as f64 * dt;
     ((ends - t_end).abs() > 1e-9 * t_end).then(|| {
         format!(
-            "time.dt = {} does not divide t_end = {}: the run takes {} of {} and ends at t = {}, {:.1e} of t_end {}; for t_end itself use dt = t_end / {} = {:e}",
+            "time.dt = {} does not divide t_end = {}: the run takes {} of {} and ends at t = {}, {} {} it ({} % of t_end); for t_end itself use dt = t_end / {} = {:e}",
             crate::scene::limits::echo_number(dt),
             crate::scene::limits::echo_number(t_end),
             crate::scene::limits::plural(steps, "step", "steps"),
             crate::scene::limits::echo_number(dt),
             crate::scene::limits::echo_significant(ends, 12),
-            (ends - t_end).abs() / t_end,
-            if ends > t_end { "after it" } else { "before it" },
+            crate::scene::limits::echo_significant((ends - t_end).abs(), 4),
+            if ends > t_end { "after" } else { "before" },
+            crate::scene::limits::echo_significant(100.0 * (ends - t_end).abs() / t_end, 3),
             steps,
             t_end / steps as f64,
         )
@@ -1087,7 +1088,7 @@ pub const PL_EDGE_SHARE: f64 = 0.1;
 /// block 1.04e-5, 8.54e-6, 8.43e-6 on 8 × 4, 16 × 8, 32 × 16 blocks (the
 /// amplitude 18 % low, the period 4.7 % long), 3 × 4 (none on an edge) 2.35e-7,
 /// 5.58e-8, 1.47e-8 (order 2).
-pub fn pl_edge_particles_warning(bodies: &[(usize, usize)]) -> Option<String> {
+pub fn pl_edge_particles_warning(bodies: &[(usize, usize)], default_mass: bool) -> Option<String> {
     let share = |(on, n): (usize, usize)| n > 0 && on as f64 >= PL_EDGE_SHARE * n as f64;
     let warned: Vec<usize> = (0..bodies.len()).filter(|&b| share(bodies[b])).collect();
     let first = *warned.first()?;
@@ -1109,8 +1110,18 @@ pub fn pl_edge_particles_warning(bodies: &[(usize, usize)]) -> Option<String> {
             k - 1
         ),
     };
+    // The default gives a vertex whose particles all lie on the edges opposite it
+    // the velocity of its neighbours (`Role::Ghost`); every other strategy holds it
+    // at zero (measured 2026-12-08 on a user's two disks translating at (0.1, 0.1)
+    // along the diagonals with `lumped`: strain where none should be, and the
+    // momentum moved from 1e-15 to 3.8e-5 at step 9).
+    let held = if default_mass {
+        ""
+    } else {
+        "; with this mass strategy (all but the default) a vertex whose only particles lie on the edges opposite it has no mass and is held at zero velocity, which strains the particles beside it and moves the bodies' momentum (two disks translating along the block diagonals with `lumped`: momentum 3.8e-5 where it was 1e-15): the default mass strategy gives such a vertex the velocity of its neighbours"
+    };
     Some(format!(
-        "{who} lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4]; `jitter` moves the particles off the edges but measured no better), or the smooth basis `ps`"
+        "{who} lie on element edges or vertices at the start (a lattice whose rows fall on the triangles' edges: a square one on blocks of four triangles has half its particles on the block diagonals): PL's gradient jumps there and each such particle takes one side's, which biases the internal force (a block vibrating in its first P-wave mode at `per_block = [4, 4]`: amplitude 18 % low, period 4.7 % long, an error that did not fall with the mesh; at [3, 4], with no particle on an edge, order 2); give a lattice whose rows miss the edges (`per_block` with one odd and one even count, such as [3, 4] or [5, 4]; `jitter` moves the particles off the edges but measured no better), or the smooth basis `ps`{held}"
     ))
 }
 
@@ -1483,7 +1494,12 @@ where
         .then(|| jitter_warning(scene, &bodies))
         .flatten();
     let on_edges = (scene.basis == crate::bases::BasisKind::Pl)
-        .then(|| pl_edge_particles_warning(&driver.particles_on_element_edges(&run.body_sizes)))
+        .then(|| {
+            pl_edge_particles_warning(
+                &driver.particles_on_element_edges(&run.body_sizes),
+                scene.mass == crate::mass::MassKind::default(),
+            )
+        })
         .flatten();
     let stretch = lattice_stretch(scene);
     let at_start = fragments(&driver.particles, &run.body_sizes, &stretch);
@@ -1951,13 +1967,19 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
     let now = crate::material::max_rotation(&driver.particles.f);
     let max_rotation = tally.max_rotation.max(now);
     // The warning concerns the particles of the paper's non-objective law only.
-    let warnings = crate::material::rotation_warning(
-        tally.max_rotation_non_objective.max(
-            driver
-                .material()
-                .max_rotation_of_non_objective(&driver.particles.f, now),
-        ),
+    let non_objective_rotation = tally.max_rotation_non_objective.max(
+        driver
+            .material()
+            .max_rotation_of_non_objective(&driver.particles.f, now),
     );
+    let warnings = crate::material::rotation_warning(non_objective_rotation);
+    // A law that is not objective, turned: the spurious strain energy of the
+    // rotation is no error of the step, and a smaller step did not help.
+    let non_objective = crate::material::non_objective_growth_cause(non_objective_rotation);
+    let energy_growth_hint = energy_growth_hint.map(|hint| match &non_objective {
+        Some(cause) => format!("{cause}; otherwise: {hint}"),
+        None => hint,
+    });
     let at_end = fragments(&driver.particles, &run.body_sizes, &tally.stretch);
     let irregularity =
         crate::arrangement::irregularity(&driver.particles, &run.body_sizes, &tally.stretch);
@@ -2057,11 +2079,20 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     e,
                     StepError::NotFinite { .. } | StepError::Collapsed { .. }
                 );
+                // A failure the driver did not put down to the law, of bodies of
+                // a law that is not objective that turned during the run.
+                let law = non_objective
+                    .as_ref()
+                    .filter(|_| inverted && !e.to_string().contains("`linear-elastic`"));
                 match (&self_weight, body_contact_fix(scene).filter(|_| inverted)) {
                     // The material's scale first: the step's own advice (a
                     // smaller step, a stiffer wall) does not fit a `young` in MPa.
                     (Some(w), _) => format!(
                         "{w}, which explains this failure before anything the step saw: {e}"
+                    ),
+                    (None, _) if law.is_some() => format!(
+                        "{e}. Before anything else: {}",
+                        law.expect("checked")
                     ),
                     (None, Some(fix)) => format!(
                         "{e}. Before anything else: the contact between the bodies with the `{}` mass can add energy (the warning above), which can make a run fail this way; {fix}",

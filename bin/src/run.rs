@@ -308,9 +308,19 @@ impl From<Vtu> for VtuEncoding {
     }
 }
 
-/// Parses `AxB`.
+/// Parses `AxB`. A single whole number (a 1D scene's count, say) is told the
+/// pair it likely means.
 pub fn pair(text: &str, what: &str) -> Result<(usize, usize), CliError> {
-    let bad = || CliError::Input(format!("{what} must look like 4x1, got `{}`", echo(text)));
+    let bad = || {
+        let hint = match text.trim().parse::<usize>() {
+            Ok(n) => format!(" (for {n} along x alone, as in a 1D scene: `{n}x1`)"),
+            Err(_) => String::new(),
+        };
+        CliError::Input(format!(
+            "{what} must look like 4x1, got `{}`{hint}",
+            echo(text)
+        ))
+    };
     let (a, b) = text.split_once('x').ok_or_else(bad)?;
     Ok((a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?))
 }

@@ -756,6 +756,15 @@ where
                     "the worst-covered function {i} at {} is covered to {c:.1e} of its support: use the default mass strategy (`extended-hybrid`), which expresses such functions through their neighbours",
                     point(&to_f64_point(&self.basis.function_point(i)))
                 ),
+                None if self.particles_per_occupied_element() < FEW_PER_ELEMENT => {
+                    // A matrix of so few particles per element is singular whether
+                    // or not the bodies' edges leave functions nearly empty (the
+                    // seeds' column at 3 per triangle for the 9 PS functions).
+                    format!(
+                        "{:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them",
+                        self.particles_per_occupied_element()
+                    )
+                }
                 None => {
                     let spec = self.mass.spec();
                     let others = if spec.starts_with("partial") {

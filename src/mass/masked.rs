@@ -1,7 +1,8 @@
 //! The sparse Cholesky solve shared by the strategies that modify `M` row by row
 //! (consistent, partial lumping, deactivation): rows held at zero (fixed or
-//! inactive) are replaced by a diagonal entry, lumped rows move every off-diagonal
-//! entry onto both diagonals, `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`. Row sums
+//! inactive) leave the system (it is factorised on its kept rows alone, and they
+//! solve to zero), lumped rows move every off-diagonal entry onto both diagonals,
+//! `M' = M + Σ M_ij (e_i − e_j)(e_i − e_j)ᵀ`. Row sums
 //! are kept, so mass and momentum are conserved, and since `M_ij ≥ 0`
 //! (non-negative bases) `M' ⪰ M` stays symmetric positive definite.
 
@@ -48,15 +49,17 @@ pub(super) fn modify_rows<T: Scalar>(
     }
 }
 
-/// Kept rows below this share of the functions are factorised alone
-/// ([`Compact`]); above it the whole pattern is, masked rows on the diagonal.
-const COMPACT_BELOW: f64 = 0.25;
-
 /// One fixed set's system restricted to its kept rows (neither fixed nor
-/// inactive), for a body that covers a small part of the mesh: the same entries
-/// as the masked system's kept block (`modify_rows`' rules, in the same order),
-/// factorised without the masked rows, whose solution is zero anyway. The
-/// symbolic factorisation is kept while the kept rows stay the same.
+/// inactive): the same entries as the masked system's kept block
+/// (`modify_rows`' rules, in the same order), factorised without the masked
+/// rows, whose solution is zero anyway. The symbolic factorisation is kept while
+/// the kept rows stay the same.
+///
+/// The whole pattern with the masked rows on the diagonal was factorised instead
+/// until 2026-12-08 whenever a quarter or more of the functions were kept; the
+/// kept rows alone cost less at every share measured (`docs/performance.md`, "The
+/// kept rows alone, at every share"), a cantilever over 30 % of its mesh 1.6×
+/// per step, a block over 40 % 1.4–2.3× with `partial`.
 struct Compact<T: Scalar> {
     /// The kept rows, ascending.
     rows: Vec<usize>,
@@ -211,62 +214,23 @@ fn off_diagonal<T: Scalar>(
     }
 }
 
-/// Solves one fixed set's system: on its kept rows when it has a compact one.
-fn solve_one<T: Scalar>(
-    solver: &mut Option<SparseCholesky<T>>,
-    compact: &mut Option<Compact<T>>,
-    rhs: &mut [T],
-) {
-    match compact {
-        Some(c) => c.solve(rhs),
-        None => solver
-            .as_mut()
-            .expect("solve before a successful factorisation")
-            .solve_in_place(rhs, 1),
-    }
-}
-
-/// [`solve_one`] of two right-hand sides in one pass over the factor.
-fn solve_two<T: Scalar>(
-    solver: &mut Option<SparseCholesky<T>>,
-    compact: &mut Option<Compact<T>>,
-    first: &mut [T],
-    second: &mut [T],
-) {
-    match compact {
-        Some(c) => c.solve_two(first, second),
-        None => solver
-            .as_mut()
-            .expect("solve before a successful factorisation")
-            .solve_two_in_place(first, second),
-    }
-}
-
-/// One factorisation per distinct set of fixed coefficients.
+/// One factorisation per distinct set of fixed coefficients, each of its kept
+/// rows alone ([`Compact`]).
 #[derive(Default)]
 pub(super) struct MaskedCholesky<T: Scalar> {
     fixed: Vec<Vec<bool>>,
     /// `solver_of[k]`: index of the factorisation used by component `k`.
     solver_of: Vec<usize>,
-    /// Per distinct fixed set, the factorisation of the whole pattern, made when
-    /// the set is first factorised whole: a body over a small part of the mesh
-    /// factorises only its compact system (below [`COMPACT_BELOW`] of the
-    /// functions) and never needs it (its symbolic analysis of every function was
-    /// a tenth of the set-up of a small body in a 200² block mesh).
-    solvers: Vec<Option<SparseCholesky<T>>>,
-    /// Modified values per distinct fixed set (allocated with its solver).
-    modified: Vec<Vec<T>>,
     /// Rows held at zero in every component (no particle, or deactivated).
     pub inactive: Vec<bool>,
     /// Rows replaced by their lumped value.
     pub lumped: Vec<bool>,
-    /// `modify_rows`' buffer, one per distinct fixed set.
+    /// `off_diagonal`'s buffer, one per distinct fixed set.
     diagonal_add: Vec<Vec<T>>,
     /// The failure of each set's last factorisation.
     failed: Vec<Option<NotPositiveDefinite>>,
-    work: [Vec<T>; 2],
-    /// Per fixed set, its kept rows' system when they are fewer than
-    /// [`COMPACT_BELOW`] of the functions (else `None`: the whole pattern).
+    /// Per fixed set, its kept rows' system (`None` before the first
+    /// factorisation).
     compact: Vec<Option<Compact<T>>>,
     /// Function → compact index, `usize::MAX` between uses; kept rows of a set.
     slot: Vec<usize>,
@@ -282,24 +246,21 @@ impl<T: Scalar> MaskedCholesky<T> {
         let pattern = setup.pattern;
         let (distinct, solver_of) = distinct_fixed_sets(setup.fixed);
         let n = pattern.dim();
-        self.solvers = distinct.iter().map(|_| None).collect();
-        self.modified = distinct.iter().map(|_| Vec::new()).collect();
         self.fixed = distinct;
         self.solver_of = solver_of;
         self.inactive = vec![false; n];
         self.lumped = vec![false; n];
         self.diagonal_add = vec![vec![T::zero(); n]; self.fixed.len()];
         self.failed = vec![None; self.fixed.len()];
-        self.work = [vec![T::zero(); n], vec![T::zero(); n]];
         self.compact = self.fixed.iter().map(|_| None).collect();
         self.slot = vec![usize::MAX; n];
         self.kept = Vec::with_capacity(n);
         self.marked = LastWritten::with_capacity(n);
     }
 
-    /// For each fixed set, whether its kept rows are few enough to be factorised
-    /// alone, and (re)builds their compact pattern when they changed. `listed`:
-    /// the only rows that may be kept, ascending (else every row may).
+    /// For each fixed set, (re)builds the compact pattern of its kept rows when
+    /// they changed. `listed`: the only rows that may be kept, ascending (else
+    /// every row may).
     fn choose_compact(&mut self, pattern: &SymmetricPattern, listed: Option<&[u32]>) {
         let n = pattern.dim();
         for s in 0..self.fixed.len() {
@@ -312,9 +273,7 @@ impl<T: Scalar> MaskedCholesky<T> {
                     .extend(list.iter().map(|&i| i as usize).filter(kept)),
                 None => self.kept.extend((0..n).filter(kept)),
             }
-            if (self.kept.len() as f64) >= COMPACT_BELOW * n as f64 {
-                self.compact[s] = None;
-            } else if self.compact[s].as_ref().is_none_or(|c| c.rows != self.kept) {
+            if self.compact[s].as_ref().is_none_or(|c| c.rows != self.kept) {
                 self.compact[s] = Some(Compact::new(pattern, self.kept.clone(), &mut self.slot));
             }
         }
@@ -357,105 +316,53 @@ impl<T: Scalar> MaskedCholesky<T> {
         values: &[T],
         listed: Option<&[u32]>,
     ) -> Result<(), MassError> {
-        let n = pattern.dim();
         self.choose_compact(pattern, listed);
-        // Masked rows get the mean active diagonal: the value does not matter for the
-        // solution (their right-hand side is zero) but keeps the condition estimate
-        // about the active system.
-        let (mut scale, mut count) = (T::zero(), 0usize);
-        let mut add = |i: usize| {
-            if !self.inactive[i] {
-                scale += values[pattern.diagonal_position(i)];
-                count += 1;
-            }
-        };
-        match listed {
-            Some(list) => list.iter().for_each(|&i| add(i as usize)),
-            None => (0..n).for_each(add),
-        }
-        let scale = if count > 0 {
-            scale / T::of(count as f64)
-        } else {
-            T::one()
-        };
         // The distinct fixed sets are independent systems: factorised side by side
         // on the pool (each result is the same for any thread count), the first
         // failure in set order reported.
-        let (inactive, lumped) = (&self.inactive, &self.lumped);
+        let lumped = &self.lumped;
         (
-            (
-                self.fixed.par_iter(),
-                self.diagonal_add.par_iter_mut(),
-                self.modified.par_iter_mut(),
-                self.solvers.par_iter_mut(),
-            ),
-            (self.failed.par_iter_mut(), self.compact.par_iter_mut()),
+            self.diagonal_add.par_iter_mut(),
+            self.failed.par_iter_mut(),
+            self.compact.par_iter_mut(),
         )
             .into_par_iter()
-            .for_each(
-                |((fixed, diagonal_add, modified, solver), (failed, compact))| {
-                    if let Some(compact) = compact.as_mut() {
-                        *failed = compact
-                            .factorize(pattern, values, lumped, diagonal_add)
-                            .err();
-                        return;
-                    }
-                    let solver = solver.get_or_insert_with(|| SparseCholesky::new(pattern, 2));
-                    if modified.len() != pattern.nnz() {
-                        *modified = vec![T::zero(); pattern.nnz()];
-                    }
-                    modify_rows(
-                        pattern,
-                        values,
-                        lumped,
-                        |i| fixed[i] || inactive[i],
-                        scale,
-                        diagonal_add,
-                        modified,
-                    );
-                    *failed = solver.factorize(modified).err();
-                },
-            );
+            .for_each(|(diagonal_add, failed, compact)| {
+                let compact = compact.as_mut().expect("built by choose_compact");
+                *failed = compact
+                    .factorize(pattern, values, lumped, diagonal_add)
+                    .err();
+            });
         if let Some(failure) = self.failed.iter().flatten().next() {
             return Err(MassError::from(failure.clone()));
         }
         Ok(())
     }
 
+    /// The compact system of component `k`'s fixed set.
+    fn compact_of(&mut self, k: usize) -> &mut Compact<T> {
+        self.compact[self.solver_of[k]]
+            .as_mut()
+            .expect("solve before a successful factorisation")
+    }
+
+    /// Solves component `k`; the rows held at zero (fixed or inactive) solve to
+    /// zero.
     pub fn solve(&mut self, k: usize, rhs: &mut [T]) -> Result<(), MassError> {
-        let s = self.solver_of[k];
-        if self.compact[s].is_none() {
-            self.mask(k, rhs);
-        }
-        solve_one(&mut self.solvers[s], &mut self.compact[s], rhs);
+        self.compact_of(k).solve(rhs);
         Ok(())
     }
 
-    /// Zeroes the entries of component `k` held at zero (fixed or inactive).
-    fn mask(&self, k: usize, rhs: &mut [T]) {
-        let fixed = &self.fixed[self.solver_of[k]];
-        for (i, r) in rhs.iter_mut().enumerate() {
-            if fixed[i] || self.inactive[i] {
-                *r = T::zero();
-            }
-        }
-    }
-
-    /// The factorisations of the distinct fixed sets `a ≠ b`, each with its
-    /// compact system, borrowed apart (to solve them side by side).
-    #[allow(clippy::type_complexity)]
-    fn two_sets(
-        &mut self,
-        a: usize,
-        b: usize,
-    ) -> (
-        (&mut Option<SparseCholesky<T>>, &mut Option<Compact<T>>),
-        (&mut Option<SparseCholesky<T>>, &mut Option<Compact<T>>),
-    ) {
-        let (low, high) = self.solvers.split_at_mut(a.max(b));
-        let (clow, chigh) = self.compact.split_at_mut(a.max(b));
-        let lower = (&mut low[a.min(b)], &mut clow[a.min(b)]);
-        let higher = (&mut high[0], &mut chigh[0]);
+    /// The compact systems of the distinct fixed sets `a ≠ b`, borrowed apart (to
+    /// solve them side by side).
+    fn two_sets(&mut self, a: usize, b: usize) -> (&mut Compact<T>, &mut Compact<T>) {
+        let (low, high) = self.compact.split_at_mut(a.max(b));
+        let lower = low[a.min(b)].as_mut();
+        let higher = high[0].as_mut();
+        let (lower, higher) = (
+            lower.expect("solve before a successful factorisation"),
+            higher.expect("solve before a successful factorisation"),
+        );
         if a < b {
             (lower, higher)
         } else {
@@ -466,21 +373,14 @@ impl<T: Scalar> MaskedCholesky<T> {
     /// [`solve`](Self::solve) for every component; two components with different
     /// fixed sets (two factorisations) are solved side by side on the pool.
     pub fn solve_all(&mut self, rhs: &mut [Vec<T>]) -> Result<(), MassError> {
-        // A compact system zeroes the rows it does not keep itself.
-        for (k, r) in rhs.iter_mut().enumerate() {
-            if self.compact[self.solver_of[k]].is_none() {
-                self.mask(k, r);
-            }
-        }
         match (rhs, self.solver_of.as_slice()) {
             ([r0, r1], &[a, b]) if a != b => {
-                let ((s0, c0), (s1, c1)) = self.two_sets(a, b);
-                rayon::join(|| solve_one(s0, c0, r0), || solve_one(s1, c1, r1));
+                let (c0, c1) = self.two_sets(a, b);
+                rayon::join(|| c0.solve(r0), || c1.solve(r1));
             }
             (rhs, _) => {
                 for (k, r) in rhs.iter_mut().enumerate() {
-                    let s = self.solver_of[k];
-                    solve_one(&mut self.solvers[s], &mut self.compact[s], r);
+                    self.compact_of(k).solve(r);
                 }
             }
         }
@@ -494,50 +394,27 @@ impl<T: Scalar> MaskedCholesky<T> {
         first: &mut [Vec<T>],
         second: &mut [Vec<T>],
     ) -> Result<(), MassError> {
-        for (k, (a, b)) in first.iter_mut().zip(second.iter_mut()).enumerate() {
-            if self.compact[self.solver_of[k]].is_none() {
-                self.mask(k, a);
-                self.mask(k, b);
-            }
-        }
         match (first, second, self.solver_of.as_slice()) {
             ([a0, a1], [b0, b1], &[a, b]) if a != b => {
-                let ((s0, c0), (s1, c1)) = self.two_sets(a, b);
-                rayon::join(|| solve_two(s0, c0, a0, b0), || solve_two(s1, c1, a1, b1));
+                let (c0, c1) = self.two_sets(a, b);
+                rayon::join(|| c0.solve_two(a0, b0), || c1.solve_two(a1, b1));
             }
             (first, second, _) => {
                 for (k, (a, b)) in first.iter_mut().zip(second.iter_mut()).enumerate() {
-                    let s = self.solver_of[k];
-                    solve_two(&mut self.solvers[s], &mut self.compact[s], a, b);
+                    self.compact_of(k).solve_two(a, b);
                 }
             }
         }
         Ok(())
     }
 
-    /// `λ_max` of `M'` by power iteration, `λ_min` by inverse iteration with the
-    /// factorisation; the largest ratio over the fixed sets.
-    pub fn condition_estimate(&mut self, pattern: &SymmetricPattern) -> f64 {
-        let mut worst = 0.0f64;
-        for s in 0..self.solvers.len() {
-            if let Some(compact) = self.compact[s].as_mut() {
-                worst = worst.max(compact.condition_estimate());
-                continue;
-            }
-            // Not factorised whole yet: nothing to estimate.
-            let (values, Some(solver)) = (&self.modified[s], self.solvers[s].as_mut()) else {
-                continue;
-            };
-            let mut op = Operator {
-                apply: &mut |x: &[T], y: &mut [T]| pattern.mul_vec(values, x, y),
-                solve: &mut |y: &mut [T]| {
-                    solver.solve_in_place(y, 1);
-                    Ok(())
-                },
-            };
-            let [x, y] = &mut self.work;
-            worst = worst.max(estimate(&mut op, x, y));
-        }
-        worst
+    /// `λ_max` of `M'` on the kept rows by power iteration, `λ_min` by inverse
+    /// iteration with the factorisation; the largest ratio over the fixed sets.
+    pub fn condition_estimate(&mut self, _pattern: &SymmetricPattern) -> f64 {
+        self.compact
+            .iter_mut()
+            .flatten()
+            .map(|c| c.condition_estimate())
+            .fold(0.0, f64::max)
     }
 }

@@ -42,16 +42,16 @@ pub(crate) struct Footprint {
     /// Bytes per element the driver allocates: the mass pattern, the factorisation
     /// and the per-function buffers.
     pub driver_per_element: f64,
-    /// [`Footprint::driver_per_element`] for a body too small to factorise the
-    /// whole pattern ([`certainly_compact`]): the masked strategies then factorise
-    /// only the rows the body covers (`mass::masked`).
+    /// [`Footprint::driver_per_element`] for a body that covers under a quarter
+    /// of the functions ([`certainly_compact`]): the masked strategies factorise
+    /// only the rows a body covers (`mass::masked`), so their factor stays small.
     pub compact_driver_per_element: f64,
 }
 
-/// Whether `particles` on a mesh of `elements` elements certainly cover fewer
-/// rows than the masked mass systems factorise alone (`mass::masked`, a quarter
-/// of the functions), wherever they go, so that no factorisation of the whole
-/// pattern is made: a particle touches at most the functions of the elements
+/// Whether `particles` on a mesh of `elements` elements certainly cover under a
+/// quarter of the functions, wherever they go, so that the masked mass systems,
+/// factorised on the rows a body covers (`mass::masked`), stay far smaller than
+/// the whole pattern's: a particle touches at most the functions of the elements
 /// around one vertex (about 21 for PS and 7 for PL, on the usual 6 triangles
 /// there), against about 1.5 functions per triangle (PS; 0.5 for PL), so the
 /// rows a body covers are at most 14 times its particles over the elements, as a
@@ -65,8 +65,8 @@ impl Footprint {
     /// elements cost less).
     pub fn of(basis: BasisKind, mass: MassKind) -> Footprint {
         let lumped = mass == MassKind::Lumped;
-        // (per particle, basis per element, driver per element: lumped, the
-        // whole pattern factorised, a compact system only.)
+        // (per particle, basis per element, driver per element: lumped, a
+        // body over the whole mesh factorised, a body under a quarter of it.)
         let (per_particle, basis_per_element, (lumped_driver, whole, compact)) = match basis {
             BasisKind::Ps => (450.0, 2_100.0, (700.0, 3_200.0, 1_800.0)),
             BasisKind::Pl => (330.0, 500.0, (150.0, 600.0, 450.0)),
@@ -81,8 +81,8 @@ impl Footprint {
     }
 
     /// Bytes per element still to allocate: all of them before the basis is built,
-    /// the driver's after; `compact`: the body certainly factorises no whole
-    /// pattern ([`certainly_compact`]).
+    /// the driver's after; `compact`: the body certainly covers under a quarter
+    /// of the functions ([`certainly_compact`]).
     pub fn per_element(&self, basis_built: bool, compact: bool) -> f64 {
         let driver = if compact {
             self.compact_driver_per_element
@@ -532,7 +532,7 @@ t_end = 1e-4
             "{}",
             e.message
         );
-        // A small body on that mesh factorises no whole pattern: the compact
+        // A small body on that mesh covers under a quarter of the functions: the compact
         // figure, unless bodies placed later may cover more.
         let small_body = Counts {
             bodies: vec![("body[0].per_block".into(), 144.0)],
