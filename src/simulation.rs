@@ -171,6 +171,12 @@ pub struct Summary {
     /// serialised when false.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
+    /// Deactivation held functions with particles at zero velocity that the
+    /// bodies' motion needed (its warning, [`deactivation_warning`]): stable in
+    /// energy, but the bodies hang from or rest on them as on a wall, which the
+    /// verdict does not see. Not serialised when false.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub held_by_deactivation: bool,
     /// Each tracked particle's (`output.tracked`) starting position and its
     /// displacement at the end of the run, in the scene's order (`mpm-cli
     /// compare` prints the first). Not in the JSON summary (`tracked.csv` holds
@@ -2001,6 +2007,11 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
             })
             .collect()
     };
+    let held_by_deactivation = deactivation_warning(
+        &tally.deactivation,
+        &tally.held,
+        &driver.mass_strategy().spec(),
+    );
     let self_weight = self_weight_warning(
         scene.gravity().as_deref(),
         &driver.particles,
@@ -2167,11 +2178,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                     tally.verdict.scale(),
                     scene.contact_walls() || scene.boundaries.iter().any(|b| !b.fix.is_empty()),
                 ))
-                .chain(deactivation_warning(
-                    &tally.deactivation,
-                    &tally.held,
-                    &driver.mass_strategy().spec(),
-                ))
+                .chain(held_by_deactivation.clone())
                 .chain(tracked_warnings(scene, &driver.particles, &tally.tracked))
                 .chain(crate::arrangement::irregularity_warning(
                     &irregularity,
@@ -2205,6 +2212,7 @@ fn summarise<const D: usize, B: Basis<f64, D>>(
                 )
                 .collect(),
             interrupted: tally.interrupted,
+            held_by_deactivation: held_by_deactivation.is_some(),
             tracked_end: tally
                 .tracked
                 .iter()

@@ -184,14 +184,22 @@ const CSV_COLUMNS: [&str; 10] = [
     "failure",
 ];
 
+/// Whether `s` is a run of a 1D basis (its tracked particle has no y).
+fn one_dimensional(s: &Summary) -> bool {
+    psmpm::bases::BasisKind::parse(s.basis).is_ok_and(|b| b.dim() == 1)
+}
+
 /// The table's verdict on a run: `stopped` (it failed; the line below the table
 /// says why), `yes, in pieces` (stable in energy, with a body broken up: the
-/// warnings say how), `yes` or `NO`.
+/// warnings say how), `yes, held` (stable in energy, with bodies held by
+/// deactivated functions: a student's falling block hung in mid-air under
+/// `yes`), `yes` or `NO`.
 fn verdict(s: &Summary) -> &'static str {
     match (s.stable, s.failure.is_some()) {
         (_, true) => "stopped",
         _ if s.interrupted => "interrupted",
         (true, false) if s.came_apart() => "yes, in pieces",
+        (true, false) if s.held_by_deactivation => "yes, held",
         (true, false) => "yes",
         (false, false) => "NO",
     }
@@ -362,9 +370,18 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
                     s.pieces[1].to_string(),
                     s.stray[1].to_string(),
                     tracked(|t| t.0[0]),
-                    tracked(|t| t.0[1]),
+                    // A 1D run has no y: empty, as without `output.tracked`.
+                    if one_dimensional(s) {
+                        String::new()
+                    } else {
+                        tracked(|t| t.0[1])
+                    },
                     tracked(|t| t.1[0]),
-                    tracked(|t| t.1[1]),
+                    if one_dimensional(s) {
+                        String::new()
+                    } else {
+                        tracked(|t| t.1[1])
+                    },
                     s.failure.clone().unwrap_or_default(),
                 ];
                 println!("{}", crate::out::csv_record(&record));
@@ -444,6 +461,13 @@ pub fn print_summaries(summaries: &[Summary], format: Format, side_by_side: bool
                     println!(
                         "the variants run at different time steps (`courant` sets each one's \
                          from its own critical step): give --dt to compare them at one step"
+                    );
+                }
+                if summaries.iter().any(|s| s.stable && s.held_by_deactivation) {
+                    println!(
+                        "yes, held: stable in energy, but deactivated functions held particles at \
+                         zero velocity, so the bodies hang from or rest on them as on a wall (the \
+                         warning above): their motion is not the scene's"
                     );
                 }
                 if summaries.iter().any(|s| s.max_condition.is_none()) {

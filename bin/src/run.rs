@@ -1163,6 +1163,9 @@ pub fn summary_text(summary: &Summary) -> String {
             // The energy verdict does not see a body broken up (the warnings say
             // how): said on the verdict's own line.
             &came_apart
+        } else if summary.stable && summary.held_by_deactivation {
+            // Likewise bodies held by deactivated functions.
+            "stable in energy, but deactivated functions held the bodies as a wall would: see the warnings"
         } else if summary.stable && summary.max_condition.is_none() {
             "stable (energy; condition not measured, see --condition)"
         } else if summary.stable {

@@ -1281,3 +1281,41 @@ fn compare_prints_a_warning_shared_by_variants_once() {
         "{stderr}"
     );
 }
+
+/// `compare --format csv` leaves the y columns of a 1D run's tracked particle
+/// empty (a teacher's 1D comparison printed `tracked_y0 = 0`, `tracked_uy = 0`).
+#[test]
+fn compare_csv_of_a_1d_scene_has_no_tracked_y() {
+    let scene = format!(
+        "{}/../docs/examples/student-bar-1d.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = cli()
+        .args([
+            "compare",
+            &scene,
+            "--basis",
+            "bspline,pl1d",
+            "--format",
+            "csv",
+            "--t-end",
+            "0.001",
+        ])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let mut lines = stdout.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{stdout}");
+    for row in &rows {
+        assert!(!row[column("tracked_x0")].is_empty(), "{stdout}");
+        assert!(!row[column("tracked_ux")].is_empty(), "{stdout}");
+        assert!(row[column("tracked_y0")].is_empty(), "{stdout}");
+        assert!(row[column("tracked_uy")].is_empty(), "{stdout}");
+    }
+}

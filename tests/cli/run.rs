@@ -2572,6 +2572,54 @@ t_end = 0.05
         "{warned}"
     );
     assert_eq!(warning("deactivate:3e-5"), None);
+    // The verdict's line says it too, and `compare` marks the variant (a
+    // student's table said `yes` for a block hanging in mid-air).
+    let (stdout, _) = succeeds(&[
+        "run",
+        file.arg(),
+        "--mass",
+        "deactivate",
+        "--diag-every",
+        "0",
+    ]);
+    assert!(
+        stdout.contains(
+            "stable in energy, but deactivated functions held the bodies as a wall would"
+        ),
+        "{stdout}"
+    );
+    let (stdout, _) = succeeds(&[
+        "run",
+        file.arg(),
+        "--mass",
+        "deactivate",
+        "--diag-every",
+        "0",
+        "--format",
+        "json",
+    ]);
+    let summary: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(
+        summary["held_by_deactivation"],
+        serde_json::Value::Bool(true)
+    );
+    let (stdout, _) = succeeds(&[
+        "compare",
+        file.arg(),
+        "--mass",
+        "deactivate,default",
+        "--jobs",
+        "1",
+    ]);
+    let rows: Vec<&str> = stdout.lines().filter(|l| l.contains("  ps  ")).collect();
+    assert!(
+        rows.len() == 2 && rows[0].contains("yes, held") && !rows[1].contains("held"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("yes, held: stable in energy, but deactivated functions"),
+        "{stdout}"
+    );
     // A heavier block (density 100) keeps its functions until it falls into
     // elements whose functions it barely covers: deactivated, they take zero
     // velocity and it rebounds from them in mid-air (14 of 108 at t = 0.1).
