@@ -47,7 +47,7 @@ pub struct PlotArgs {
     #[arg(long, default_value = "incentre")]
     split: String,
     /// PS: the mirror line the control triangles keep where a vertex is symmetric
-    /// about both axes: vertical or horizontal.
+    /// about both axes: vertical, horizontal, diagonal or anti-diagonal.
     #[arg(long, value_name = "LINE", default_value = "vertical")]
     mirror_line: String,
     /// Draw only the part of the mesh in the rectangle [X0, X1] × [Y0, Y1] (the

@@ -34,7 +34,8 @@ pub struct Overrides {
     #[arg(long)]
     pub split: Option<String>,
     /// PS: the mirror line the basis keeps where a vertex is symmetric about both
-    /// axes (block grids): vertical (default) or horizontal, the scene's own.
+    /// axes (block grids): vertical (default), horizontal, diagonal (y − x =
+    /// const) or anti-diagonal (x + y = const), the scene's own.
     #[arg(long, value_name = "LINE")]
     pub mirror_line: Option<String>,
     /// Triangulation of each block: four-triangles (the seeds' grid) or delaunay

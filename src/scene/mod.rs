@@ -103,7 +103,8 @@ pub struct Scene {
     pub split: SplitPoint,
     /// PS: the mirror line the control triangle keeps at a vertex whose PS points
     /// are mirror-symmetric about both axis-aligned lines through it (the interior
-    /// vertices of the block grids), `vertical` or `horizontal`: the scene's own
+    /// vertices of the block grids), `vertical`, `horizontal`, `diagonal` or
+    /// `anti-diagonal` (the 45° lines of a square grid): the scene's own
     /// mirror line, so that the mass strategies keep its symmetry
     /// ([`psmpm_basis::basis::powell_sabin::MirrorAxis`]). PL: with `horizontal`, a
     /// particle on an element edge is held by the triangle

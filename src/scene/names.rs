@@ -71,21 +71,25 @@ pub(super) mod mirror_line_name {
     }
 }
 
-/// `vertical` or `horizontal`.
+/// `vertical`, `horizontal`, `diagonal` or `anti-diagonal`.
 pub fn mirror_line_to_str(m: MirrorAxis) -> &'static str {
     match m {
         MirrorAxis::Vertical => "vertical",
         MirrorAxis::Horizontal => "horizontal",
+        MirrorAxis::Diagonal => "diagonal",
+        MirrorAxis::AntiDiagonal => "anti-diagonal",
     }
 }
 
-/// Parses `vertical` or `horizontal`.
+/// Parses `vertical`, `horizontal`, `diagonal` or `anti-diagonal`.
 pub fn parse_mirror_line(name: &str) -> Result<MirrorAxis, String> {
     match name {
         "vertical" => Ok(MirrorAxis::Vertical),
         "horizontal" => Ok(MirrorAxis::Horizontal),
+        "diagonal" => Ok(MirrorAxis::Diagonal),
+        "anti-diagonal" => Ok(MirrorAxis::AntiDiagonal),
         other => Err(format!(
-            "unknown mirror line `{}` (known: vertical, horizontal)",
+            "unknown mirror line `{}` (known: vertical, horizontal, diagonal, anti-diagonal)",
             super::limits::echo(other)
         )),
     }

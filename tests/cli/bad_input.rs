@@ -607,8 +607,8 @@ fn unknown_name_cases() -> Vec<Case> {
             .edit("split = \"incentre\"", "split = @@\"orthocentre\"")
             .expect("split: unknown split point `orthocentre` (known: incentre, centroid)"),
         case("unknown-mirror-line", BAR)
-            .edit("split = \"incentre\"", "split = \"incentre\"\nmirror_line = @@\"diagonal\"")
-            .expect("mirror_line: unknown mirror line `diagonal` (known: vertical, horizontal)"),
+            .edit("split = \"incentre\"", "split = \"incentre\"\nmirror_line = @@\"oblique\"")
+            .expect("mirror_line: unknown mirror line `oblique` (known: vertical, horizontal, diagonal, anti-diagonal)"),
         case("unknown-resolution-basis", BAR)
             .edit("basis = \"pl\"", "basis = @@\"quadratic\"")
             .expect("resolution[0].basis: unknown basis `quadratic` (known: ps, pl, bspline, pl1d)"),

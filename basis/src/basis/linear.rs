@@ -108,7 +108,7 @@ impl<T: Real> Basis<T, 2> for Linear<T> {
             // Location's own choice (the lowest-numbered triangle, then the walk's
             // first) keeps vertical mirror lines on the block grids
             // (`tests/symmetry.rs`), and scenes keep the results they had.
-            MirrorAxis::Vertical => t,
+            MirrorAxis::Vertical | MirrorAxis::Diagonal | MirrorAxis::AntiDiagonal => t,
             MirrorAxis::Horizontal => self.mesh.triangle_kept_at(t, p, self.mirror),
         })
     }

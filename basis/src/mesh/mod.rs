@@ -544,6 +544,19 @@ impl TriMesh {
             match axis {
                 MirrorAxis::Vertical => (d.y.abs() - d.x.abs(), centroid.y, d.norm()),
                 MirrorAxis::Horizontal => (d.x.abs() - d.y.abs(), centroid.x, d.norm()),
+                // Along (`x + y`) and across (`y − x`) a 45° line: its mirror keeps
+                // the first and turns the second, as the horizontal one does with
+                // `x` and `y` (the anti-diagonal's the other way round).
+                MirrorAxis::Diagonal => (
+                    (d.x + d.y).abs() - (d.y - d.x).abs(),
+                    centroid.x + centroid.y,
+                    d.norm(),
+                ),
+                MirrorAxis::AntiDiagonal => (
+                    (d.y - d.x).abs() - (d.x + d.y).abs(),
+                    centroid.y - centroid.x,
+                    d.norm(),
+                ),
             }
         };
         let mut best = t;
@@ -598,6 +611,12 @@ pub enum MirrorAxis {
     /// A line `y = const`: a scene symmetric top to bottom (bodies striking each
     /// other along `x` about a horizontal mid-line, gravity along `x` or none).
     Horizontal,
+    /// A line `y − x = const`: a scene symmetric about a 45° line (two disks
+    /// striking each other along the diagonal of a square, no gravity). PS only:
+    /// PL keeps point location's own triangle on an edge.
+    Diagonal,
+    /// A line `x + y = const`: a scene symmetric about a −45° line.
+    AntiDiagonal,
 }
 
 /// The signed area of triangle (a, b, c), positive when counter-clockwise.
@@ -640,10 +659,7 @@ mod tests {
             (a + b + c) / 3.0
         };
         for axis in [MirrorAxis::Vertical, MirrorAxis::Horizontal] {
-            let index = match axis {
-                MirrorAxis::Vertical => 0,
-                MirrorAxis::Horizontal => 1,
-            };
+            let index = usize::from(axis == MirrorAxis::Horizontal);
             let mut checked = 0;
             for (i, j) in (0..16).flat_map(|i| (0..8).map(move |j| (i, j))) {
                 let corner = Vec2::new(0.25 * i as f64, 0.25 * j as f64);

@@ -8,7 +8,8 @@
 //! - every triple of hull lines whose half-planes bound a triangle.
 //!
 //! The candidate of smallest area wins, except where the PS points are
-//! mirror-symmetric about the vertical or the horizontal line through `V_i`:
+//! mirror-symmetric about the vertical or the horizontal line through `V_i` (or a
+//! diagonal one, where the scene asks for it):
 //! there the smallest candidate with the same mirror symmetry wins (the
 //! [`MirrorAxis`] asked for where the points have both), so that a mesh
 //! symmetric about a line gets a basis symmetric about it (the smallest triangle of
@@ -290,13 +291,30 @@ enum Mirror {
     Vertical,
     /// The line `y = vertex.y`.
     Horizontal,
+    /// The line `y − vertex.y = x − vertex.x`.
+    Diagonal,
+    /// The line `y − vertex.y = −(x − vertex.x)`.
+    AntiDiagonal,
 }
 
 impl Mirror {
     fn reflect(self, vertex: Vec2, p: Vec2) -> Vec2 {
+        let d = p - vertex;
         match self {
             Mirror::Vertical => Vec2::new(2.0 * vertex.x - p.x, p.y),
             Mirror::Horizontal => Vec2::new(p.x, 2.0 * vertex.y - p.y),
+            Mirror::Diagonal => vertex + Vec2::new(d.y, d.x),
+            Mirror::AntiDiagonal => vertex - Vec2::new(d.y, d.x),
+        }
+    }
+
+    /// The unit direction of a diagonal line (`None` for the axis-aligned ones).
+    fn diagonal_direction(self) -> Option<Vec2> {
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        match self {
+            Mirror::Diagonal => Some(Vec2::new(r, r)),
+            Mirror::AntiDiagonal => Some(Vec2::new(r, -r)),
+            _ => None,
         }
     }
 
@@ -308,16 +326,81 @@ impl Mirror {
         })
     }
 
-    /// The mirror of the vertex's PS points, if they have one; `axis` first.
+    /// The mirror of the vertex's PS points, if they have one; `axis` first. The
+    /// diagonal lines are tried only where the scene asks for one (the other
+    /// scenes keep the triangles they had); a vertex whose points have no
+    /// diagonal mirror (on a boundary along an axis) keeps an axis-aligned one,
+    /// which a diagonal mirror of the mesh maps onto its partner's.
     fn of(vertex: Vec2, points: &[Vec2], tol: f64, axis: MirrorAxis) -> Option<Mirror> {
-        let order = match axis {
-            MirrorAxis::Vertical => [Mirror::Vertical, Mirror::Horizontal],
-            MirrorAxis::Horizontal => [Mirror::Horizontal, Mirror::Vertical],
+        use Mirror::{AntiDiagonal, Diagonal, Horizontal, Vertical};
+        let order: &[Mirror] = match axis {
+            MirrorAxis::Vertical => &[Vertical, Horizontal],
+            MirrorAxis::Horizontal => &[Horizontal, Vertical],
+            MirrorAxis::Diagonal => &[Diagonal, AntiDiagonal, Vertical, Horizontal],
+            MirrorAxis::AntiDiagonal => &[AntiDiagonal, Diagonal, Vertical, Horizontal],
         };
         order
-            .into_iter()
+            .iter()
+            .copied()
             .find(|m| m.maps_onto_itself(vertex, points, tol))
     }
+}
+
+/// The smallest isosceles triangles symmetric about the line through `vertex`
+/// along the unit vector `a` that contain `points`, one pointing each way along
+/// it, with its base orthogonal to the line on the farthest point behind. The
+/// hull lines give no symmetric candidate about a diagonal around a square of PS
+/// points whose corners lie on the axes (the valence-4 block centres of the
+/// `blocks` grids): its edges mirrored about the diagonal are parallel. With `u`
+/// along the line and `w` across it, the apex at `u_A` beyond every point and the
+/// base at `u_b`, the half-width grows as `s (u_A − u)`, `s = max |w_p| / (u_A −
+/// u_p)`, and the area `s (u_A − u_b)²` is convex in `u_A`: its minimum is at a
+/// stationary point of one point's term (`u_A = 2 u_p − u_b`) or where two terms
+/// cross, all of which are tried.
+fn isosceles_candidates(vertex: Vec2, a: Vec2, points: &[Vec2]) -> Vec<[Vec2; 3]> {
+    let b = Vec2::new(-a.y, a.x);
+    let mut out = Vec::new();
+    for sign in [1.0, -1.0] {
+        let (a, b) = (a * sign, b * sign);
+        let uw: Vec<(f64, f64)> = points
+            .iter()
+            .map(|p| ((p - vertex).dot(&a), (p - vertex).dot(&b).abs()))
+            .collect();
+        let base = uw.iter().fold(f64::INFINITY, |m, &(u, _)| m.min(u));
+        let top = uw.iter().fold(f64::NEG_INFINITY, |m, &(u, _)| m.max(u));
+        let scale = top - base;
+        if scale <= 0.0 {
+            continue;
+        }
+        let slope = |apex: f64| {
+            uw.iter()
+                .filter(|&&(_, w)| w > 0.0)
+                .fold(0.0f64, |m, &(u, w)| m.max(w / (apex - u)))
+        };
+        let mut apexes: Vec<f64> = uw.iter().map(|&(u, _)| 2.0 * u - base).collect();
+        for (i, &(ui, wi)) in uw.iter().enumerate() {
+            for &(uj, wj) in &uw[i + 1..] {
+                if (wi - wj).abs() > 1e-12 * scale {
+                    apexes.push((wi * uj - wj * ui) / (wi - wj));
+                }
+            }
+        }
+        let best = apexes
+            .into_iter()
+            .filter(|&apex| apex > top + 1e-9 * scale)
+            .map(|apex| (apex, slope(apex) * (apex - base) * (apex - base)))
+            .filter(|&(_, area)| area > 0.0 && area.is_finite())
+            .min_by(|x, y| x.1.total_cmp(&y.1));
+        if let Some((apex, _)) = best {
+            let half = slope(apex) * (apex - base);
+            out.push([
+                vertex + a * apex,
+                vertex + a * base + b * half,
+                vertex + a * base - b * half,
+            ]);
+        }
+    }
+    out
 }
 
 /// The smallest candidate (wedge or triple of hull lines) containing `points`; with
@@ -364,6 +447,12 @@ fn smallest_candidate(
             best_mirrored = Some((t, a));
         }
     };
+    // About a diagonal line the hull lines may give no symmetric candidate.
+    if let (None, Some(a)) = (required, mirror.and_then(Mirror::diagonal_direction)) {
+        for t in isosceles_candidates(vertex, a, points) {
+            consider(t);
+        }
+    }
     let n = lines.len();
     for i in 0..n {
         for j in i + 1..n {

@@ -1053,6 +1053,16 @@ mod tests {
             m[axis] = [4.0, 3.0][axis] - p[axis];
             m
         };
+        symmetric_under(ps, [4.0, 3.0], mirror)
+    }
+
+    /// Whether `ps` on a grid of `size` is symmetric under the reflection
+    /// `mirror` (see [`mirror_symmetric`]).
+    fn symmetric_under(
+        ps: &PowellSabin<f64>,
+        size: [f64; 2],
+        mirror: impl Fn(Vec2) -> Vec2,
+    ) -> Result<(), String> {
         let vertices = ps.mesh().vertices();
         let mut image = Vec::with_capacity(ps.num_functions());
         for i in 0..ps.num_functions() {
@@ -1072,8 +1082,8 @@ mod tests {
         for k in 0..400 {
             // A deterministic scatter over the domain (additive recurrence).
             let x = Vec2::new(
-                4.0 * (0.5 + k as f64 * 0.618_033_988_749_895).fract(),
-                3.0 * (0.5 + k as f64 * 0.754_877_666_246_693).fract(),
+                size[0] * (0.5 + k as f64 * 0.618_033_988_749_895).fract(),
+                size[1] * (0.5 + k as f64 * 0.754_877_666_246_693).fract(),
             );
             let (ea, eb) = (
                 ps.locate(&x, None).unwrap(),
@@ -1119,6 +1129,35 @@ mod tests {
         // Each keeps only its own line.
         assert!(mirror_symmetric(&vertical, 1).is_err());
         assert!(mirror_symmetric(&horizontal, 0).is_err());
+    }
+
+    /// A square block grid is symmetric about its diagonals too: with
+    /// [`MirrorAxis::Diagonal`] (or `AntiDiagonal`) the basis keeps that line (two
+    /// disks striking each other along the diagonal of a square). The block
+    /// centres' control triangles come from `control_triangle`'s isosceles
+    /// candidates, which the hull lines do not give there.
+    #[test]
+    fn a_square_grid_has_a_basis_symmetric_about_the_diagonal_asked_for() {
+        let mesh = generators::block_grid(0.0, 3.0, 0.0, 3.0, 3, 3).unwrap();
+        let diagonal = |p: Vec2| Vec2::new(p.y, p.x);
+        let anti = |p: Vec2| Vec2::new(3.0 - p.y, 3.0 - p.x);
+        for (axis, keeps) in [(MirrorAxis::Diagonal, 0), (MirrorAxis::AntiDiagonal, 1)] {
+            let ps =
+                PowellSabin::<f64>::with_mirror(mesh.clone(), SplitPoint::Incentre, axis).unwrap();
+            let result = [
+                symmetric_under(&ps, [3.0, 3.0], diagonal),
+                symmetric_under(&ps, [3.0, 3.0], anti),
+            ];
+            if let Err(e) = &result[keeps] {
+                panic!("{axis:?}: {e}");
+            }
+            assert!(result[1 - keeps].is_err(), "{axis:?}");
+            let (pu, min) = (check::partition_of_unity(&ps), check::min_value(&ps));
+            assert!(pu < 1e-12 && min > -1e-12, "{pu:e} {min:e}");
+            assert!(check::linear_precision(&ps).0 < 1e-12);
+        }
+        let vertical = PowellSabin::<f64>::new(mesh, SplitPoint::Incentre).unwrap();
+        assert!(symmetric_under(&vertical, [3.0, 3.0], diagonal).is_err());
     }
 
     #[test]
