@@ -377,6 +377,22 @@ impl<T: Scalar> SparseCholesky<T> {
         }
     }
 
+    /// Column pointers of the upper triangle this factorisation was made for.
+    pub fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+
+    /// Row indices of the upper triangle this factorisation was made for.
+    pub fn row_idx(&self) -> &[usize] {
+        &self.row_idx
+    }
+
+    /// [`col_ptr`](Self::col_ptr) and [`row_idx`](Self::row_idx) shared
+    /// (reference-counted, no copy), to read while the factorisation is used.
+    pub fn shared_pattern(&self) -> (Arc<[usize]>, Arc<[usize]>) {
+        (self.col_ptr.clone(), self.row_idx.clone())
+    }
+
     /// Whether this factorisation was made for the upper pattern `col_ptr`, `row_idx`.
     pub fn has_pattern(&self, col_ptr: &[usize], row_idx: &[usize]) -> bool {
         *self.col_ptr == *col_ptr && *self.row_idx == *row_idx

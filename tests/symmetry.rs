@@ -286,47 +286,21 @@ fn a_scene_symmetric_about_a_horizontal_line_stays_symmetric_with_that_mirror_li
 }
 
 /// Two elastic disks striking each other along the diagonal of a square (Sulsky
-/// et al. 1994; a user's scene of 2026-12-08, here on 10 × 10 blocks): the scene
+/// et al. 1994; a user's scene of 2026-12-08, `docs/examples/sulsky-disks.toml`,
+/// to t = 2.5): the scene
 /// is symmetric about the line `y = x` it moves along, and the block grid is
 /// too, but a PS basis keeping the vertical line at its block corners and
 /// centres is not. With `mirror_line = "diagonal"` every particle ends at the
 /// mirror image of its partner's about `y = x`, within what round-off makes of
 /// the default's thresholds (the disks measured 1.9e-2 off with `vertical`).
 fn disks_along_the_diagonal(mass: &str, mirror_line: &str) -> Scene {
-    let text = format!(
-        r#"
-name = "disks-along-the-diagonal"
-dim = 2
-basis = "ps"
-mass = "{mass}"
-mirror_line = "{mirror_line}"
-[mesh]
-kind = "blocks"
-x = [0.0, 1.0]
-y = [0.0, 1.0]
-blocks = [10, 10]
-[material]
-young = 1000.0
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "disk"
-centre = [0.2, 0.2]
-radius = 0.2
-count = [16, 16]
-initial_velocity = {{ kind = "uniform", value = [0.1, 0.1] }}
-[[body]]
-shape = "disk"
-centre = [0.8, 0.8]
-radius = 0.2
-count = [16, 16]
-initial_velocity = {{ kind = "uniform", value = [-0.1, -0.1] }}
-[time]
-courant = 0.5
-t_end = 2.5
-"#
-    );
-    Scene::from_toml(&text, "disks-along-the-diagonal.toml").unwrap()
+    let text = include_str!("../docs/examples/sulsky-disks.toml")
+        .replace(
+            "\nmirror_line = \"diagonal\"\n",
+            &format!("\nmirror_line = \"{mirror_line}\"\nmass = \"{mass}\"\n"),
+        )
+        .replace("t_end = 3.5", "t_end = 2.5");
+    Scene::from_toml(&text, "sulsky-disks.toml").unwrap()
 }
 
 #[test]

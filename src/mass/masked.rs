@@ -63,12 +63,12 @@ pub(super) fn modify_rows<T: Scalar>(
 struct Compact<T: Scalar> {
     /// The kept rows, ascending.
     rows: Vec<usize>,
-    /// Upper triangle in compressed columns over the kept rows.
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    /// Per compact entry, the position of its entry in the full pattern.
-    source: Vec<usize>,
+    /// Per compact entry, the position of its entry in the full pattern (the
+    /// pattern holds fewer than `u32::MAX` entries: `SymmetricPattern::new`).
+    source: Vec<u32>,
     values: Vec<T>,
+    /// The factorisation of the upper triangle over the kept rows, which holds
+    /// that triangle's pattern (`col_ptr`, `row_idx`).
     solver: SparseCholesky<T>,
     /// Right-hand side and work vectors over the kept rows.
     rhs: Vec<T>,
@@ -94,7 +94,7 @@ impl<T: Scalar> Compact<T> {
                 let q = slot[idx[k]];
                 if q != usize::MAX {
                     row_idx.push(q);
-                    source.push(k);
+                    source.push(k as u32);
                 }
             }
             col_ptr.push(row_idx.len());
@@ -103,14 +103,12 @@ impl<T: Scalar> Compact<T> {
             slot[i] = usize::MAX;
         }
         let m = rows.len();
-        let solver = SparseCholesky::from_upper(col_ptr.clone(), row_idx.clone(), 2);
+        let solver = SparseCholesky::from_upper(col_ptr, row_idx, 2);
         Compact {
             values: vec![T::zero(); source.len()],
             rhs: vec![T::zero(); 2 * m],
             work: [vec![T::zero(); m], vec![T::zero(); m]],
             rows,
-            col_ptr,
-            row_idx,
             source,
             solver,
         }
@@ -129,9 +127,10 @@ impl<T: Scalar> Compact<T> {
         for &i in &self.rows {
             diagonal_add[i] = T::zero();
         }
+        let col_ptr = self.solver.col_ptr();
         for (q, &c) in self.rows.iter().enumerate() {
-            for t in self.col_ptr[q]..self.col_ptr[q + 1] {
-                let k = self.source[t];
+            for t in col_ptr[q]..col_ptr[q + 1] {
+                let k = self.source[t] as usize;
                 let r = idx[k];
                 self.values[t] = if r == c {
                     values[k]
@@ -142,7 +141,7 @@ impl<T: Scalar> Compact<T> {
         }
         for (q, &i) in self.rows.iter().enumerate() {
             // The diagonal is the last entry of its (upper) column.
-            self.values[self.col_ptr[q + 1] - 1] += diagonal_add[i];
+            self.values[col_ptr[q + 1] - 1] += diagonal_add[i];
         }
         self.solver.factorize(&self.values)
     }
@@ -181,10 +180,13 @@ impl<T: Scalar> Compact<T> {
 
     /// The condition estimate of the kept system.
     fn condition_estimate(&mut self) -> f64 {
-        let (col_ptr, row_idx, values) = (&self.col_ptr, &self.row_idx, &self.values);
+        // The pattern is the solver's, shared for the products while the inverse
+        // iteration uses the solver.
+        let (col_ptr, row_idx) = self.solver.shared_pattern();
+        let values = &self.values;
         let solver = &mut self.solver;
         let mut op = Operator {
-            apply: &mut |x: &[T], y: &mut [T]| mul_upper(col_ptr, row_idx, values, x, y),
+            apply: &mut |x: &[T], y: &mut [T]| mul_upper(&col_ptr, &row_idx, values, x, y),
             solve: &mut |y: &mut [T]| {
                 solver.solve_in_place(y, 1);
                 Ok(())

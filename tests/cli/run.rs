@@ -2777,40 +2777,15 @@ t_end = 0.5
 /// same disks with the objective `corotational` law are stable.
 #[test]
 fn energy_gained_by_a_non_objective_law_under_rotation_names_the_law_first() {
+    let example = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/examples/sulsky-disks.toml"
+    ))
+    .unwrap();
     let scene = |model: &str| {
         SceneFile::new(
             &format!("sulsky-{model}"),
-            &format!(
-                r#"name = "sulsky-disks"
-dim = 2
-basis = "ps"
-[mesh]
-kind = "blocks"
-x = [0.0, 1.0]
-y = [0.0, 1.0]
-blocks = [10, 10]
-[material]
-model = "{model}"
-young = 1000.0
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "disk"
-centre = [0.2, 0.2]
-radius = 0.2
-count = [16, 16]
-initial_velocity = {{ kind = "uniform", value = [0.1, 0.1] }}
-[[body]]
-shape = "disk"
-centre = [0.8, 0.8]
-radius = 0.2
-count = [16, 16]
-initial_velocity = {{ kind = "uniform", value = [-0.1, -0.1] }}
-[time]
-courant = 0.5
-t_end = 3.5
-"#
-            ),
+            &example.replace("model = \"corotational\"", &format!("model = \"{model}\"")),
         )
     };
     let run = |file: &SceneFile| {
