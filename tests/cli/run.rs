@@ -2820,36 +2820,17 @@ fn energy_gained_by_a_non_objective_law_under_rotation_names_the_law_first() {
 /// says so for every strategy but the default, which keeps the momentum.
 #[test]
 fn particles_on_pl_edges_warn_that_other_strategies_hold_massless_vertices() {
+    // The users' disks (`docs/examples/sulsky-disks.toml`) with PL, to t = 0.3.
+    let example = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/examples/sulsky-disks.toml"
+    ))
+    .unwrap();
     let file = SceneFile::new(
         "disks-on-diagonals",
-        r#"name = "disks-on-diagonals"
-dim = 2
-basis = "pl"
-[mesh]
-kind = "blocks"
-x = [0.0, 1.0]
-y = [0.0, 1.0]
-blocks = [10, 10]
-[material]
-young = 1000.0
-poisson = 0.3
-density = 1000.0
-[[body]]
-shape = "disk"
-centre = [0.2, 0.2]
-radius = 0.2
-count = [16, 16]
-initial_velocity = { kind = "uniform", value = [0.1, 0.1] }
-[[body]]
-shape = "disk"
-centre = [0.8, 0.8]
-radius = 0.2
-count = [16, 16]
-initial_velocity = { kind = "uniform", value = [-0.1, -0.1] }
-[time]
-courant = 0.5
-t_end = 0.3
-"#,
+        &example
+            .replace("\nbasis = \"ps\"\n", "\nbasis = \"pl\"\n")
+            .replace("t_end = 3.5", "t_end = 0.3"),
     );
     let run = |mass: &str| {
         let out = cli()
