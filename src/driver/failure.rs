@@ -103,15 +103,10 @@ where
             // element holds (a user's thrown block with `partial` stopped at the same
             // time with 3.8 and 13.8 per element).
             let per_element = self.particles_per_occupied_element();
-            let few = format!(
-                "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
-            );
             let fix = if spec.starts_with("extended-hybrid") {
-                few
+                few_particles(per_element)
             } else if per_element < FEW_PER_ELEMENT {
-                format!(
-                    "{few}; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them"
-                )
+                few_particles_or_the_default(per_element)
             } else {
                 format!(
                     "the mass strategy `{spec}` solves for the nearly empty functions at the bodies' edges, which more particles per element do not fill ({per_element:.1} per occupied element here); take the default mass strategy (`mass = \"default\"`), which extends them, or `lumped`"
@@ -760,10 +755,7 @@ where
                     // A matrix of so few particles per element is singular whether
                     // or not the bodies' edges leave functions nearly empty (the
                     // seeds' column at 3 per triangle for the 9 PS functions).
-                    format!(
-                        "{:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them",
-                        self.particles_per_occupied_element()
-                    )
+                    few_particles_or_the_default(self.particles_per_occupied_element())
                 }
                 None => {
                     let spec = self.mass.spec();
@@ -784,6 +776,23 @@ where
             hint,
         }
     }
+}
+
+/// `per_element` particles per occupied element, too few for the functions each
+/// element holds, and the fix.
+fn few_particles(per_element: f64) -> String {
+    format!(
+        "{per_element:.1} particles per occupied element are too few for the functions each element holds; use more particles per element (`per_block` or `count`; `--particles`), or `lumped`"
+    )
+}
+
+/// [`few_particles`], and the default mass strategy for functions a body's edge
+/// leaves nearly empty, which more particles do not fill.
+fn few_particles_or_the_default(per_element: f64) -> String {
+    format!(
+        "{}; where a body's edge leaves functions nearly empty more particles do not fill them, and the default mass strategy (`mass = \"default\"`) extends them",
+        few_particles(per_element)
+    )
 }
 
 /// A triangle's longest edge over its height on that edge (`L² / 2A`; infinite
